@@ -1,0 +1,266 @@
+//! Expressions of the spec: Rust syntax parsed with `syn`, restricted to arithmetic over named
+//! symbols and a few float methods, so that generated code is plain, total and readable.
+
+use quote::ToTokens;
+use std::collections::BTreeSet;
+
+/// Navigation quantities an A or H expression may use, with what they are (SI units).
+/// The generated code binds each one from `NavPoint` (see `nav_accessor`).
+pub const NAV_SYMBOLS: [(&str, &str); 22] = [
+    ("lat", "geodetic latitude [rad]"),
+    ("h", "height above the ellipsoid, up [m]"),
+    ("vn", "north velocity [m/s]"),
+    ("ve", "east velocity [m/s]"),
+    ("vd", "down velocity [m/s]"),
+    ("rm", "meridian radius of curvature plus height, R_M + h [m]"),
+    ("rn", "transverse radius of curvature plus height, R_N + h [m]"),
+    ("omega", "Earth rotation rate [rad/s]"),
+    ("f_n", "north specific force, (C f^b)_N [m/s^2]"),
+    ("f_e", "east specific force [m/s^2]"),
+    ("f_d", "down specific force [m/s^2]"),
+    ("c11", "C_b^n element (1,1)"),
+    ("c12", "C_b^n element (1,2)"),
+    ("c13", "C_b^n element (1,3)"),
+    ("c21", "C_b^n element (2,1)"),
+    ("c22", "C_b^n element (2,2)"),
+    ("c23", "C_b^n element (2,3)"),
+    ("c31", "C_b^n element (3,1)"),
+    ("c32", "C_b^n element (3,2)"),
+    ("c33", "C_b^n element (3,3)"),
+    ("dg_dlat", "normal gravity derivative by latitude [m/s^2/rad]"),
+    ("dg_dh", "normal gravity derivative by height [1/s^2]"),
+];
+
+/// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s].
+pub const IMU_SIGNALS: [&str; 2] = ["f", "w"];
+
+/// Float methods an expression may call.
+pub const METHODS: [&str; 6] = ["sin", "cos", "tan", "abs", "sqrt", "powi"];
+
+/// Where an expression is used, which decides the symbols it may reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExprKind {
+    /// An entry of A or H: navigation symbols only.
+    Navigation,
+    /// A term's regressor: IMU signals only.
+    Regressor,
+}
+
+/// A validated expression.
+#[derive(Debug, Clone)]
+pub struct Expr {
+    /// The expression as written in the spec (trimmed).
+    pub source: String,
+    /// Parsed form.
+    pub ast: syn::Expr,
+}
+
+impl Expr {
+    /// Canonical text (token stream), used to identify equal regressors.
+    pub fn key(&self) -> String {
+        self.ast.to_token_stream().to_string()
+    }
+
+    /// Symbols used: navigation names, or `f.x`-style signal names.
+    pub fn symbols(&self) -> BTreeSet<String> {
+        let mut out = BTreeSet::new();
+        collect(&self.ast, &mut out);
+        out
+    }
+
+    /// True when the expression is the literal `1` or `1.0`.
+    pub fn is_one(&self) -> bool {
+        matches!(self.source.as_str(), "1" | "1.0")
+    }
+}
+
+fn collect(e: &syn::Expr, out: &mut BTreeSet<String>) {
+    match e {
+        syn::Expr::Path(p) => {
+            if let Some(id) = p.path.get_ident() {
+                out.insert(id.to_string());
+            }
+        }
+        syn::Expr::Field(f) => {
+            out.insert(f.to_token_stream().to_string().replace(' ', ""));
+        }
+        syn::Expr::Binary(b) => {
+            collect(&b.left, out);
+            collect(&b.right, out);
+        }
+        syn::Expr::Unary(u) => collect(&u.expr, out),
+        syn::Expr::Paren(p) => collect(&p.expr, out),
+        syn::Expr::MethodCall(m) => {
+            collect(&m.receiver, out);
+            for a in &m.args {
+                collect(a, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+fn is_nav_symbol(name: &str) -> bool {
+    NAV_SYMBOLS.iter().any(|(n, _)| *n == name)
+}
+
+fn nav_symbol_list() -> String {
+    let v: Vec<&str> = NAV_SYMBOLS.iter().map(|(n, _)| *n).collect();
+    v.join(" ")
+}
+
+/// Parses and validates an expression; the error message names the offending piece.
+pub fn parse(source: &str, kind: ExprKind) -> Result<Expr, String> {
+    let source = source.trim();
+    let ast: syn::Expr = syn::parse_str(source)
+        .map_err(|e| format!("syntax error in expression `{source}`: {e}"))?;
+    check(&ast, kind).map_err(|m| format!("{m} in expression `{source}`"))?;
+    let mut ast = ast;
+    floatify(&mut ast);
+    Ok(Expr {
+        source: source.to_string(),
+        ast,
+    })
+}
+
+/// Turns integer literals into float literals (`2` → `2.0`) except `powi`'s exponent, so that
+/// generated code is well-typed f64 arithmetic.
+fn floatify(e: &mut syn::Expr) {
+    match e {
+        syn::Expr::Lit(l) => {
+            if let syn::Lit::Int(i) = &l.lit {
+                let text = format!("{}.0", i.base10_digits());
+                l.lit = syn::Lit::Float(syn::LitFloat::new(&text, i.span()));
+            }
+        }
+        syn::Expr::Binary(b) => {
+            floatify(&mut b.left);
+            floatify(&mut b.right);
+        }
+        syn::Expr::Unary(u) => floatify(&mut u.expr),
+        syn::Expr::Paren(p) => floatify(&mut p.expr),
+        syn::Expr::MethodCall(m) => floatify(&mut m.receiver),
+        _ => {}
+    }
+}
+
+fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
+    match e {
+        syn::Expr::Lit(l) => match &l.lit {
+            syn::Lit::Float(_) | syn::Lit::Int(_) => Ok(()),
+            _ => Err("only numeric literals are allowed".into()),
+        },
+        syn::Expr::Path(p) => {
+            let name = p
+                .path
+                .get_ident()
+                .map(|i| i.to_string())
+                .ok_or_else(|| format!("unknown symbol `{}`", p.to_token_stream()))?;
+            match kind {
+                ExprKind::Navigation if is_nav_symbol(&name) => Ok(()),
+                ExprKind::Navigation => Err(format!(
+                    "unknown symbol `{name}` (navigation symbols: {})",
+                    nav_symbol_list()
+                )),
+                ExprKind::Regressor => Err(format!(
+                    "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2] and w.x w.y w.z [rad/s])"
+                )),
+            }
+        }
+        syn::Expr::Field(f) => {
+            let base = match &*f.base {
+                syn::Expr::Path(p) => p.path.get_ident().map(|i| i.to_string()),
+                _ => None,
+            };
+            let member = match &f.member {
+                syn::Member::Named(i) => i.to_string(),
+                syn::Member::Unnamed(_) => String::new(),
+            };
+            let ok_member = matches!(member.as_str(), "x" | "y" | "z");
+            match (kind, base.as_deref()) {
+                (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
+                (ExprKind::Regressor, _) => Err(format!(
+                    "unknown signal `{}` (use f.x f.y f.z or w.x w.y w.z)",
+                    f.to_token_stream().to_string().replace(' ', "")
+                )),
+                (ExprKind::Navigation, _) => Err(format!(
+                    "unknown symbol `{}` (IMU signals belong in a term's regressor)",
+                    f.to_token_stream().to_string().replace(' ', "")
+                )),
+            }
+        }
+        syn::Expr::Binary(b) => {
+            use syn::BinOp::*;
+            match b.op {
+                Add(_) | Sub(_) | Mul(_) | Div(_) => {}
+                _ => return Err(format!("operator `{}` is not allowed", b.op.to_token_stream())),
+            }
+            check(&b.left, kind)?;
+            check(&b.right, kind)
+        }
+        syn::Expr::Unary(u) => match u.op {
+            syn::UnOp::Neg(_) => check(&u.expr, kind),
+            _ => Err(format!("operator `{}` is not allowed", u.op.to_token_stream())),
+        },
+        syn::Expr::Paren(p) => check(&p.expr, kind),
+        syn::Expr::MethodCall(m) => {
+            let name = m.method.to_string();
+            if !METHODS.contains(&name.as_str()) {
+                return Err(format!(
+                    "unknown method `{name}` (allowed: {})",
+                    METHODS.join(" ")
+                ));
+            }
+            if name == "powi" {
+                let ok = m.args.len() == 1
+                    && matches!(m.args.first(), Some(syn::Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(_), .. })));
+                if !ok {
+                    return Err("`powi` takes one integer literal".into());
+                }
+            } else if !m.args.is_empty() {
+                return Err(format!("`{name}` takes no arguments"));
+            }
+            check(&m.receiver, kind)
+        }
+        other => Err(format!(
+            "`{}` is not allowed (arithmetic, literals, symbols and {} only)",
+            other.to_token_stream(),
+            METHODS.join(" ")
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accepts_navigation_and_regressor_expressions() {
+        let e = parse("-omega * lat.sin() - ve * lat.tan() / rn", ExprKind::Navigation).unwrap();
+        let s = e.symbols();
+        assert!(s.contains("omega") && s.contains("lat") && s.contains("rn"));
+        let r = parse("-(w.y.powi(2) + w.z.powi(2))", ExprKind::Regressor).unwrap();
+        assert_eq!(
+            r.symbols().into_iter().collect::<Vec<_>>(),
+            vec!["w.y".to_string(), "w.z".to_string()]
+        );
+        assert!(parse("1", ExprKind::Regressor).unwrap().symbols().is_empty());
+    }
+
+    #[test]
+    fn rejects_unknown_symbols_methods_and_syntax() {
+        let e = parse("omeag * 2.0", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("unknown symbol `omeag`"), "{e}");
+        let e = parse("f.q", ExprKind::Regressor).unwrap_err();
+        assert!(e.contains("unknown signal `f.q`"), "{e}");
+        let e = parse("f.x", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("unknown symbol"), "{e}");
+        let e = parse("lat.exp()", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("unknown method `exp`"), "{e}");
+        let e = parse("lat *", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("syntax error"), "{e}");
+        let e = parse("lat.powi(h)", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("powi"), "{e}");
+        assert!(parse("vn % 2", ExprKind::Navigation).is_err());
+    }
+}

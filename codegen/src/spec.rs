@@ -1,0 +1,719 @@
+//! Loading and validating the declarative model spec (`model-spec/*.toml`).
+//!
+//! Every problem is reported as one [`SpecError`] naming the file, the line, the item (state,
+//! term, entry, preset or measurement) and what is wrong.
+
+use crate::expr::{self, Expr, ExprKind};
+use crate::units;
+use serde::Deserialize;
+use std::collections::{BTreeSet, HashMap};
+use std::fmt;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// The spec files, in the order they are read.
+pub const SPEC_FILES: [&str; 4] = [
+    "navigation.toml",
+    "terms.toml",
+    "measurements.toml",
+    "presets.toml",
+];
+
+/// One problem in the spec: file, 1-based line, the item it concerns, and the message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SpecError {
+    /// Path of the spec file.
+    pub file: PathBuf,
+    /// 1-based line (0 when the problem concerns the whole file).
+    pub line: usize,
+    /// The item concerned, e.g. "term `eps_x`".
+    pub item: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for SpecError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}: ", self.file.display(), self.line)?;
+        } else {
+            write!(f, "{}: ", self.file.display())?;
+        }
+        if !self.item.is_empty() {
+            write!(f, "{}: ", self.item)?;
+        }
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for SpecError {}
+
+/// Which instrument a term corrupts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sensor {
+    /// Gyro: the term adds to the measured angular rate [rad/s].
+    Gyro,
+    /// Accelerometer: the term adds to the measured specific force [m/s²].
+    Accel,
+}
+
+/// A navigation error state (attitude, velocity, position).
+#[derive(Debug, Clone)]
+pub struct NavState {
+    /// Canonical name, e.g. `phi_n`.
+    pub name: String,
+    /// SI unit of the state.
+    pub unit: String,
+    /// Unit used at the edges.
+    pub display: String,
+    /// Factor from display unit to SI.
+    pub display_to_si: f64,
+    /// Default prior 1-σ, SI.
+    pub sigma: f64,
+    /// Present only with `+vertical`.
+    pub vertical: bool,
+    /// One-line description.
+    pub doc: String,
+}
+
+/// A non-zero entry of the navigation block of A(t).
+#[derive(Debug, Clone)]
+pub struct NavEntry {
+    /// Row: index into [`Spec::nav_states`].
+    pub row: usize,
+    /// Column: index into [`Spec::nav_states`].
+    pub col: usize,
+    /// The validated expression.
+    pub expr: Expr,
+}
+
+/// A regressor: the body-frame signal whose step mean multiplies a term's state.
+#[derive(Debug, Clone)]
+pub struct Regressor {
+    /// The validated expression over `f.x .. w.z`.
+    pub expr: Expr,
+    /// True when the expression uses no IMU signal (e.g. `1`): it needs no accumulation.
+    pub constant: bool,
+}
+
+/// An instrument error term (one state).
+#[derive(Debug, Clone)]
+pub struct Term {
+    /// Canonical name, e.g. `kaq_x_xy`.
+    pub name: String,
+    /// Sensor corrupted.
+    pub sensor: Sensor,
+    /// Sensing axis, 0 = x, 1 = y, 2 = z (FRD body).
+    pub axis: usize,
+    /// Index into [`Spec::regressors`].
+    pub regressor: usize,
+    /// SI unit of the state.
+    pub unit: String,
+    /// Unit at the edges.
+    pub display: String,
+    /// Factor from display unit to SI.
+    pub display_to_si: f64,
+    /// Default prior 1-σ, SI.
+    pub sigma: f64,
+    /// Random-walk density of the state, SI per √s (0 = random constant).
+    pub noise: f64,
+    /// Group label for listings.
+    pub group: String,
+    /// One-line description.
+    pub doc: String,
+    /// Candidate library term (in no preset by default).
+    pub library: bool,
+}
+
+/// One H entry of a measurement row.
+#[derive(Debug, Clone)]
+pub struct HEntry {
+    /// Global state name.
+    pub state: String,
+    /// Validated expression.
+    pub expr: Expr,
+}
+
+/// One component of a measurement.
+#[derive(Debug, Clone)]
+pub struct MeasRow {
+    /// Component name, e.g. `dp_n`.
+    pub name: String,
+    /// Unit of the component.
+    pub unit: String,
+    /// Non-zero H entries.
+    pub h: Vec<HEntry>,
+}
+
+/// A measurement type (`vel_ne`, `pos_ne`, `pos_h`).
+#[derive(Debug, Clone)]
+pub struct Measurement {
+    /// Canonical name.
+    pub name: String,
+    /// One-line description.
+    pub doc: String,
+    /// Default noise 1-σ per component, SI.
+    pub sigma: f64,
+    /// Components.
+    pub rows: Vec<MeasRow>,
+}
+
+/// A named model.
+#[derive(Debug, Clone)]
+pub struct Preset {
+    /// Name, e.g. `P31`.
+    pub name: String,
+    /// One-line description.
+    pub doc: String,
+    /// State names in order.
+    pub states: Vec<String>,
+}
+
+/// The composition rule of DESIGN §4 for instrument columns.
+#[derive(Debug, Clone)]
+pub struct Compose {
+    /// Rows (nav indices) filled by gyro terms, in body-axis-to-NED order (N, E, D).
+    pub gyro_rows: Vec<usize>,
+    /// Sign of the gyro column (−1: −C e_i r).
+    pub gyro_sign: i32,
+    /// Rows (nav indices) filled by accelerometer terms.
+    pub accel_rows: Vec<usize>,
+    /// Sign of the accelerometer column (+1: C e_i r).
+    pub accel_sign: i32,
+}
+
+/// White sensor noise densities, SI.
+#[derive(Debug, Clone, Copy)]
+pub struct SensorNoise {
+    /// Gyro angle random walk [rad/√s].
+    pub gyro_arw: f64,
+    /// Accelerometer velocity random walk [m/s/√s].
+    pub accel_vrw: f64,
+}
+
+/// The whole validated spec.
+#[derive(Debug, Clone)]
+pub struct Spec {
+    /// Directory the spec was read from.
+    pub dir: PathBuf,
+    /// Navigation states (including the vertical ones), in order.
+    pub nav_states: Vec<NavState>,
+    /// Non-zero entries of the full (vertical) navigation block.
+    pub nav_entries: Vec<NavEntry>,
+    /// Instrument column rule.
+    pub compose: Compose,
+    /// Instrument error terms.
+    pub terms: Vec<Term>,
+    /// Distinct regressors used by the terms.
+    pub regressors: Vec<Regressor>,
+    /// Measurement types.
+    pub measurements: Vec<Measurement>,
+    /// Presets, in file order.
+    pub presets: Vec<Preset>,
+    /// White sensor noise.
+    pub sensor_noise: SensorNoise,
+}
+
+// ---------------------------------------------------------------- raw TOML
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawNavigation {
+    state: Vec<RawState>,
+    a: Vec<RawEntry>,
+    compose: RawCompose,
+    sensor_noise: RawSensorNoise,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawState {
+    name: Spanned<String>,
+    unit: String,
+    display: String,
+    sigma: String,
+    #[serde(default)]
+    vertical: bool,
+    doc: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawEntry {
+    row: Spanned<String>,
+    col: Spanned<String>,
+    expr: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCompose {
+    gyro_rows: Spanned<Vec<String>>,
+    gyro_sign: i32,
+    accel_rows: Spanned<Vec<String>>,
+    accel_sign: i32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSensorNoise {
+    gyro_arw: Spanned<String>,
+    accel_vrw: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTerms {
+    term: Vec<RawTerm>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTerm {
+    name: Spanned<String>,
+    sensor: Spanned<String>,
+    axis: Spanned<String>,
+    regressor: Spanned<String>,
+    unit: Spanned<String>,
+    display: Spanned<String>,
+    sigma: Spanned<String>,
+    #[serde(default)]
+    noise: Option<Spanned<String>>,
+    group: String,
+    doc: String,
+    #[serde(default)]
+    library: bool,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMeasurements {
+    measurement: Vec<RawMeasurement>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMeasurement {
+    name: Spanned<String>,
+    doc: String,
+    sigma: Spanned<String>,
+    rows: Vec<RawMeasRow>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMeasRow {
+    name: String,
+    unit: String,
+    h: Vec<RawHEntry>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawHEntry {
+    state: Spanned<String>,
+    expr: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPresets {
+    preset: toml::map::Map<String, toml::Value>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPreset {
+    doc: String,
+    states: Vec<String>,
+}
+
+// ---------------------------------------------------------------- loading
+
+/// Source text of one spec file, for turning byte spans into line numbers.
+struct Source {
+    path: PathBuf,
+    text: String,
+}
+
+impl Source {
+    fn read(dir: &Path, name: &str) -> Result<Source, SpecError> {
+        let path = dir.join(name);
+        let text = std::fs::read_to_string(&path).map_err(|e| SpecError {
+            file: path.clone(),
+            line: 0,
+            item: String::new(),
+            message: format!("cannot read spec file: {e}"),
+        })?;
+        Ok(Source { path, text })
+    }
+
+    fn line_of(&self, offset: usize) -> usize {
+        let end = offset.min(self.text.len());
+        self.text[..end].bytes().filter(|&b| b == b'\n').count() + 1
+    }
+
+    fn error(&self, span: std::ops::Range<usize>, item: &str, message: impl Into<String>) -> SpecError {
+        SpecError {
+            file: self.path.clone(),
+            line: self.line_of(span.start),
+            item: item.to_string(),
+            message: message.into(),
+        }
+    }
+
+    fn parse<T: for<'de> Deserialize<'de>>(&self) -> Result<T, SpecError> {
+        toml::from_str(&self.text).map_err(|e| {
+            let line = e.span().map(|s| self.line_of(s.start)).unwrap_or(0);
+            SpecError {
+                file: self.path.clone(),
+                line,
+                item: String::new(),
+                message: e.message().trim().to_string(),
+            }
+        })
+    }
+}
+
+fn check_name(src: &Source, name: &Spanned<String>, what: &str) -> Result<(), SpecError> {
+    let n = name.get_ref();
+    let ok = !n.is_empty()
+        && n.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && n.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+    if ok {
+        Ok(())
+    } else {
+        Err(src.error(
+            name.span(),
+            &format!("{what} `{n}`"),
+            "names must be lower-case letters, digits and `_`, starting with a letter",
+        ))
+    }
+}
+
+fn quantity(
+    src: &Source,
+    text: &Spanned<String>,
+    unit: &str,
+    item: &str,
+    field: &str,
+) -> Result<f64, SpecError> {
+    units::parse_quantity_as(text.get_ref(), unit)
+        .map_err(|e| src.error(text.span(), item, format!("{field}: {e}")))
+}
+
+impl Spec {
+    /// Reads and validates the spec in `dir` (the four files of [`SPEC_FILES`]).
+    pub fn load(dir: &Path) -> Result<Spec, SpecError> {
+        let nav_src = Source::read(dir, SPEC_FILES[0])?;
+        let terms_src = Source::read(dir, SPEC_FILES[1])?;
+        let meas_src = Source::read(dir, SPEC_FILES[2])?;
+        let preset_src = Source::read(dir, SPEC_FILES[3])?;
+
+        let raw_nav: RawNavigation = nav_src.parse()?;
+        let raw_terms: RawTerms = terms_src.parse()?;
+        let raw_meas: RawMeasurements = meas_src.parse()?;
+        let raw_presets: RawPresets = preset_src.parse()?;
+
+        let mut names: HashMap<String, String> = HashMap::new();
+
+        // navigation states
+        let mut nav_states = Vec::new();
+        for s in &raw_nav.state {
+            let item = format!("state `{}`", s.name.get_ref());
+            check_name(&nav_src, &s.name, "state")?;
+            if names
+                .insert(s.name.get_ref().clone(), "navigation.toml".into())
+                .is_some()
+            {
+                return Err(nav_src.error(s.name.span(), &item, "duplicate name"));
+            }
+            let unit = units::parse_unit(&s.unit)
+                .map_err(|e| nav_src.error(s.name.span(), &item, format!("unit: {e}")))?;
+            let display = units::parse_unit(&s.display)
+                .map_err(|e| nav_src.error(s.name.span(), &item, format!("display: {e}")))?;
+            if unit.dim != display.dim {
+                return Err(nav_src.error(
+                    s.name.span(),
+                    &item,
+                    format!("display unit `{}` does not match unit `{}`", s.display, s.unit),
+                ));
+            }
+            let sigma = units::parse_quantity_as(&s.sigma, &s.unit)
+                .map_err(|e| nav_src.error(s.name.span(), &item, format!("sigma: {e}")))?;
+            nav_states.push(NavState {
+                name: s.name.get_ref().clone(),
+                unit: s.unit.clone(),
+                display: s.display.clone(),
+                display_to_si: display.to_si / unit.to_si,
+                sigma,
+                vertical: s.vertical,
+                doc: s.doc.clone(),
+            });
+        }
+        let nav_index = |n: &str| nav_states.iter().position(|s| s.name == n);
+
+        // navigation block
+        let mut nav_entries: Vec<NavEntry> = Vec::new();
+        for e in &raw_nav.a {
+            let item = format!("A entry ({}, {})", e.row.get_ref(), e.col.get_ref());
+            let row = nav_index(e.row.get_ref()).ok_or_else(|| {
+                nav_src.error(e.row.span(), &item, format!("unknown state `{}`", e.row.get_ref()))
+            })?;
+            let col = nav_index(e.col.get_ref()).ok_or_else(|| {
+                nav_src.error(e.col.span(), &item, format!("unknown state `{}`", e.col.get_ref()))
+            })?;
+            if nav_entries.iter().any(|x| x.row == row && x.col == col) {
+                return Err(nav_src.error(e.row.span(), &item, "duplicate entry"));
+            }
+            let expr = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
+                .map_err(|m| nav_src.error(e.expr.span(), &item, m))?;
+            nav_entries.push(NavEntry { row, col, expr });
+        }
+
+        let rows = |list: &Spanned<Vec<String>>, what: &str| -> Result<Vec<usize>, SpecError> {
+            if list.get_ref().len() != 3 {
+                return Err(nav_src.error(list.span(), "compose", format!("{what} needs 3 rows (N, E, D)")));
+            }
+            list.get_ref()
+                .iter()
+                .map(|n| {
+                    nav_index(n).ok_or_else(|| {
+                        nav_src.error(list.span(), "compose", format!("{what}: unknown state `{n}`"))
+                    })
+                })
+                .collect()
+        };
+        let compose = Compose {
+            gyro_rows: rows(&raw_nav.compose.gyro_rows, "gyro_rows")?,
+            gyro_sign: raw_nav.compose.gyro_sign,
+            accel_rows: rows(&raw_nav.compose.accel_rows, "accel_rows")?,
+            accel_sign: raw_nav.compose.accel_sign,
+        };
+        for (sign, what) in [(compose.gyro_sign, "gyro_sign"), (compose.accel_sign, "accel_sign")] {
+            if sign != 1 && sign != -1 {
+                return Err(nav_src.error(0..0, "compose", format!("{what} must be 1 or -1")));
+            }
+        }
+        let sensor_noise = SensorNoise {
+            gyro_arw: quantity(&nav_src, &raw_nav.sensor_noise.gyro_arw, "rad/sqrt(s)", "sensor_noise", "gyro_arw")?,
+            accel_vrw: quantity(&nav_src, &raw_nav.sensor_noise.accel_vrw, "m/s/sqrt(s)", "sensor_noise", "accel_vrw")?,
+        };
+
+        // terms
+        let mut terms = Vec::new();
+        let mut regressors: Vec<Regressor> = Vec::new();
+        for t in &raw_terms.term {
+            let item = format!("term `{}`", t.name.get_ref());
+            check_name(&terms_src, &t.name, "term")?;
+            if let Some(prev) = names.insert(t.name.get_ref().clone(), "terms.toml".into()) {
+                return Err(terms_src.error(
+                    t.name.span(),
+                    &item,
+                    format!("duplicate name (already defined in {prev})"),
+                ));
+            }
+            let sensor = match t.sensor.get_ref().as_str() {
+                "gyro" => Sensor::Gyro,
+                "accel" => Sensor::Accel,
+                other => {
+                    return Err(terms_src.error(
+                        t.sensor.span(),
+                        &item,
+                        format!("unknown sensor `{other}` (expected `gyro` or `accel`)"),
+                    ))
+                }
+            };
+            let axis = match t.axis.get_ref().as_str() {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                other => {
+                    return Err(terms_src.error(
+                        t.axis.span(),
+                        &item,
+                        format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
+                    ))
+                }
+            };
+            let rexpr = expr::parse(t.regressor.get_ref(), ExprKind::Regressor)
+                .map_err(|m| terms_src.error(t.regressor.span(), &item, format!("regressor: {m}")))?;
+            let key = rexpr.key();
+            let regressor = match regressors.iter().position(|r| r.expr.key() == key) {
+                Some(i) => i,
+                None => {
+                    let constant = rexpr.symbols().is_empty();
+                    regressors.push(Regressor {
+                        expr: rexpr,
+                        constant,
+                    });
+                    regressors.len() - 1
+                }
+            };
+            let unit = units::parse_unit(t.unit.get_ref())
+                .map_err(|e| terms_src.error(t.unit.span(), &item, format!("unit: {e}")))?;
+            let display = units::parse_unit(t.display.get_ref())
+                .map_err(|e| terms_src.error(t.display.span(), &item, format!("display: {e}")))?;
+            if unit.dim != display.dim {
+                return Err(terms_src.error(
+                    t.display.span(),
+                    &item,
+                    format!(
+                        "display unit `{}` does not match unit `{}`",
+                        t.display.get_ref(),
+                        t.unit.get_ref()
+                    ),
+                ));
+            }
+            let sigma = quantity(&terms_src, &t.sigma, t.unit.get_ref(), &item, "sigma")?;
+            let noise = match &t.noise {
+                Some(n) => quantity(
+                    &terms_src,
+                    n,
+                    &format!("({})/sqrt(s)", t.unit.get_ref()).replace("(1)/", "1/"),
+                    &item,
+                    "noise",
+                )?,
+                None => 0.0,
+            };
+            terms.push(Term {
+                name: t.name.get_ref().clone(),
+                sensor,
+                axis,
+                regressor,
+                unit: t.unit.get_ref().clone(),
+                display: t.display.get_ref().clone(),
+                display_to_si: display.to_si / unit.to_si,
+                sigma,
+                noise,
+                group: t.group.clone(),
+                doc: t.doc.clone(),
+                library: t.library,
+            });
+        }
+
+        // measurements
+        let mut measurements = Vec::new();
+        for m in &raw_meas.measurement {
+            let item = format!("measurement `{}`", m.name.get_ref());
+            check_name(&meas_src, &m.name, "measurement")?;
+            if measurements.iter().any(|x: &Measurement| &x.name == m.name.get_ref()) {
+                return Err(meas_src.error(m.name.span(), &item, "duplicate name"));
+            }
+            let first_unit = m.rows.first().map(|r| r.unit.clone()).unwrap_or_default();
+            let sigma = quantity(&meas_src, &m.sigma, &first_unit, &item, "sigma")?;
+            let mut rows = Vec::new();
+            for r in &m.rows {
+                let mut h = Vec::new();
+                for e in &r.h {
+                    if !names.contains_key(e.state.get_ref()) {
+                        return Err(meas_src.error(
+                            e.state.span(),
+                            &item,
+                            format!("unknown state `{}`", e.state.get_ref()),
+                        ));
+                    }
+                    let expr = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
+                        .map_err(|msg| meas_src.error(e.expr.span(), &item, msg))?;
+                    h.push(HEntry {
+                        state: e.state.get_ref().clone(),
+                        expr,
+                    });
+                }
+                rows.push(MeasRow {
+                    name: r.name.clone(),
+                    unit: r.unit.clone(),
+                    h,
+                });
+            }
+            measurements.push(Measurement {
+                name: m.name.get_ref().clone(),
+                doc: m.doc.clone(),
+                sigma,
+                rows,
+            });
+        }
+
+        // presets
+        let horizontal: Vec<&str> = nav_states
+            .iter()
+            .filter(|s| !s.vertical)
+            .map(|s| s.name.as_str())
+            .collect();
+        let mut presets = Vec::new();
+        for (name, value) in raw_presets.preset.iter() {
+            let line_span = preset_src
+                .text
+                .find(&format!("[preset.{name}]"))
+                .map(|i| i..i)
+                .unwrap_or(0..0);
+            let item = format!("preset `{name}`");
+            let raw: RawPreset = value
+                .clone()
+                .try_into()
+                .map_err(|e: toml::de::Error| preset_src.error(line_span.clone(), &item, e.message().trim()))?;
+            let mut seen = BTreeSet::new();
+            for s in &raw.states {
+                if !seen.insert(s.as_str()) {
+                    return Err(preset_src.error(line_span.clone(), &item, format!("state `{s}` listed twice")));
+                }
+                if !names.contains_key(s) {
+                    return Err(preset_src.error(
+                        line_span.clone(),
+                        &item,
+                        format!("names missing term `{s}` (not a state of navigation.toml nor a term of terms.toml)"),
+                    ));
+                }
+                if nav_states.iter().any(|n| &n.name == s && n.vertical) {
+                    return Err(preset_src.error(
+                        line_span.clone(),
+                        &item,
+                        format!("vertical state `{s}` cannot be listed; write the model as `{name}+vertical`"),
+                    ));
+                }
+            }
+            if raw.states.len() < horizontal.len()
+                || raw.states[..horizontal.len()].iter().map(String::as_str).ne(horizontal.iter().copied())
+            {
+                return Err(preset_src.error(
+                    line_span.clone(),
+                    &item,
+                    format!("must start with the navigation states {}", horizontal.join(" ")),
+                ));
+            }
+            presets.push(Preset {
+                name: name.clone(),
+                doc: raw.doc,
+                states: raw.states,
+            });
+        }
+        presets.sort_by_key(|p| {
+            preset_src
+                .text
+                .find(&format!("[preset.{}]", p.name))
+                .unwrap_or(usize::MAX)
+        });
+
+        Ok(Spec {
+            dir: dir.to_path_buf(),
+            nav_states,
+            nav_entries,
+            compose,
+            terms,
+            regressors,
+            measurements,
+            presets,
+            sensor_noise,
+        })
+    }
+
+    /// Index of a term by name.
+    pub fn term_index(&self, name: &str) -> Option<usize> {
+        self.terms.iter().position(|t| t.name == name)
+    }
+
+    /// Index of a navigation state by name.
+    pub fn nav_index(&self, name: &str) -> Option<usize> {
+        self.nav_states.iter().position(|s| s.name == name)
+    }
+}

@@ -1,0 +1,121 @@
+//! Types describing what the model spec declares (states, terms, measurements, presets); the
+//! values themselves are generated from `model-spec/` into [`crate::generated`].
+
+use crate::nav_point::NavPoint;
+
+/// Which instrument a term corrupts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sensor {
+    /// Gyro: adds to the measured angular rate [rad/s].
+    Gyro,
+    /// Accelerometer: adds to the measured specific force [m/s²].
+    Accel,
+}
+
+/// A navigation error state as declared in `model-spec/navigation.toml`.
+#[derive(Debug, Clone, Copy)]
+pub struct NavStateInfo {
+    /// Canonical name, e.g. `phi_n`.
+    pub name: &'static str,
+    /// SI unit of the state.
+    pub unit: &'static str,
+    /// Unit at the edges (reports, CLI).
+    pub display: &'static str,
+    /// Factor from the display unit to SI.
+    pub display_to_si: f64,
+    /// Default prior 1-σ, SI.
+    pub sigma: f64,
+    /// Present only with `+vertical`.
+    pub vertical: bool,
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+/// An instrument error term as declared in `model-spec/terms.toml`.
+#[derive(Debug, Clone, Copy)]
+pub struct TermInfo {
+    /// Canonical name, e.g. `kaq_x_xy`.
+    pub name: &'static str,
+    /// Sensor corrupted.
+    pub sensor: Sensor,
+    /// Body (FRD) sensing axis: 0 = x, 1 = y, 2 = z.
+    pub axis: usize,
+    /// Index into `generated::common::REGRESSORS`.
+    pub regressor: usize,
+    /// SI unit of the state.
+    pub unit: &'static str,
+    /// Unit at the edges.
+    pub display: &'static str,
+    /// Factor from the display unit to SI.
+    pub display_to_si: f64,
+    /// Default prior 1-σ, SI.
+    pub sigma: f64,
+    /// Random-walk density of the state [SI/√s]; 0 for a random constant.
+    pub noise: f64,
+    /// Group label.
+    pub group: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+    /// Candidate library term (DESIGN §7).
+    pub library: bool,
+}
+
+/// One component of a measurement.
+#[derive(Debug, Clone, Copy)]
+pub struct MeasRowInfo {
+    /// Component name, e.g. `dp_n`.
+    pub name: &'static str,
+    /// Unit of the component.
+    pub unit: &'static str,
+}
+
+/// A measurement type as declared in `model-spec/measurements.toml`.
+#[derive(Debug, Clone, Copy)]
+pub struct MeasurementInfo {
+    /// Canonical name: `vel_ne`, `pos_ne`, `pos_h`.
+    pub name: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+    /// Default noise 1-σ per component, SI.
+    pub sigma: f64,
+    /// Components.
+    pub rows: &'static [MeasRowInfo],
+    /// States the measurement references (all must be in a model for it to apply).
+    pub states: &'static [&'static str],
+}
+
+/// What a model state is: a navigation state or an instrument term (catalogue indices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StateRef {
+    /// Index into `generated::common::NAV_STATES`.
+    Nav(usize),
+    /// Index into `generated::common::TERMS`.
+    Term(usize),
+}
+
+/// The generated kernels of one preset, reachable by name at run time.
+#[derive(Debug, Clone, Copy)]
+pub struct PresetKernels {
+    /// Name, e.g. `P31+vertical`.
+    pub name: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+    /// Vertical channel present.
+    pub vertical: bool,
+    /// State names in order.
+    pub states: &'static [&'static str],
+    /// Catalogue reference of each state.
+    pub state_refs: &'static [StateRef],
+    /// Structural non-zeros of A.
+    pub a_pattern: &'static [(usize, usize)],
+    /// Accumulated regressors (indices into `generated::common::REGRESSORS`).
+    pub regressor_ids: &'static [usize],
+    /// Supported measurements.
+    pub measurements: &'static [&'static str],
+    /// Fills A (N×N row-major) from regressor means.
+    pub fill_a: fn(&NavPoint, &[f64], &mut [f64]),
+    /// Fills H of a measurement (rows×N row-major); false if unsupported.
+    pub fill_h: fn(&str, &NavPoint, &mut [f64]) -> bool,
+    /// P ← Φ P Φᵀ + diag(q)·dt (N×N row-major).
+    pub propagate_cov: fn(&[f64], f64, &[f64], &mut [f64]),
+}

@@ -1,0 +1,48 @@
+//! `sinsmodel jacobian --model MODEL --at POINT.json`.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use sinsmodel::jacobian::{jacobian, PointSpec};
+use sinsmodel::model::Model;
+use std::path::PathBuf;
+
+/// Arguments of `jacobian`.
+#[derive(Args)]
+pub struct JacobianArgs {
+    /// Model, e.g. P31, P28+kaq_x_xy, P31+vertical.
+    #[arg(long)]
+    model: String,
+    /// Point: JSON object {lat_deg, h_m, v_ned, euler_deg, f_b, w_b}, or an array of them
+    /// (then the output is an array).
+    #[arg(long)]
+    at: PathBuf,
+    /// Compose A and H at run time even when the model is a preset.
+    #[arg(long)]
+    runtime: bool,
+}
+
+/// Runs the command.
+pub fn run(args: &JacobianArgs) -> Result<()> {
+    let model = Model::parse(&args.model)?;
+    let text = std::fs::read_to_string(&args.at)
+        .with_context(|| format!("cannot read {}", args.at.display()))?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not valid JSON", args.at.display()))?;
+    let out = match value {
+        serde_json::Value::Array(items) => {
+            let mut outs = Vec::with_capacity(items.len());
+            for (k, v) in items.into_iter().enumerate() {
+                let p: PointSpec = serde_json::from_value(v)
+                    .with_context(|| format!("{}: point {k}", args.at.display()))?;
+                outs.push(jacobian(&model, &p, args.runtime).with_context(|| format!("{}: point {k}", args.at.display()))?);
+            }
+            serde_json::to_string(&outs)?
+        }
+        v => {
+            let p: PointSpec = serde_json::from_value(v).with_context(|| format!("{}", args.at.display()))?;
+            serde_json::to_string(&jacobian(&model, &p, args.runtime).with_context(|| format!("{}", args.at.display()))?)?
+        }
+    };
+    println!("{out}");
+    Ok(())
+}

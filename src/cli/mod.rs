@@ -1,0 +1,4 @@
+//! Subcommands of the `sinsmodel` binary, one module each.
+
+pub mod jacobian;
+pub mod model;

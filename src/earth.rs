@@ -1,0 +1,93 @@
+//! WGS-84 Earth model: radii of curvature, Earth rate, normal gravity (Somigliana with the
+//! WGS-84 free-air correction) and its derivatives. SI units, radians, NED frame.
+
+/// WGS-84 semi-major axis [m].
+pub const A: f64 = 6_378_137.0;
+/// WGS-84 flattening [-].
+pub const F: f64 = 1.0 / 298.257_223_563;
+/// First eccentricity squared [-].
+pub const E2: f64 = F * (2.0 - F);
+/// Earth rotation rate [rad/s].
+pub const OMEGA: f64 = 7.292_115e-5;
+/// Geocentric gravitational constant [m³/s²].
+pub const GM: f64 = 3.986_004_418e14;
+/// Normal gravity at the equator [m/s²].
+pub const GAMMA_E: f64 = 9.780_325_335_9;
+/// Normal gravity at the poles [m/s²].
+pub const GAMMA_P: f64 = 9.832_184_937_8;
+
+/// Meridian radius of curvature R_M at latitude `lat` [rad] → [m].
+pub fn radius_meridian(lat: f64) -> f64 {
+    let s2 = lat.sin().powi(2);
+    A * (1.0 - E2) / (1.0 - E2 * s2).powf(1.5)
+}
+
+/// Transverse (prime-vertical) radius of curvature R_N at latitude `lat` [rad] → [m].
+pub fn radius_transverse(lat: f64) -> f64 {
+    let s2 = lat.sin().powi(2);
+    A / (1.0 - E2 * s2).sqrt()
+}
+
+const B: f64 = A * (1.0 - F);
+const K_SOMIGLIANA: f64 = (B * GAMMA_P - A * GAMMA_E) / (A * GAMMA_E);
+const M_RATIO: f64 = OMEGA * OMEGA * A * A * B / GM;
+
+fn free_air(lat: f64, h: f64) -> f64 {
+    let s2 = lat.sin().powi(2);
+    1.0 - 2.0 / A * (1.0 + F + M_RATIO - 2.0 * F * s2) * h + 3.0 * h * h / (A * A)
+}
+
+fn gamma0(lat: f64) -> f64 {
+    let s2 = lat.sin().powi(2);
+    GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / (1.0 - E2 * s2).sqrt()
+}
+
+/// Normal gravity magnitude γ(lat, h) [m/s²], pointing down in NED.
+pub fn gravity(lat: f64, h: f64) -> f64 {
+    gamma0(lat) * free_air(lat, h)
+}
+
+/// ∂γ/∂lat [m/s²/rad].
+pub fn gravity_dlat(lat: f64, h: f64) -> f64 {
+    let (s, c) = lat.sin_cos();
+    let s2 = s * s;
+    let w = 1.0 - E2 * s2;
+    let dg0 = GAMMA_E
+        * (2.0 * K_SOMIGLIANA * s * c / w.sqrt() + (1.0 + K_SOMIGLIANA * s2) * E2 * s * c / w.powf(1.5));
+    let dfree = 8.0 * F * s * c * h / A;
+    dg0 * free_air(lat, h) + gamma0(lat) * dfree
+}
+
+/// ∂γ/∂h [1/s²] (negative: the unstable vertical loop).
+pub fn gravity_dh(lat: f64, h: f64) -> f64 {
+    let s2 = lat.sin().powi(2);
+    gamma0(lat) * (-2.0 / A * (1.0 + F + M_RATIO - 2.0 * F * s2) + 6.0 * h / (A * A))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_values() {
+        // Normal gravity at the equator and the pole, sea level.
+        assert!((gravity(0.0, 0.0) - GAMMA_E).abs() < 1e-12);
+        assert!((gravity(std::f64::consts::FRAC_PI_2, 0.0) - GAMMA_P).abs() < 1e-9);
+        // Free-air gradient ≈ -3.086e-6 /s² at mid latitude.
+        assert!((gravity_dh(0.78, 0.0) + 3.086e-6).abs() < 1e-8);
+        // Radii at the equator: R_N = a, R_M = a (1 - e²).
+        assert!((radius_transverse(0.0) - A).abs() < 1e-6);
+        assert!((radius_meridian(0.0) - A * (1.0 - E2)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        for &(lat, h) in &[(0.3, 100.0), (-1.1, 5000.0), (0.9, -50.0)] {
+            let d = 1e-6;
+            let fd_lat = (gravity(lat + d, h) - gravity(lat - d, h)) / (2.0 * d);
+            assert!((fd_lat - gravity_dlat(lat, h)).abs() < 1e-8, "{fd_lat} {}", gravity_dlat(lat, h));
+            let fd_h = (gravity(lat, h + 1.0) - gravity(lat, h - 1.0)) / 2.0;
+            assert!((fd_h - gravity_dh(lat, h)).abs() < 1e-12);
+        }
+    }
+}

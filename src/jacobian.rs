@@ -1,0 +1,109 @@
+//! The `jacobian` command: A and H of a model at one linearisation point given as JSON, for the
+//! independent CasADi check (`tools/verify-jacobians`).
+
+use crate::attitude::dcm_from_euler;
+use crate::model::Model;
+use crate::nav_point::NavPoint;
+use anyhow::{bail, Context, Result};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A linearisation point as written in POINT.json (degrees only for angles at this edge).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSpec {
+    /// Geodetic latitude [deg].
+    pub lat_deg: f64,
+    /// Height [m].
+    pub h_m: f64,
+    /// NED velocity [m/s].
+    pub v_ned: [f64; 3],
+    /// Roll, pitch, yaw [deg]; C_b^n = Rz(yaw)·Ry(pitch)·Rx(roll).
+    pub euler_deg: [f64; 3],
+    /// Specific force, FRD body [m/s²].
+    pub f_b: [f64; 3],
+    /// Angular rate, FRD body [rad/s].
+    pub w_b: [f64; 3],
+}
+
+/// The JSON printed by `sinsmodel jacobian`.
+#[derive(Debug, Clone, Serialize)]
+pub struct JacobianOut {
+    /// Model name.
+    pub model: String,
+    /// State names in order.
+    pub states: Vec<&'static str>,
+    /// Dense A, row-major rows.
+    pub a: Vec<Vec<f64>>,
+    /// Structural non-zeros of A as [row, col].
+    pub pattern: Vec<[usize; 2]>,
+    /// H of each measurement the model supports.
+    pub h: BTreeMap<&'static str, Vec<Vec<f64>>>,
+}
+
+impl PointSpec {
+    /// Checks that every number is finite and the latitude is inside ±90°.
+    pub fn validate(&self) -> Result<()> {
+        let all = [self.lat_deg, self.h_m]
+            .into_iter()
+            .chain(self.v_ned)
+            .chain(self.euler_deg)
+            .chain(self.f_b)
+            .chain(self.w_b);
+        if all.into_iter().any(|v| !v.is_finite()) {
+            bail!("point has a non-finite number");
+        }
+        if self.lat_deg.abs() >= 90.0 {
+            bail!("lat_deg = {} is outside (-90, 90)", self.lat_deg);
+        }
+        Ok(())
+    }
+
+    /// The navigation point (radii frozen at this latitude and height).
+    pub fn nav_point(&self) -> NavPoint {
+        let d = std::f64::consts::PI / 180.0;
+        let c = dcm_from_euler(self.euler_deg[0] * d, self.euler_deg[1] * d, self.euler_deg[2] * d);
+        NavPoint::new(
+            self.lat_deg * d,
+            self.h_m,
+            Vector3::from(self.v_ned),
+            &c,
+            &Vector3::from(self.f_b),
+        )
+    }
+}
+
+/// A and H of `model` at `point`, regressors evaluated at the single sample (f_b, w_b).
+pub fn jacobian(model: &Model, point: &PointSpec, runtime: bool) -> Result<JacobianOut> {
+    point.validate()?;
+    let nav = point.nav_point();
+    let mut acc = model.accumulator();
+    acc.add(&Vector3::from(point.f_b), &Vector3::from(point.w_b));
+    let r = acc.mean();
+    let n = model.n();
+    let mut a = vec![0.0; n * n];
+    if runtime {
+        model.fill_a_runtime(&nav, &r, &mut a);
+    } else {
+        model.fill_a(&nav, &r, &mut a);
+    }
+    let mut h = BTreeMap::new();
+    for m in model.measurements() {
+        let mut hm = vec![0.0; m.rows.len() * n];
+        let rows = if runtime {
+            model.fill_h_runtime(m.name, &nav, &mut hm)
+        } else {
+            model.fill_h(m.name, &nav, &mut hm)
+        }
+        .with_context(|| format!("measurement {}", m.name))?;
+        h.insert(m.name, hm.chunks(n).take(rows).map(<[f64]>::to_vec).collect());
+    }
+    Ok(JacobianOut {
+        model: model.name.clone(),
+        states: model.names.clone(),
+        a: a.chunks(n).map(<[f64]>::to_vec).collect(),
+        pattern: model.a_pattern().iter().map(|&(i, j)| [i, j]).collect(),
+        h,
+    })
+}

@@ -1,0 +1,12 @@
+//! sinsmodel: an error-model compiler and model-discovery tool for strapdown inertial
+//! navigation systems. Frames: NED navigation, FRD body; SI units and radians inside.
+
+pub mod attitude;
+pub mod catalog;
+pub mod covariance;
+pub mod earth;
+pub mod generated;
+pub mod jacobian;
+pub mod model;
+pub mod nav_point;
+pub mod units;

@@ -1,0 +1,40 @@
+//! The `sinsmodel` command line.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod cli;
+
+/// Error-model compiler and model-discovery tool for strapdown inertial navigation systems.
+#[derive(Parser)]
+#[command(name = "sinsmodel", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Inspect the compiled models: list presets and terms, show one model.
+    Model {
+        #[command(subcommand)]
+        action: cli::model::ModelAction,
+    },
+    /// Print A(t) and H of a model at one point (JSON), for the CasADi check.
+    Jacobian(cli::jacobian::JacobianArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Model { action } => cli::model::run(action),
+        Command::Jacobian(args) => cli::jacobian::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,325 @@
+//! Models as users write them (`P31`, `P28+kaq_x_xy+kgf_xz`, `P31+vertical`): parsing, the
+//! state layout, and A(t)/H filling, either through a preset's generated kernels or composed at
+//! run time from the generated navigation block and per-term columns.
+
+use crate::catalog::{MeasurementInfo, PresetKernels, StateRef};
+use crate::generated::{common, PRESETS};
+use crate::nav_point::NavPoint;
+use nalgebra::Vector3;
+use std::fmt;
+
+/// Why a model string could not be used.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModelError(pub String);
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// A resolved model: ordered states and the means to fill A and H.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Canonical text, e.g. `P28+vertical+kaq_x_xy`.
+    pub name: String,
+    /// Vertical channel present.
+    pub vertical: bool,
+    /// States in order (catalogue references).
+    pub states: Vec<StateRef>,
+    /// State names in order.
+    pub names: Vec<&'static str>,
+    /// Accumulated (non-constant) regressors, indices into `common::REGRESSORS`.
+    pub regressor_ids: Vec<usize>,
+    /// The preset's generated kernels when the model is exactly a preset (optionally +vertical).
+    pub preset: Option<&'static PresetKernels>,
+    nav_pos: [Option<usize>; common::NAV_COUNT],
+    a_pattern: Vec<(usize, usize)>,
+}
+
+fn preset_names() -> String {
+    PRESETS
+        .iter()
+        .filter(|p| !p.vertical)
+        .map(|p| p.name)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+impl Model {
+    /// Parses `PRESET[+vertical][+term…]`; added terms go after the preset's, in the order given.
+    pub fn parse(text: &str) -> Result<Model, ModelError> {
+        let mut parts = text.split('+').map(str::trim);
+        let base = parts.next().unwrap_or("");
+        let mut vertical = false;
+        let mut extra: Vec<usize> = Vec::new();
+        for p in parts {
+            if p.eq_ignore_ascii_case("vertical") {
+                if vertical {
+                    return Err(ModelError(format!("model `{text}`: `vertical` given twice")));
+                }
+                vertical = true;
+                continue;
+            }
+            let t = common::TERMS.iter().position(|t| t.name == p).ok_or_else(|| {
+                ModelError(format!(
+                    "model `{text}`: unknown term `{p}` (see `sinsmodel model list`)"
+                ))
+            })?;
+            if extra.contains(&t) {
+                return Err(ModelError(format!("model `{text}`: term `{p}` given twice")));
+            }
+            extra.push(t);
+        }
+        let preset = PRESETS
+            .iter()
+            .find(|k| k.name.eq_ignore_ascii_case(base) && !k.vertical)
+            .ok_or_else(|| {
+                ModelError(format!(
+                    "model `{text}`: unknown preset `{base}` (presets: {}); write a model as PRESET[+vertical][+term…]",
+                    preset_names()
+                ))
+            })?;
+        let kernels = PRESETS
+            .iter()
+            .find(|k| k.name == format!("{}{}", preset.name, if vertical { "+vertical" } else { "" }))
+            .expect("every preset has a +vertical twin");
+        let mut states: Vec<StateRef> = kernels.state_refs.to_vec();
+        for &t in &extra {
+            if states.contains(&StateRef::Term(t)) {
+                return Err(ModelError(format!(
+                    "model `{text}`: term `{}` is already in {}",
+                    common::TERMS[t].name,
+                    preset.name
+                )));
+            }
+            states.push(StateRef::Term(t));
+        }
+        let mut name = kernels.name.to_string();
+        for &t in &extra {
+            name.push('+');
+            name.push_str(common::TERMS[t].name);
+        }
+        Ok(Model::from_states(name, vertical, states, extra.is_empty().then_some(kernels)))
+    }
+
+    fn from_states(
+        name: String,
+        vertical: bool,
+        states: Vec<StateRef>,
+        preset: Option<&'static PresetKernels>,
+    ) -> Model {
+        let names = states
+            .iter()
+            .map(|s| match *s {
+                StateRef::Nav(k) => common::NAV_STATES[k].name,
+                StateRef::Term(k) => common::TERMS[k].name,
+            })
+            .collect();
+        let mut nav_pos = [None; common::NAV_COUNT];
+        for (i, s) in states.iter().enumerate() {
+            if let StateRef::Nav(k) = *s {
+                nav_pos[k] = Some(i);
+            }
+        }
+        let mut regressor_ids = Vec::new();
+        for s in &states {
+            if let StateRef::Term(t) = *s {
+                let r = common::TERMS[t].regressor;
+                if !common::REGRESSOR_CONSTANT[r] && !regressor_ids.contains(&r) {
+                    regressor_ids.push(r);
+                }
+            }
+        }
+        let mut a_pattern = Vec::new();
+        for &(r, c) in common::NAV_PATTERN.iter() {
+            if let (Some(i), Some(j)) = (nav_pos[r], nav_pos[c]) {
+                a_pattern.push((i, j));
+            }
+        }
+        for (j, s) in states.iter().enumerate() {
+            if let StateRef::Term(t) = *s {
+                for &r in common::TERM_ROWS[t] {
+                    if let Some(i) = nav_pos[r] {
+                        a_pattern.push((i, j));
+                    }
+                }
+            }
+        }
+        a_pattern.sort_unstable();
+        Model {
+            name,
+            vertical,
+            states,
+            names,
+            regressor_ids,
+            preset,
+            nav_pos,
+            a_pattern,
+        }
+    }
+
+    /// Number of states.
+    pub fn n(&self) -> usize {
+        self.states.len()
+    }
+
+    /// Index of a state by canonical name.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| *n == name)
+    }
+
+    /// Structural non-zeros of A, row-major.
+    pub fn a_pattern(&self) -> &[(usize, usize)] {
+        &self.a_pattern
+    }
+
+    /// SI unit of state `i`.
+    pub fn unit(&self, i: usize) -> &'static str {
+        match self.states[i] {
+            StateRef::Nav(k) => common::NAV_STATES[k].unit,
+            StateRef::Term(k) => common::TERMS[k].unit,
+        }
+    }
+
+    /// Default prior 1-σ of state `i`, SI.
+    pub fn prior_sigma(&self, i: usize) -> f64 {
+        match self.states[i] {
+            StateRef::Nav(k) => common::NAV_STATES[k].sigma,
+            StateRef::Term(k) => common::TERMS[k].sigma,
+        }
+    }
+
+    /// Measurements whose states are all in this model.
+    pub fn measurements(&self) -> Vec<&'static MeasurementInfo> {
+        common::MEASUREMENTS
+            .iter()
+            .filter(|m| m.states.iter().all(|s| self.index_of(s).is_some()))
+            .collect()
+    }
+
+    /// Step means of this model's regressors over IMU samples (f [m/s²], w [rad/s], FRD).
+    pub fn accumulator(&self) -> RegressorAccumulator {
+        RegressorAccumulator {
+            ids: self.regressor_ids.clone(),
+            sum: vec![0.0; self.regressor_ids.len()],
+            count: 0,
+        }
+    }
+
+    /// Fills A (n×n row-major, zeroed by the caller) through the preset kernel when there is
+    /// one, else by run-time composition.
+    pub fn fill_a(&self, nav: &NavPoint, r: &[f64], a: &mut [f64]) {
+        match self.preset {
+            Some(k) => (k.fill_a)(nav, r, a),
+            None => self.fill_a_runtime(nav, r, a),
+        }
+    }
+
+    /// Fills A by run-time composition: the generated navigation block and per-term columns.
+    pub fn fill_a_runtime(&self, nav: &NavPoint, r: &[f64], a: &mut [f64]) {
+        let n = self.n();
+        let mut block = [[0.0; common::NAV_COUNT]; common::NAV_COUNT];
+        common::fill_nav_block(nav, &mut block);
+        for &(r_nav, c_nav) in common::NAV_PATTERN.iter() {
+            if let (Some(i), Some(j)) = (self.nav_pos[r_nav], self.nav_pos[c_nav]) {
+                a[i * n + j] = block[r_nav][c_nav];
+            }
+        }
+        for (j, s) in self.states.iter().enumerate() {
+            if let StateRef::Term(t) = *s {
+                let reg = common::TERMS[t].regressor;
+                let rv = self
+                    .regressor_ids
+                    .iter()
+                    .position(|&x| x == reg)
+                    .map(|k| r[k])
+                    .unwrap_or(0.0);
+                let mut col = [0.0; common::NAV_COUNT];
+                common::term_column(t, nav, rv, &mut col);
+                for &row in common::TERM_ROWS[t] {
+                    if let Some(i) = self.nav_pos[row] {
+                        a[i * n + j] = col[row];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Fills H (components × n, row-major, zeroed by the caller) for measurement `meas`;
+    /// returns the number of components.
+    pub fn fill_h(&self, meas: &str, nav: &NavPoint, h: &mut [f64]) -> Result<usize, ModelError> {
+        let rows = self.measurement(meas)?.rows.len();
+        if let Some(k) = self.preset {
+            if (k.fill_h)(meas, nav, h) {
+                return Ok(rows);
+            }
+        }
+        self.fill_h_runtime(meas, nav, h)
+    }
+
+    fn measurement(&self, meas: &str) -> Result<&'static MeasurementInfo, ModelError> {
+        let m = common::MEASUREMENTS
+            .iter()
+            .find(|m| m.name == meas)
+            .ok_or_else(|| ModelError(format!("unknown measurement `{meas}`")))?;
+        if let Some(s) = m.states.iter().find(|s| self.index_of(s).is_none()) {
+            return Err(ModelError(format!(
+                "measurement `{meas}` needs state `{s}`, which model {} lacks",
+                self.name
+            )));
+        }
+        Ok(m)
+    }
+
+    /// Fills H by run-time composition from the generated measurement entries.
+    pub fn fill_h_runtime(&self, meas: &str, nav: &NavPoint, h: &mut [f64]) -> Result<usize, ModelError> {
+        let m = self.measurement(meas)?;
+        let idx = common::MEASUREMENTS
+            .iter()
+            .position(|x| x.name == meas)
+            .expect("found above");
+        let n = self.n();
+        let mut missing = None;
+        common::measurement_entries(idx, nav, &mut |row, state, v| match self.index_of(state) {
+            Some(j) => h[row * n + j] = v,
+            None => missing = Some(state),
+        });
+        match missing {
+            Some(s) => Err(ModelError(format!("measurement `{meas}` needs state `{s}`"))),
+            None => Ok(m.rows.len()),
+        }
+    }
+}
+
+/// Running sums of a model's regressors over the IMU samples of one filter step.
+#[derive(Debug, Clone)]
+pub struct RegressorAccumulator {
+    ids: Vec<usize>,
+    sum: Vec<f64>,
+    count: u32,
+}
+
+impl RegressorAccumulator {
+    /// Adds one sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
+    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
+        for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
+            *s += common::regressor_value(id, f, w);
+        }
+        self.count += 1;
+    }
+
+    /// Means (mean of squares, never square of means); zeros when empty.
+    pub fn mean(&self) -> Vec<f64> {
+        let k = if self.count > 0 { 1.0 / self.count as f64 } else { 0.0 };
+        self.sum.iter().map(|s| s * k).collect()
+    }
+
+    /// Starts a new step.
+    pub fn reset(&mut self) {
+        self.sum.iter_mut().for_each(|s| *s = 0.0);
+        self.count = 0;
+    }
+}

@@ -1,0 +1,56 @@
+//! The navigation quantities A(t) and H are evaluated at (DESIGN §4): position, velocity,
+//! attitude and specific force, with the WGS-84 radii frozen at the point.
+
+use crate::earth;
+use nalgebra::{Matrix3, Vector3};
+
+/// A linearisation point: every symbol the spec's A and H expressions may use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NavPoint {
+    /// Geodetic latitude [rad].
+    pub lat: f64,
+    /// Height above the ellipsoid, up [m].
+    pub h: f64,
+    /// Velocity, NED [m/s].
+    pub v_ned: [f64; 3],
+    /// R_M + h [m].
+    pub rm: f64,
+    /// R_N + h [m].
+    pub rn: f64,
+    /// Earth rotation rate [rad/s].
+    pub omega: f64,
+    /// Specific force in NED, C f^b [m/s²].
+    pub f_ned: [f64; 3],
+    /// C_b^n, row-major.
+    pub c: [[f64; 3]; 3],
+    /// ∂γ/∂lat [m/s²/rad].
+    pub dg_dlat: f64,
+    /// ∂γ/∂h [1/s²].
+    pub dg_dh: f64,
+}
+
+impl NavPoint {
+    /// Builds the point from latitude [rad], height [m], NED velocity [m/s], C_b^n and the
+    /// body-frame specific force f^b [m/s²].
+    pub fn new(lat: f64, h: f64, v_ned: Vector3<f64>, c_bn: &Matrix3<f64>, f_b: &Vector3<f64>) -> NavPoint {
+        let f_n = c_bn * f_b;
+        let mut c = [[0.0; 3]; 3];
+        for (i, row) in c.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = c_bn[(i, j)];
+            }
+        }
+        NavPoint {
+            lat,
+            h,
+            v_ned: [v_ned.x, v_ned.y, v_ned.z],
+            rm: earth::radius_meridian(lat) + h,
+            rn: earth::radius_transverse(lat) + h,
+            omega: earth::OMEGA,
+            f_ned: [f_n.x, f_n.y, f_n.z],
+            c,
+            dg_dlat: earth::gravity_dlat(lat, h),
+            dg_dh: earth::gravity_dh(lat, h),
+        }
+    }
+}
