@@ -31,7 +31,11 @@ pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
 /// φ = ½ [E₂₃ − E₃₂, E₃₁ − E₁₃, E₁₂ − E₂₁] (DESIGN §1).
 pub fn attitude_error(c_computed: &Matrix3<f64>, c_true: &Matrix3<f64>) -> Vector3<f64> {
     let e = c_computed * c_true.transpose();
-    0.5 * Vector3::new(e[(1, 2)] - e[(2, 1)], e[(2, 0)] - e[(0, 2)], e[(0, 1)] - e[(1, 0)])
+    0.5 * Vector3::new(
+        e[(1, 2)] - e[(2, 1)],
+        e[(2, 0)] - e[(0, 2)],
+        e[(0, 1)] - e[(1, 0)],
+    )
 }
 
 #[cfg(test)]

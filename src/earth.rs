@@ -53,7 +53,8 @@ pub fn gravity_dlat(lat: f64, h: f64) -> f64 {
     let s2 = s * s;
     let w = 1.0 - E2 * s2;
     let dg0 = GAMMA_E
-        * (2.0 * K_SOMIGLIANA * s * c / w.sqrt() + (1.0 + K_SOMIGLIANA * s2) * E2 * s * c / w.powf(1.5));
+        * (2.0 * K_SOMIGLIANA * s * c / w.sqrt()
+            + (1.0 + K_SOMIGLIANA * s2) * E2 * s * c / w.powf(1.5));
     let dfree = 8.0 * F * s * c * h / A;
     dg0 * free_air(lat, h) + gamma0(lat) * dfree
 }
@@ -85,7 +86,11 @@ mod tests {
         for &(lat, h) in &[(0.3, 100.0), (-1.1, 5000.0), (0.9, -50.0)] {
             let d = 1e-6;
             let fd_lat = (gravity(lat + d, h) - gravity(lat - d, h)) / (2.0 * d);
-            assert!((fd_lat - gravity_dlat(lat, h)).abs() < 1e-8, "{fd_lat} {}", gravity_dlat(lat, h));
+            assert!(
+                (fd_lat - gravity_dlat(lat, h)).abs() < 1e-8,
+                "{fd_lat} {}",
+                gravity_dlat(lat, h)
+            );
             let fd_h = (gravity(lat, h + 1.0) - gravity(lat, h - 1.0)) / 2.0;
             assert!((fd_h - gravity_dh(lat, h)).abs() < 1e-12);
         }

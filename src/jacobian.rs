@@ -63,7 +63,11 @@ impl PointSpec {
     /// The navigation point (radii frozen at this latitude and height).
     pub fn nav_point(&self) -> NavPoint {
         let d = std::f64::consts::PI / 180.0;
-        let c = dcm_from_euler(self.euler_deg[0] * d, self.euler_deg[1] * d, self.euler_deg[2] * d);
+        let c = dcm_from_euler(
+            self.euler_deg[0] * d,
+            self.euler_deg[1] * d,
+            self.euler_deg[2] * d,
+        );
         NavPoint::new(
             self.lat_deg * d,
             self.h_m,
@@ -97,7 +101,10 @@ pub fn jacobian(model: &Model, point: &PointSpec, runtime: bool) -> Result<Jacob
             model.fill_h(m.name, &nav, &mut hm)
         }
         .with_context(|| format!("measurement {}", m.name))?;
-        h.insert(m.name, hm.chunks(n).take(rows).map(<[f64]>::to_vec).collect());
+        h.insert(
+            m.name,
+            hm.chunks(n).take(rows).map(<[f64]>::to_vec).collect(),
+        );
     }
     Ok(JacobianOut {
         model: model.name.clone(),

@@ -58,18 +58,25 @@ impl Model {
         for p in parts {
             if p.eq_ignore_ascii_case("vertical") {
                 if vertical {
-                    return Err(ModelError(format!("model `{text}`: `vertical` given twice")));
+                    return Err(ModelError(format!(
+                        "model `{text}`: `vertical` given twice"
+                    )));
                 }
                 vertical = true;
                 continue;
             }
-            let t = common::TERMS.iter().position(|t| t.name == p).ok_or_else(|| {
-                ModelError(format!(
-                    "model `{text}`: unknown term `{p}` (see `sinsmodel model list`)"
-                ))
-            })?;
+            let t = common::TERMS
+                .iter()
+                .position(|t| t.name == p)
+                .ok_or_else(|| {
+                    ModelError(format!(
+                        "model `{text}`: unknown term `{p}` (see `sinsmodel model list`)"
+                    ))
+                })?;
             if extra.contains(&t) {
-                return Err(ModelError(format!("model `{text}`: term `{p}` given twice")));
+                return Err(ModelError(format!(
+                    "model `{text}`: term `{p}` given twice"
+                )));
             }
             extra.push(t);
         }
@@ -84,7 +91,9 @@ impl Model {
             })?;
         let kernels = PRESETS
             .iter()
-            .find(|k| k.name == format!("{}{}", preset.name, if vertical { "+vertical" } else { "" }))
+            .find(|k| {
+                k.name == format!("{}{}", preset.name, if vertical { "+vertical" } else { "" })
+            })
             .expect("every preset has a +vertical twin");
         let mut states: Vec<StateRef> = kernels.state_refs.to_vec();
         for &t in &extra {
@@ -102,7 +111,12 @@ impl Model {
             name.push('+');
             name.push_str(common::TERMS[t].name);
         }
-        Ok(Model::from_states(name, vertical, states, extra.is_empty().then_some(kernels)))
+        Ok(Model::from_states(
+            name,
+            vertical,
+            states,
+            extra.is_empty().then_some(kernels),
+        ))
     }
 
     fn from_states(
@@ -275,7 +289,12 @@ impl Model {
     }
 
     /// Fills H by run-time composition from the generated measurement entries.
-    pub fn fill_h_runtime(&self, meas: &str, nav: &NavPoint, h: &mut [f64]) -> Result<usize, ModelError> {
+    pub fn fill_h_runtime(
+        &self,
+        meas: &str,
+        nav: &NavPoint,
+        h: &mut [f64],
+    ) -> Result<usize, ModelError> {
         let m = self.measurement(meas)?;
         let idx = common::MEASUREMENTS
             .iter()
@@ -288,7 +307,9 @@ impl Model {
             None => missing = Some(state),
         });
         match missing {
-            Some(s) => Err(ModelError(format!("measurement `{meas}` needs state `{s}`"))),
+            Some(s) => Err(ModelError(format!(
+                "measurement `{meas}` needs state `{s}`"
+            ))),
             None => Ok(m.rows.len()),
         }
     }
@@ -313,7 +334,11 @@ impl RegressorAccumulator {
 
     /// Means (mean of squares, never square of means); zeros when empty.
     pub fn mean(&self) -> Vec<f64> {
-        let k = if self.count > 0 { 1.0 / self.count as f64 } else { 0.0 };
+        let k = if self.count > 0 {
+            1.0 / self.count as f64
+        } else {
+            0.0
+        };
         self.sum.iter().map(|s| s * k).collect()
     }
 

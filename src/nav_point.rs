@@ -32,7 +32,13 @@ pub struct NavPoint {
 impl NavPoint {
     /// Builds the point from latitude [rad], height [m], NED velocity [m/s], C_b^n and the
     /// body-frame specific force f^b [m/s²].
-    pub fn new(lat: f64, h: f64, v_ned: Vector3<f64>, c_bn: &Matrix3<f64>, f_b: &Vector3<f64>) -> NavPoint {
+    pub fn new(
+        lat: f64,
+        h: f64,
+        v_ned: Vector3<f64>,
+        c_bn: &Matrix3<f64>,
+        f_b: &Vector3<f64>,
+    ) -> NavPoint {
         let f_n = c_bn * f_b;
         let mut c = [[0.0; 3]; 3];
         for (i, row) in c.iter_mut().enumerate() {

@@ -9,7 +9,6 @@
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod common {
     include!(concat!(env!("OUT_DIR"), "/common.rs"));
 }
@@ -21,7 +20,6 @@ pub mod common {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p13 {
     include!(concat!(env!("OUT_DIR"), "/p13.rs"));
 }
@@ -33,7 +31,6 @@ pub mod p13 {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p13_vertical {
     include!(concat!(env!("OUT_DIR"), "/p13_vertical.rs"));
 }
@@ -45,7 +42,6 @@ pub mod p13_vertical {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p24 {
     include!(concat!(env!("OUT_DIR"), "/p24.rs"));
 }
@@ -57,7 +53,6 @@ pub mod p24 {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p24_vertical {
     include!(concat!(env!("OUT_DIR"), "/p24_vertical.rs"));
 }
@@ -69,7 +64,6 @@ pub mod p24_vertical {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p28 {
     include!(concat!(env!("OUT_DIR"), "/p28.rs"));
 }
@@ -81,7 +75,6 @@ pub mod p28 {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p28_vertical {
     include!(concat!(env!("OUT_DIR"), "/p28_vertical.rs"));
 }
@@ -93,7 +86,6 @@ pub mod p28_vertical {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p31 {
     include!(concat!(env!("OUT_DIR"), "/p31.rs"));
 }
@@ -105,7 +97,6 @@ pub mod p31 {
     clippy::approx_constant,
     clippy::too_many_lines
 )]
-
 pub mod p31_vertical {
     include!(concat!(env!("OUT_DIR"), "/p31_vertical.rs"));
 }

@@ -27,7 +27,10 @@ fn nav_accessor(sym: &str) -> TokenStream {
         "f_n" => quote!(nav.f_ned[0]),
         "f_e" => quote!(nav.f_ned[1]),
         "f_d" => quote!(nav.f_ned[2]),
-        s if s.len() == 3 && s.starts_with('c') && s[1..].chars().all(|c| ('1'..='3').contains(&c)) => {
+        s if s.len() == 3
+            && s.starts_with('c')
+            && s[1..].chars().all(|c| ('1'..='3').contains(&c)) =>
+        {
             let i = (s.as_bytes()[1] - b'1') as usize;
             let j = (s.as_bytes()[2] - b'1') as usize;
             quote!(nav.c[#i][#j])
@@ -116,10 +119,10 @@ pub fn format_file(tokens: TokenStream) -> String {
     let mut out = String::from(HEADER);
     let mut prev = "";
     for line in pretty.lines() {
-        let starts_item = !line.is_empty()
-            && !line.starts_with([' ', '}', ']', ')'])
-            && !(prev.starts_with("///") || prev.starts_with("#["))
-            && !(prev.starts_with("use ") && line.starts_with("use "));
+        let continues = line.is_empty() || line.starts_with([' ', '}', ']', ')']);
+        let after_attr = prev.starts_with("///") || prev.starts_with("#[") || prev == ")]";
+        let use_run = prev.starts_with("use ") && line.starts_with("use ");
+        let starts_item = !(continues || after_attr || use_run);
         if starts_item {
             out.push('\n');
         }
@@ -154,7 +157,10 @@ pub fn common_module(spec: &Spec) -> String {
     let n_nav = spec.nav_states.len();
     let nav_consts = spec.nav_states.iter().enumerate().map(|(i, s)| {
         let c = const_name(&s.name);
-        let doc = format!(" Index of `{}` in the full navigation block: {} [{}].", s.name, s.doc, s.unit);
+        let doc = format!(
+            " Index of `{}` in the full navigation block: {} [{}].",
+            s.name, s.doc, s.unit
+        );
         quote!(#[doc = #doc] pub const #c: usize = #i;)
     });
     let nav_infos = spec.nav_states.iter().map(|s| {
@@ -208,7 +214,10 @@ pub fn common_module(spec: &Spec) -> String {
     });
 
     let nav_pattern = nav_entries.iter().map(|e| {
-        let (r, c) = (const_name(&spec.nav_states[e.row].name), const_name(&spec.nav_states[e.col].name));
+        let (r, c) = (
+            const_name(&spec.nav_states[e.row].name),
+            const_name(&spec.nav_states[e.col].name),
+        );
         quote!((#r, #c))
     });
     let n_nav_nnz = nav_entries.len();
@@ -235,7 +244,10 @@ pub fn common_module(spec: &Spec) -> String {
         ));
         let lines = col.iter().map(|(row, e)| {
             let rc = const_name(&spec.nav_states[*row].name);
-            let cm = comment(&format!("A[{}][{}] = {}", spec.nav_states[*row].name, term.name, e.comment));
+            let cm = comment(&format!(
+                "A[{}][{}] = {}",
+                spec.nav_states[*row].name, term.name, e.comment
+            ));
             let v = &e.value;
             quote!(#cm col[#rc] = #v;)
         });
@@ -263,17 +275,29 @@ pub fn common_module(spec: &Spec) -> String {
             .flat_map(|(row, r)| {
                 r.h.iter().map(move |h| {
                     let ast = &h.expr.ast;
-                    SymEntry { row, col: 0, comment: h.expr.source.clone(), value: quote!(#ast) }
+                    SymEntry {
+                        row,
+                        col: 0,
+                        comment: h.expr.source.clone(),
+                        value: quote!(#ast),
+                    }
                 })
             })
             .collect();
         let refs: Vec<&SymEntry> = entries.iter().collect();
         let binds = bindings(&refs);
-        let states: Vec<&str> = meas.rows.iter().flat_map(|r| r.h.iter().map(|h| h.state.as_str())).collect();
+        let states: Vec<&str> = meas
+            .rows
+            .iter()
+            .flat_map(|r| r.h.iter().map(|h| h.state.as_str()))
+            .collect();
         let lines = entries.iter().zip(states).map(|(e, s)| {
             let row = e.row;
             let v = &e.value;
-            let cm = comment(&format!("H[{}][{}] = {}", meas.rows[row].name, s, e.comment));
+            let cm = comment(&format!(
+                "H[{}][{}] = {}",
+                meas.rows[row].name, s, e.comment
+            ));
             quote!(#cm emit(#row, #s, #v);)
         });
         quote!(#m => { let _ = nav; #binds #(#lines)* })
@@ -360,7 +384,9 @@ fn phi_pattern(n: usize, a: &BTreeSet<(usize, usize)>) -> PhiPattern {
     let mut entries = Vec::new();
     for &i in &rows {
         for j in 0..n {
-            let ks: Vec<usize> = (0..n).filter(|&k| a.contains(&(i, k)) && a.contains(&(k, j))).collect();
+            let ks: Vec<usize> = (0..n)
+                .filter(|&k| a.contains(&(i, k)) && a.contains(&(k, j)))
+                .collect();
             let direct = a.contains(&(i, j));
             if direct || !ks.is_empty() {
                 entries.push((i, j, direct, ks));
@@ -381,7 +407,9 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let n = layout.states.len();
     let name = &layout.name;
     let vertical = layout.vertical;
-    let names: Vec<String> = (0..n).map(|i| layout.state_name(spec, i).to_string()).collect();
+    let names: Vec<String> = (0..n)
+        .map(|i| layout.state_name(spec, i).to_string())
+        .collect();
     let consts = names.iter().enumerate().map(|(i, s)| {
         let c = const_name(s);
         let doc = format!(" Index of `{s}`.");
@@ -415,7 +443,10 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let binds = bindings(&refs);
     let a_lines = entries.iter().map(|e| {
         let (r, c) = (const_name(&names[e.row]), const_name(&names[e.col]));
-        let cm = comment(&format!("A[{}][{}] = {}", names[e.row], names[e.col], e.comment));
+        let cm = comment(&format!(
+            "A[{}][{}] = {}",
+            names[e.row], names[e.col], e.comment
+        ));
         let v = &e.value;
         quote!(#cm a[#r][#c] = #v;)
     });
@@ -433,11 +464,17 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
             let lines = h.iter().map(|e| {
                 let row = e.row;
                 let c = const_name(&names[e.col]);
-                let cm = comment(&format!("H[{}][{}] = {}", meas.rows[row].name, names[e.col], e.comment));
+                let cm = comment(&format!(
+                    "H[{}][{}] = {}",
+                    meas.rows[row].name, names[e.col], e.comment
+                ));
                 let v = &e.value;
                 quote!(#cm h[#row][#c] = #v;)
             });
-            let doc = format!(" Writes the non-zeros of H for `{}`: {}.", meas.name, meas.doc);
+            let doc = format!(
+                " Writes the non-zeros of H for `{}`: {}.",
+                meas.name, meas.doc
+            );
             h_fns.push(quote! {
                 #[doc = #doc]
                 pub fn #f(nav: &NavPoint, h: &mut [[f64; N]; #rows]) {
@@ -473,19 +510,27 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let b_lines = phi.rows.iter().enumerate().map(|(rd, &i)| {
         let cm = comment(&format!("row {}", names[i]));
         let ri = const_name(&names[i]);
-        let lines = phi.entries.iter().filter(|e| e.0 == i).map(|(_, j, direct, ks)| {
-            let cj = const_name(&names[*j]);
-            let prods = ks.iter().map(|k| {
-                let ck = const_name(&names[*k]);
-                quote!(a[#ri][#ck] * a[#ck][#cj])
+        let lines = phi
+            .entries
+            .iter()
+            .filter(|e| e.0 == i)
+            .map(|(_, j, direct, ks)| {
+                let cj = const_name(&names[*j]);
+                let prods = ks.iter().map(|k| {
+                    let ck = const_name(&names[*k]);
+                    quote!(a[#ri][#ck] * a[#ck][#cj])
+                });
+                let second = if ks.is_empty() {
+                    quote!()
+                } else {
+                    quote!(half_dt2 * (#(#prods)+*))
+                };
+                match (*direct, ks.is_empty()) {
+                    (true, true) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt;),
+                    (true, false) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt + #second;),
+                    (false, _) => quote!(b[#rd][#cj] = #second;),
+                }
             });
-            let second = if ks.is_empty() { quote!() } else { quote!(half_dt2 * (#(#prods)+*)) };
-            match (*direct, ks.is_empty()) {
-                (true, true) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt;),
-                (true, false) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt + #second;),
-                (false, _) => quote!(b[#rd][#cj] = #second;),
-            }
-        });
         quote!(#cm #(#lines)*)
     });
 

@@ -12,8 +12,14 @@ pub const NAV_SYMBOLS: [(&str, &str); 22] = [
     ("vn", "north velocity [m/s]"),
     ("ve", "east velocity [m/s]"),
     ("vd", "down velocity [m/s]"),
-    ("rm", "meridian radius of curvature plus height, R_M + h [m]"),
-    ("rn", "transverse radius of curvature plus height, R_N + h [m]"),
+    (
+        "rm",
+        "meridian radius of curvature plus height, R_M + h [m]",
+    ),
+    (
+        "rn",
+        "transverse radius of curvature plus height, R_N + h [m]",
+    ),
     ("omega", "Earth rotation rate [rad/s]"),
     ("f_n", "north specific force, (C f^b)_N [m/s^2]"),
     ("f_e", "east specific force [m/s^2]"),
@@ -27,7 +33,10 @@ pub const NAV_SYMBOLS: [(&str, &str); 22] = [
     ("c31", "C_b^n element (3,1)"),
     ("c32", "C_b^n element (3,2)"),
     ("c33", "C_b^n element (3,3)"),
-    ("dg_dlat", "normal gravity derivative by latitude [m/s^2/rad]"),
+    (
+        "dg_dlat",
+        "normal gravity derivative by latitude [m/s^2/rad]",
+    ),
     ("dg_dh", "normal gravity derivative by height [1/s^2]"),
 ];
 
@@ -193,14 +202,22 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
             use syn::BinOp::*;
             match b.op {
                 Add(_) | Sub(_) | Mul(_) | Div(_) => {}
-                _ => return Err(format!("operator `{}` is not allowed", b.op.to_token_stream())),
+                _ => {
+                    return Err(format!(
+                        "operator `{}` is not allowed",
+                        b.op.to_token_stream()
+                    ))
+                }
             }
             check(&b.left, kind)?;
             check(&b.right, kind)
         }
         syn::Expr::Unary(u) => match u.op {
             syn::UnOp::Neg(_) => check(&u.expr, kind),
-            _ => Err(format!("operator `{}` is not allowed", u.op.to_token_stream())),
+            _ => Err(format!(
+                "operator `{}` is not allowed",
+                u.op.to_token_stream()
+            )),
         },
         syn::Expr::Paren(p) => check(&p.expr, kind),
         syn::Expr::MethodCall(m) => {
@@ -213,7 +230,13 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
             }
             if name == "powi" {
                 let ok = m.args.len() == 1
-                    && matches!(m.args.first(), Some(syn::Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(_), .. })));
+                    && matches!(
+                        m.args.first(),
+                        Some(syn::Expr::Lit(syn::ExprLit {
+                            lit: syn::Lit::Int(_),
+                            ..
+                        }))
+                    );
                 if !ok {
                     return Err("`powi` takes one integer literal".into());
                 }
@@ -236,7 +259,11 @@ mod tests {
 
     #[test]
     fn accepts_navigation_and_regressor_expressions() {
-        let e = parse("-omega * lat.sin() - ve * lat.tan() / rn", ExprKind::Navigation).unwrap();
+        let e = parse(
+            "-omega * lat.sin() - ve * lat.tan() / rn",
+            ExprKind::Navigation,
+        )
+        .unwrap();
         let s = e.symbols();
         assert!(s.contains("omega") && s.contains("lat") && s.contains("rn"));
         let r = parse("-(w.y.powi(2) + w.z.powi(2))", ExprKind::Regressor).unwrap();
@@ -244,7 +271,10 @@ mod tests {
             r.symbols().into_iter().collect::<Vec<_>>(),
             vec!["w.y".to_string(), "w.z".to_string()]
         );
-        assert!(parse("1", ExprKind::Regressor).unwrap().symbols().is_empty());
+        assert!(parse("1", ExprKind::Regressor)
+            .unwrap()
+            .symbols()
+            .is_empty());
     }
 
     #[test]

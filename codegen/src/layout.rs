@@ -159,7 +159,10 @@ impl Layout {
 
     /// Structural pattern of A as (row, col) pairs.
     pub fn a_pattern(&self, spec: &Spec) -> BTreeSet<(usize, usize)> {
-        self.a_entries(spec).iter().map(|e| (e.row, e.col)).collect()
+        self.a_entries(spec)
+            .iter()
+            .map(|e| (e.row, e.col))
+            .collect()
     }
 }
 

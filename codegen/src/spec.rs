@@ -353,7 +353,12 @@ impl Source {
         self.text[..end].bytes().filter(|&b| b == b'\n').count() + 1
     }
 
-    fn error(&self, span: std::ops::Range<usize>, item: &str, message: impl Into<String>) -> SpecError {
+    fn error(
+        &self,
+        span: std::ops::Range<usize>,
+        item: &str,
+        message: impl Into<String>,
+    ) -> SpecError {
         SpecError {
             file: self.path.clone(),
             line: self.line_of(span.start),
@@ -379,7 +384,8 @@ fn check_name(src: &Source, name: &Spanned<String>, what: &str) -> Result<(), Sp
     let n = name.get_ref();
     let ok = !n.is_empty()
         && n.chars().next().is_some_and(|c| c.is_ascii_lowercase())
-        && n.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        && n.chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
     if ok {
         Ok(())
     } else {
@@ -436,7 +442,10 @@ impl Spec {
                 return Err(nav_src.error(
                     s.name.span(),
                     &item,
-                    format!("display unit `{}` does not match unit `{}`", s.display, s.unit),
+                    format!(
+                        "display unit `{}` does not match unit `{}`",
+                        s.display, s.unit
+                    ),
                 ));
             }
             let sigma = units::parse_quantity_as(&s.sigma, &s.unit)
@@ -458,10 +467,18 @@ impl Spec {
         for e in &raw_nav.a {
             let item = format!("A entry ({}, {})", e.row.get_ref(), e.col.get_ref());
             let row = nav_index(e.row.get_ref()).ok_or_else(|| {
-                nav_src.error(e.row.span(), &item, format!("unknown state `{}`", e.row.get_ref()))
+                nav_src.error(
+                    e.row.span(),
+                    &item,
+                    format!("unknown state `{}`", e.row.get_ref()),
+                )
             })?;
             let col = nav_index(e.col.get_ref()).ok_or_else(|| {
-                nav_src.error(e.col.span(), &item, format!("unknown state `{}`", e.col.get_ref()))
+                nav_src.error(
+                    e.col.span(),
+                    &item,
+                    format!("unknown state `{}`", e.col.get_ref()),
+                )
             })?;
             if nav_entries.iter().any(|x| x.row == row && x.col == col) {
                 return Err(nav_src.error(e.row.span(), &item, "duplicate entry"));
@@ -473,13 +490,21 @@ impl Spec {
 
         let rows = |list: &Spanned<Vec<String>>, what: &str| -> Result<Vec<usize>, SpecError> {
             if list.get_ref().len() != 3 {
-                return Err(nav_src.error(list.span(), "compose", format!("{what} needs 3 rows (N, E, D)")));
+                return Err(nav_src.error(
+                    list.span(),
+                    "compose",
+                    format!("{what} needs 3 rows (N, E, D)"),
+                ));
             }
             list.get_ref()
                 .iter()
                 .map(|n| {
                     nav_index(n).ok_or_else(|| {
-                        nav_src.error(list.span(), "compose", format!("{what}: unknown state `{n}`"))
+                        nav_src.error(
+                            list.span(),
+                            "compose",
+                            format!("{what}: unknown state `{n}`"),
+                        )
                     })
                 })
                 .collect()
@@ -490,14 +515,29 @@ impl Spec {
             accel_rows: rows(&raw_nav.compose.accel_rows, "accel_rows")?,
             accel_sign: raw_nav.compose.accel_sign,
         };
-        for (sign, what) in [(compose.gyro_sign, "gyro_sign"), (compose.accel_sign, "accel_sign")] {
+        for (sign, what) in [
+            (compose.gyro_sign, "gyro_sign"),
+            (compose.accel_sign, "accel_sign"),
+        ] {
             if sign != 1 && sign != -1 {
                 return Err(nav_src.error(0..0, "compose", format!("{what} must be 1 or -1")));
             }
         }
         let sensor_noise = SensorNoise {
-            gyro_arw: quantity(&nav_src, &raw_nav.sensor_noise.gyro_arw, "rad/sqrt(s)", "sensor_noise", "gyro_arw")?,
-            accel_vrw: quantity(&nav_src, &raw_nav.sensor_noise.accel_vrw, "m/s/sqrt(s)", "sensor_noise", "accel_vrw")?,
+            gyro_arw: quantity(
+                &nav_src,
+                &raw_nav.sensor_noise.gyro_arw,
+                "rad/sqrt(s)",
+                "sensor_noise",
+                "gyro_arw",
+            )?,
+            accel_vrw: quantity(
+                &nav_src,
+                &raw_nav.sensor_noise.accel_vrw,
+                "m/s/sqrt(s)",
+                "sensor_noise",
+                "accel_vrw",
+            )?,
         };
 
         // terms
@@ -536,8 +576,9 @@ impl Spec {
                     ))
                 }
             };
-            let rexpr = expr::parse(t.regressor.get_ref(), ExprKind::Regressor)
-                .map_err(|m| terms_src.error(t.regressor.span(), &item, format!("regressor: {m}")))?;
+            let rexpr = expr::parse(t.regressor.get_ref(), ExprKind::Regressor).map_err(|m| {
+                terms_src.error(t.regressor.span(), &item, format!("regressor: {m}"))
+            })?;
             let key = rexpr.key();
             let regressor = match regressors.iter().position(|r| r.expr.key() == key) {
                 Some(i) => i,
@@ -597,7 +638,10 @@ impl Spec {
         for m in &raw_meas.measurement {
             let item = format!("measurement `{}`", m.name.get_ref());
             check_name(&meas_src, &m.name, "measurement")?;
-            if measurements.iter().any(|x: &Measurement| &x.name == m.name.get_ref()) {
+            if measurements
+                .iter()
+                .any(|x: &Measurement| &x.name == m.name.get_ref())
+            {
                 return Err(meas_src.error(m.name.span(), &item, "duplicate name"));
             }
             let first_unit = m.rows.first().map(|r| r.unit.clone()).unwrap_or_default();
@@ -648,14 +692,17 @@ impl Spec {
                 .map(|i| i..i)
                 .unwrap_or(0..0);
             let item = format!("preset `{name}`");
-            let raw: RawPreset = value
-                .clone()
-                .try_into()
-                .map_err(|e: toml::de::Error| preset_src.error(line_span.clone(), &item, e.message().trim()))?;
+            let raw: RawPreset = value.clone().try_into().map_err(|e: toml::de::Error| {
+                preset_src.error(line_span.clone(), &item, e.message().trim())
+            })?;
             let mut seen = BTreeSet::new();
             for s in &raw.states {
                 if !seen.insert(s.as_str()) {
-                    return Err(preset_src.error(line_span.clone(), &item, format!("state `{s}` listed twice")));
+                    return Err(preset_src.error(
+                        line_span.clone(),
+                        &item,
+                        format!("state `{s}` listed twice"),
+                    ));
                 }
                 if !names.contains_key(s) {
                     return Err(preset_src.error(
@@ -673,12 +720,18 @@ impl Spec {
                 }
             }
             if raw.states.len() < horizontal.len()
-                || raw.states[..horizontal.len()].iter().map(String::as_str).ne(horizontal.iter().copied())
+                || raw.states[..horizontal.len()]
+                    .iter()
+                    .map(String::as_str)
+                    .ne(horizontal.iter().copied())
             {
                 return Err(preset_src.error(
                     line_span.clone(),
                     &item,
-                    format!("must start with the navigation states {}", horizontal.join(" ")),
+                    format!(
+                        "must start with the navigation states {}",
+                        horizontal.join(" ")
+                    ),
                 ));
             }
             presets.push(Preset {

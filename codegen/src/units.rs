@@ -241,10 +241,19 @@ mod tests {
     #[test]
     fn converts_edge_units_to_si() {
         let deg_h = std::f64::consts::PI / 180.0 / 3600.0;
-        assert!(close(parse_quantity_as("0.01 deg/h", "rad/s").unwrap(), 0.01 * deg_h));
-        assert!(close(parse_quantity_as("50 ug", "m/s^2").unwrap(), 50e-6 * STANDARD_GRAVITY));
+        assert!(close(
+            parse_quantity_as("0.01 deg/h", "rad/s").unwrap(),
+            0.01 * deg_h
+        ));
+        assert!(close(
+            parse_quantity_as("50 ug", "m/s^2").unwrap(),
+            50e-6 * STANDARD_GRAVITY
+        ));
         assert!(close(parse_quantity_as("-10 ppm", "1").unwrap(), -1e-5));
-        assert!(close(parse_quantity_as("5e-5 s^2/m", "s^2/m").unwrap(), 5e-5));
+        assert!(close(
+            parse_quantity_as("5e-5 s^2/m", "s^2/m").unwrap(),
+            5e-5
+        ));
         assert!(close(
             parse_quantity_as("10 ug/g^2", "s^2/m").unwrap(),
             10e-6 / STANDARD_GRAVITY

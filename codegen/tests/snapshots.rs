@@ -7,7 +7,8 @@ use std::path::PathBuf;
 #[test]
 fn snapshots_are_fresh() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let spec = sinsmodel_codegen::Spec::load(&root.join("../model-spec")).unwrap_or_else(|e| panic!("{e}"));
+    let spec = sinsmodel_codegen::Spec::load(&root.join("../model-spec"))
+        .unwrap_or_else(|e| panic!("{e}"));
     let files = sinsmodel_codegen::generate(&spec);
     let dir = root.join("snapshots");
     let update = std::env::var_os("UPDATE_SNAPSHOTS").is_some();
@@ -25,7 +26,11 @@ fn snapshots_are_fresh() {
     }
     // snapshots of modules the spec no longer generates are stale too
     for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-        let stem = entry.path().file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        let stem = entry
+            .path()
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
         if !files.iter().any(|f| f.module == stem) {
             if update {
                 std::fs::remove_file(entry.path()).unwrap();

@@ -9,7 +9,12 @@ fn spec_dir() -> PathBuf {
 }
 
 /// Copies the real spec into a temp dir, applies `edit(file name, text) -> text`, loads it.
-fn load_edited(edit: impl Fn(&str, String) -> String) -> (tempfile::TempDir, Result<Spec, sinsmodel_codegen::SpecError>) {
+fn load_edited(
+    edit: impl Fn(&str, String) -> String,
+) -> (
+    tempfile::TempDir,
+    Result<Spec, sinsmodel_codegen::SpecError>,
+) {
     let dir = tempfile::tempdir().unwrap();
     for f in sinsmodel_codegen::spec::SPEC_FILES {
         let text = std::fs::read_to_string(spec_dir().join(f)).unwrap();
@@ -23,16 +28,29 @@ fn load_edited(edit: impl Fn(&str, String) -> String) -> (tempfile::TempDir, Res
 fn line_of(dir: &Path, file: &str, needle: &str) -> usize {
     let text = std::fs::read_to_string(dir.join(file)).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    lines.iter().rposition(|l| l.contains(needle)).expect("needle present") + 1
+    lines
+        .iter()
+        .rposition(|l| l.contains(needle))
+        .expect("needle present")
+        + 1
 }
 
 fn expect_error(file: &str, from: &str, to: &str, needle_line: &str, item: &str, problem: &str) {
-    let (dir, r) = load_edited(|f, t| if f == file { t.replacen(from, to, 1) } else { t });
+    let (dir, r) = load_edited(|f, t| {
+        if f == file {
+            t.replacen(from, to, 1)
+        } else {
+            t
+        }
+    });
     let e = r.expect_err("the edited spec must be rejected");
     let msg = e.to_string();
     assert!(msg.contains(file), "message names the file: {msg}");
     assert!(msg.contains(item), "message names the item `{item}`: {msg}");
-    assert!(msg.contains(problem), "message names the problem `{problem}`: {msg}");
+    assert!(
+        msg.contains(problem),
+        "message names the problem `{problem}`: {msg}"
+    );
     let want = line_of(dir.path(), file, needle_line);
     assert_eq!(e.line, want, "line of: {msg}");
 }
@@ -49,43 +67,105 @@ fn the_real_spec_loads() {
 
 #[test]
 fn unknown_symbol_in_a_regressor() {
-    expect_error("terms.toml", "regressor = \"f.x * f.y\"", "regressor = \"f.x * g.y\"", "g.y", "term `kaq_x_xy`", "unknown signal `g.y`");
+    expect_error(
+        "terms.toml",
+        "regressor = \"f.x * f.y\"",
+        "regressor = \"f.x * g.y\"",
+        "g.y",
+        "term `kaq_x_xy`",
+        "unknown signal `g.y`",
+    );
 }
 
 #[test]
 fn unknown_symbol_in_the_navigation_block() {
-    expect_error("navigation.toml", "expr = \"vn / rm\"", "expr = \"vn / rmm\"", "vn / rmm", "A entry (phi_n, phi_d)", "unknown symbol `rmm`");
+    expect_error(
+        "navigation.toml",
+        "expr = \"vn / rm\"",
+        "expr = \"vn / rmm\"",
+        "vn / rmm",
+        "A entry (phi_n, phi_d)",
+        "unknown symbol `rmm`",
+    );
 }
 
 #[test]
 fn syntax_error_in_an_expression() {
-    expect_error("terms.toml", "regressor = \"w.x\"", "regressor = \"w.x *\"", "w.x *", "term `kg_11`", "syntax error");
+    expect_error(
+        "terms.toml",
+        "regressor = \"w.x\"",
+        "regressor = \"w.x *\"",
+        "w.x *",
+        "term `kg_11`",
+        "syntax error",
+    );
 }
 
 #[test]
 fn duplicate_term_name() {
-    expect_error("terms.toml", "name = \"eps_y\"", "name = \"eps_x\"", "name = \"eps_x\"", "term `eps_x`", "duplicate name");
+    expect_error(
+        "terms.toml",
+        "name = \"eps_y\"",
+        "name = \"eps_x\"",
+        "name = \"eps_x\"",
+        "term `eps_x`",
+        "duplicate name",
+    );
 }
 
 #[test]
 fn preset_naming_a_missing_term() {
-    expect_error("presets.toml", "\"d_x\", \"d_y\", \"d_z\",", "\"d_x\", \"d_y\", \"d_q\",", "[preset.P31]", "preset `P31`", "missing term `d_q`");
+    expect_error(
+        "presets.toml",
+        "\"d_x\", \"d_y\", \"d_z\",",
+        "\"d_x\", \"d_y\", \"d_q\",",
+        "[preset.P31]",
+        "preset `P31`",
+        "missing term `d_q`",
+    );
 }
 
 #[test]
 fn wrong_sensor_and_axis() {
-    expect_error("terms.toml", "sensor = \"accel\"", "sensor = \"acel\"", "acel", "term `nabla_x`", "unknown sensor `acel`");
-    expect_error("terms.toml", "axis = \"z\"", "axis = \"w\"", "axis = \"w\"", "term `eps_z`", "unknown axis `w`");
+    expect_error(
+        "terms.toml",
+        "sensor = \"accel\"",
+        "sensor = \"acel\"",
+        "acel",
+        "term `nabla_x`",
+        "unknown sensor `acel`",
+    );
+    expect_error(
+        "terms.toml",
+        "axis = \"z\"",
+        "axis = \"w\"",
+        "axis = \"w\"",
+        "term `eps_z`",
+        "unknown axis `w`",
+    );
 }
 
 #[test]
 fn wrong_unit() {
-    expect_error("terms.toml", "sigma = \"0.02 deg/h\"", "sigma = \"0.02 m/s\"", "0.02 m/s", "term `eps_x`", "dimension");
+    expect_error(
+        "terms.toml",
+        "sigma = \"0.02 deg/h\"",
+        "sigma = \"0.02 m/s\"",
+        "0.02 m/s",
+        "term `eps_x`",
+        "dimension",
+    );
 }
 
 #[test]
 fn malformed_toml() {
-    let (_d, r) = load_edited(|f, t| if f == "presets.toml" { t.replacen("states = [", "states = [[", 1) } else { t });
+    let (_d, r) = load_edited(|f, t| {
+        if f == "presets.toml" {
+            t.replacen("states = [", "states = [[", 1)
+        } else {
+            t
+        }
+    });
     let msg = r.unwrap_err().to_string();
     assert!(msg.contains("presets.toml:"), "{msg}");
 }
@@ -94,7 +174,10 @@ fn malformed_toml() {
 fn missing_spec_file() {
     let dir = tempfile::tempdir().unwrap();
     let msg = Spec::load(dir.path()).unwrap_err().to_string();
-    assert!(msg.contains("navigation.toml") && msg.contains("cannot read"), "{msg}");
+    assert!(
+        msg.contains("navigation.toml") && msg.contains("cannot read"),
+        "{msg}"
+    );
 }
 
 /// Adding a term is one entry in terms.toml: its column appears in the generated code and in
@@ -107,16 +190,29 @@ fn a_new_term_is_one_spec_entry() {
     let t = spec.term_index("kgt_x").expect("new term loaded");
     let files = generate(&spec);
     let common = &files.iter().find(|f| f.module == "common").unwrap().text;
-    assert!(common.contains("name: \"kgt_x\""), "catalogue lists the new term");
-    assert!(common.contains("// A[phi_n][kgt_x] = -C11 * <w.x * f.z>"), "column comment present");
+    assert!(
+        common.contains("name: \"kgt_x\""),
+        "catalogue lists the new term"
+    );
+    assert!(
+        common.contains("// A[phi_n][kgt_x] = -C11 * <w.x * f.z>"),
+        "column comment present"
+    );
     assert!(common.contains("w.x * f.z"), "regressor evaluated");
     // in a model P28 + kgt_x, the new column fills the three attitude rows with -C[:,0] <w.x f.z>
     let p28 = spec.presets.iter().position(|p| p.name == "P28").unwrap();
     let mut layout = Layout::preset(&spec, p28, false);
     layout.states.push(sinsmodel_codegen::StateRef::Term(t));
     let col = layout.states.len() - 1;
-    let entries: Vec<_> = layout.a_entries(&spec).into_iter().filter(|e| e.col == col).collect();
-    let rows: Vec<_> = entries.iter().map(|e| layout.state_name(&spec, e.row)).collect();
+    let entries: Vec<_> = layout
+        .a_entries(&spec)
+        .into_iter()
+        .filter(|e| e.col == col)
+        .collect();
+    let rows: Vec<_> = entries
+        .iter()
+        .map(|e| layout.state_name(&spec, e.row))
+        .collect();
     assert_eq!(rows, ["phi_n", "phi_e", "phi_d"]);
     assert_eq!(entries[2].comment, "-C31 * <w.x * f.z>");
 }

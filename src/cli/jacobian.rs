@@ -34,13 +34,20 @@ pub fn run(args: &JacobianArgs) -> Result<()> {
             for (k, v) in items.into_iter().enumerate() {
                 let p: PointSpec = serde_json::from_value(v)
                     .with_context(|| format!("{}: point {k}", args.at.display()))?;
-                outs.push(jacobian(&model, &p, args.runtime).with_context(|| format!("{}: point {k}", args.at.display()))?);
+                outs.push(
+                    jacobian(&model, &p, args.runtime)
+                        .with_context(|| format!("{}: point {k}", args.at.display()))?,
+                );
             }
             serde_json::to_string(&outs)?
         }
         v => {
-            let p: PointSpec = serde_json::from_value(v).with_context(|| format!("{}", args.at.display()))?;
-            serde_json::to_string(&jacobian(&model, &p, args.runtime).with_context(|| format!("{}", args.at.display()))?)?
+            let p: PointSpec =
+                serde_json::from_value(v).with_context(|| format!("{}", args.at.display()))?;
+            serde_json::to_string(
+                &jacobian(&model, &p, args.runtime)
+                    .with_context(|| format!("{}", args.at.display()))?,
+            )?
         }
     };
     println!("{out}");

@@ -36,7 +36,12 @@ pub fn run(action: ModelAction) -> Result<()> {
 fn list_text() -> String {
     let mut s = String::from("Presets (add `+vertical` for dv_d and dh, `+TERM` for any term):\n");
     for p in PRESETS.iter().filter(|p| !p.vertical) {
-        s.push_str(&format!("  {:<5} {:>2} states  {}\n", p.name, p.states.len(), p.doc));
+        s.push_str(&format!(
+            "  {:<5} {:>2} states  {}\n",
+            p.name,
+            p.states.len(),
+            p.doc
+        ));
     }
     s.push_str("\nNavigation states:\n");
     for st in common::NAV_STATES.iter() {
@@ -92,7 +97,13 @@ pub fn show_text(m: &Model) -> String {
             StateRef::Nav(k) => common::NAV_STATES[k].doc,
             StateRef::Term(k) => common::TERMS[k].doc,
         };
-        s.push_str(&format!("  {:>2} {:<9} {:<9} {}\n", i, name, format!("[{}]", m.unit(i)), kind));
+        s.push_str(&format!(
+            "  {:>2} {:<9} {:<9} {}\n",
+            i,
+            name,
+            format!("[{}]", m.unit(i)),
+            kind
+        ));
     }
     s.push_str(&format!(
         "\nA: {} structural non-zeros of {} ({:.1} %)\n",
@@ -112,7 +123,11 @@ pub fn show_text(m: &Model) -> String {
             meas.name,
             nnz,
             meas.rows.len(),
-            meas.rows.iter().map(|r| r.name).collect::<Vec<_>>().join(" ")
+            meas.rows
+                .iter()
+                .map(|r| r.name)
+                .collect::<Vec<_>>()
+                .join(" ")
         ));
     }
     s.push_str("\nSparsity of A (# = structural non-zero; columns in state order):\n");
@@ -125,7 +140,11 @@ pub fn show_text(m: &Model) -> String {
     for i in 0..n {
         let mut row = format!("  {:>2} {:<8}", i, truncate(m.names[i], 7));
         for j in 0..n {
-            row.push(if m.a_pattern().binary_search(&(i, j)).is_ok() { '#' } else { '.' });
+            row.push(if m.a_pattern().binary_search(&(i, j)).is_ok() {
+                '#'
+            } else {
+                '.'
+            });
         }
         s.push_str(&row);
         s.push('\n');

@@ -1,0 +1,110 @@
+//! The `sinsmodel` binary: model listing, model show, jacobian output and its input errors.
+
+use std::process::Command;
+
+fn sinsmodel(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn model_show_p31_lists_the_canonical_states_in_order() {
+    let (ok, out, _) = sinsmodel(&["model", "show", "P31"]);
+    assert!(ok);
+    let names: Vec<&str> = out
+        .lines()
+        .filter_map(|l| {
+            let mut it = l.split_whitespace();
+            let idx = it.next()?.parse::<usize>().ok()?;
+            let name = it.next()?;
+            it.next()?.starts_with('[').then_some((idx, name))
+        })
+        .map(|(_, n)| n)
+        .collect();
+    let want = "phi_n phi_e phi_d dv_n dv_e dlat dlon eps_x eps_y eps_z nabla_x nabla_y nabla_z \
+                kg_11 kg_21 kg_31 kg_22 kg_32 kg_33 ka_11 ka_21 ka_31 ka_12 ka_22 ka_32 ka_13 ka_23 ka_33 d_x d_y d_z";
+    assert_eq!(names.join(" "), want);
+    assert!(out.contains("Model P31: 31 states"));
+    assert!(out.contains("A: 81 structural non-zeros"), "{out}");
+    assert!(out.contains("H pos_ne: 2 non-zeros"));
+}
+
+#[test]
+fn model_list_shows_presets_and_library_terms_with_units() {
+    let (ok, out, _) = sinsmodel(&["model", "list"]);
+    assert!(ok);
+    for needle in [
+        "P13", "P24", "P28", "P31", "kaq_x_xy", "kgf_zz", "size_z", "deg/h", "ug/g^2",
+    ] {
+        assert!(out.contains(needle), "missing {needle}");
+    }
+}
+
+#[test]
+fn jacobian_prints_dense_a_and_h() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("point.json");
+    std::fs::write(
+        &p,
+        r#"{"lat_deg": 28.22, "h_m": 0, "v_ned": [0,0,0], "euler_deg": [0,0,0], "f_b": [0,0,-9.79], "w_b": [0,0,0]}"#,
+    )
+    .unwrap();
+    let (ok, out, err) = sinsmodel(&[
+        "jacobian",
+        "--model",
+        "P28+kaq_x_xy",
+        "--at",
+        p.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["states"].as_array().unwrap().len(), 29);
+    assert_eq!(v["a"].as_array().unwrap().len(), 29);
+    // level, at rest: dv_e/phi_n = f_D = -g
+    assert!((v["a"][4][0].as_f64().unwrap() + 9.79).abs() < 1e-12);
+    assert_eq!(v["h"]["vel_ne"][0][3].as_f64(), Some(1.0));
+    let rm = v["h"]["pos_ne"][0][5].as_f64().unwrap();
+    assert!(rm > 6.33e6 && rm < 6.40e6, "{rm}");
+}
+
+#[test]
+fn jacobian_rejects_bad_input_with_a_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("missing.json", None, "cannot read"),
+        ("bad.json", Some("{\"lat_deg\": 1,"), "not valid JSON"),
+        (
+            "field.json",
+            Some(
+                r#"{"lat_deg": 1, "h_m": 0, "v_ned": [0,0,0], "euler_deg": [0,0,0], "f_b": [0,0,-9.8]}"#,
+            ),
+            "missing field `w_b`",
+        ),
+        (
+            "lat.json",
+            Some(
+                r#"{"lat_deg": 95, "h_m": 0, "v_ned": [0,0,0], "euler_deg": [0,0,0], "f_b": [0,0,-9.8], "w_b": [0,0,0]}"#,
+            ),
+            "outside",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let p = dir.path().join(name);
+        if let Some(t) = text {
+            std::fs::write(&p, t).unwrap();
+        }
+        let (ok, _, err) = sinsmodel(&["jacobian", "--model", "P31", "--at", p.to_str().unwrap()]);
+        assert!(!ok, "{name} accepted");
+        assert!(err.contains(needle) && err.contains(name), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let (ok, _, err) = sinsmodel(&["model", "show", "P32"]);
+    assert!(!ok && err.contains("unknown preset `P32`"), "{err}");
+}
