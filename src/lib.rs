@@ -1,12 +1,19 @@
 //! sinsmodel: an error-model compiler and model-discovery tool for strapdown inertial
 //! navigation systems. Frames: NED navigation, FRD body; SI units and radians inside.
 
+pub mod atomic_file;
 pub mod attitude;
 pub mod catalog;
 pub mod covariance;
 pub mod earth;
 pub mod generated;
+pub mod imu;
 pub mod jacobian;
 pub mod model;
 pub mod nav_point;
+pub mod rng;
+pub mod scenario;
+pub mod simulator;
+pub mod strapdown;
+pub mod trajectory;
 pub mod units;

@@ -1,0 +1,376 @@
+//! Simulation scenarios (TOML): start state, motion segments, vibration, injected sensor errors,
+//! noise and GNSS aiding. See `scenarios/*.toml` for documented examples.
+
+use crate::generated::common;
+use crate::units;
+use anyhow::{anyhow, bail, Context, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Start of the trajectory.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Start {
+    /// Latitude [deg].
+    pub lat_deg: f64,
+    /// Longitude [deg].
+    pub lon_deg: f64,
+    /// Height [m].
+    #[serde(default)]
+    pub h_m: f64,
+    /// Roll, pitch, yaw [deg] (C_b^n = Rz(yaw) Ry(pitch) Rx(roll)).
+    #[serde(default)]
+    pub euler_deg: [f64; 3],
+    /// Initial speed along the heading [m/s].
+    #[serde(default)]
+    pub speed_mps: f64,
+}
+
+/// One motion segment.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Segment {
+    /// `rest` (speed must be 0), `cruise` (constant speed), `accelerate`, `turn`.
+    pub kind: String,
+    /// Duration [s].
+    pub duration_s: f64,
+    /// Along-track acceleration for `accelerate` [m/s²].
+    #[serde(default)]
+    pub accel_mps2: f64,
+    /// Yaw rate for `turn` [deg/s].
+    #[serde(default)]
+    pub yaw_rate_deg_s: f64,
+}
+
+/// A vibration source.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Vibration {
+    /// `sine` (linear), `random` (linear, band-limited), `angular` (sinusoidal Euler angle).
+    pub kind: String,
+    /// `n` `e` `d` (NED) or `x` `y` `z` (FRD body) for linear; `roll` `pitch` `yaw` for angular.
+    pub axis: String,
+    /// Sine: peak acceleration (e.g. "6 g"); angular: peak angle (e.g. "1 deg").
+    #[serde(default)]
+    pub amplitude: Option<String>,
+    /// Frequency [Hz] (sine, angular).
+    #[serde(default)]
+    pub freq_hz: f64,
+    /// Phase [deg] (sine, angular).
+    #[serde(default)]
+    pub phase_deg: f64,
+    /// Random: acceleration PSD (e.g. "0.01 g^2/Hz"), flat over `band_hz`.
+    #[serde(default)]
+    pub psd: Option<String>,
+    /// Random: [low, high] band edges [Hz].
+    #[serde(default)]
+    pub band_hz: Option<[f64; 2]>,
+    /// Random: number of sinusoids synthesising the band (default 200).
+    #[serde(default)]
+    pub components: Option<usize>,
+    /// Windows [start_s, end_s, amplitude scale]; default: always on at scale 1.
+    #[serde(default)]
+    pub schedule: Option<Vec<[f64; 3]>>,
+}
+
+/// GNSS position aiding written by the simulator.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GnssSpec {
+    /// Rate [Hz].
+    pub rate_hz: f64,
+    /// Horizontal 1-σ (e.g. "0.5 m").
+    #[serde(default = "default_sigma_ne")]
+    pub sigma_ne: String,
+    /// Vertical 1-σ (e.g. "1 m").
+    #[serde(default = "default_sigma_d")]
+    pub sigma_d: String,
+    /// Add Gaussian noise with those σ (default true).
+    #[serde(default = "yes")]
+    pub noisy: bool,
+}
+
+fn default_sigma_ne() -> String {
+    "0.5 m".into()
+}
+fn default_sigma_d() -> String {
+    "1 m".into()
+}
+fn yes() -> bool {
+    true
+}
+
+/// Sensor noise.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseSpec {
+    /// Angle random walk (e.g. "0.01 deg/sqrt(h)").
+    pub arw: Option<String>,
+    /// Velocity random walk (e.g. "10 ug/sqrt(Hz)").
+    pub vrw: Option<String>,
+    /// Gyro bias random walk (e.g. "0.001 deg/h/sqrt(h)").
+    pub gyro_bias_rw: Option<String>,
+    /// Accelerometer bias random walk (e.g. "1 ug/sqrt(h)").
+    pub accel_bias_rw: Option<String>,
+    /// Gyro quantum (e.g. "0.1 arcsec").
+    pub gyro_quantum: Option<String>,
+    /// Accelerometer quantum (e.g. "1e-4 m/s").
+    pub accel_quantum: Option<String>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    name: String,
+    imu_rate_hz: f64,
+    #[serde(default = "default_truth_rate")]
+    truth_rate_hz: f64,
+    #[serde(default)]
+    seed: u64,
+    start: Start,
+    segment: Vec<Segment>,
+    #[serde(default)]
+    vibration: Vec<Vibration>,
+    #[serde(default)]
+    errors: BTreeMap<String, String>,
+    #[serde(default)]
+    noise: NoiseSpec,
+    #[serde(default)]
+    gnss: Option<GnssSpec>,
+}
+
+fn default_truth_rate() -> f64 {
+    10.0
+}
+
+/// A validated scenario, SI units.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// Name.
+    pub name: String,
+    /// IMU rate [Hz].
+    pub imu_rate_hz: f64,
+    /// Truth output rate [Hz].
+    pub truth_rate_hz: f64,
+    /// Seed of every random draw.
+    pub seed: u64,
+    /// Start.
+    pub start: Start,
+    /// Segments.
+    pub segments: Vec<Segment>,
+    /// Vibration sources.
+    pub vibration: Vec<Vibration>,
+    /// Injected errors: (term index in `common::TERMS`, SI value).
+    pub errors: Vec<(usize, f64)>,
+    /// ARW [rad/√s], VRW [m/s/√s], gyro/accel bias RW [rad/s/√s, m/s²/√s], quanta [rad, m/s].
+    pub noise: NoiseSi,
+    /// GNSS aiding (rate [Hz], σ_ne [m], σ_d [m], noisy).
+    pub gnss: Option<(f64, f64, f64, bool)>,
+    /// The scenario text, for provenance.
+    pub text: String,
+}
+
+/// Noise parameters in SI.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoiseSi {
+    /// Angle random walk [rad/√s].
+    pub arw: f64,
+    /// Velocity random walk [m/s/√s].
+    pub vrw: f64,
+    /// Gyro bias random walk [rad/s/√s].
+    pub gyro_bias_rw: f64,
+    /// Accelerometer bias random walk [m/s²/√s].
+    pub accel_bias_rw: f64,
+    /// Gyro quantum [rad] (0 = none).
+    pub gyro_quantum: f64,
+    /// Accelerometer quantum [m/s] (0 = none).
+    pub accel_quantum: f64,
+}
+
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.contains(needle))
+        .map(|i| i + 1)
+        .unwrap_or(0)
+}
+
+impl Scenario {
+    /// Total duration [s].
+    pub fn duration(&self) -> f64 {
+        self.segments.iter().map(|s| s.duration_s).sum()
+    }
+
+    /// Reads and validates a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scenario {}", path.display()))?;
+        Scenario::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses scenario text; `origin` names it in messages.
+    pub fn parse(text: &str, origin: &str) -> Result<Scenario> {
+        let raw: RawScenario = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start].lines().count().max(1))
+                .unwrap_or(0);
+            anyhow!("{origin}:{line}: {}", e.message().trim())
+        })?;
+        let at = |needle: &str| format!("{origin}:{}", line_of(text, needle));
+        if !(raw.imu_rate_hz > 0.0 && raw.imu_rate_hz.is_finite()) {
+            bail!("{}: imu_rate_hz must be positive", at("imu_rate_hz"));
+        }
+        if !(raw.truth_rate_hz > 0.0 && raw.truth_rate_hz <= raw.imu_rate_hz) {
+            bail!(
+                "{}: truth_rate_hz must be in (0, imu_rate_hz]",
+                at("truth_rate_hz")
+            );
+        }
+        if raw.start.lat_deg.abs() >= 89.0 {
+            bail!("{}: lat_deg must be within ±89°", at("lat_deg"));
+        }
+        if raw.segment.is_empty() {
+            bail!("{origin}: at least one [[segment]] is needed");
+        }
+        let mut speed = raw.start.speed_mps;
+        for (k, s) in raw.segment.iter().enumerate() {
+            let where_ = format!("{origin}: segment {} (`{}`)", k + 1, s.kind);
+            if !(s.duration_s > 0.0 && s.duration_s.is_finite()) {
+                bail!("{where_}: duration_s must be positive");
+            }
+            match s.kind.as_str() {
+                "rest" if speed != 0.0 => {
+                    bail!("{where_}: rest needs zero speed (speed is {speed} m/s)")
+                }
+                "rest" | "cruise" | "turn" => {}
+                "accelerate" => speed += s.accel_mps2 * s.duration_s,
+                other => bail!("{where_}: unknown kind `{other}` (rest, cruise, accelerate, turn)"),
+            }
+            if speed < 0.0 {
+                bail!("{where_}: speed would become negative");
+            }
+        }
+        for v in &raw.vibration {
+            let where_ = format!(
+                "{}: vibration `{}` on `{}`",
+                at(&format!("axis = \"{}\"", v.axis)),
+                v.kind,
+                v.axis
+            );
+            let linear_axes = ["n", "e", "d", "x", "y", "z"];
+            match v.kind.as_str() {
+                "sine" | "random" if !linear_axes.contains(&v.axis.as_str()) => {
+                    bail!("{where_}: axis must be one of n e d x y z")
+                }
+                "angular" if !["roll", "pitch", "yaw"].contains(&v.axis.as_str()) => {
+                    bail!("{where_}: axis must be roll, pitch or yaw")
+                }
+                "sine" | "random" | "angular" => {}
+                other => bail!("{where_}: unknown kind `{other}` (sine, random, angular)"),
+            }
+            match v.kind.as_str() {
+                "sine" => {
+                    let a = v
+                        .amplitude
+                        .as_deref()
+                        .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
+                    units::parse_quantity_as(a, "m/s^2")
+                        .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
+                }
+                "angular" => {
+                    let a = v
+                        .amplitude
+                        .as_deref()
+                        .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
+                    units::parse_quantity_as(a, "rad")
+                        .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
+                }
+                _ => {
+                    let p = v
+                        .psd
+                        .as_deref()
+                        .ok_or_else(|| anyhow!("{where_}: psd missing"))?;
+                    units::parse_quantity_as(p, "m^2/s^4/Hz")
+                        .map_err(|e| anyhow!("{where_}: psd: {e}"))?;
+                    let b = v
+                        .band_hz
+                        .ok_or_else(|| anyhow!("{where_}: band_hz missing"))?;
+                    if !(b[0] > 0.0 && b[1] > b[0]) {
+                        bail!("{where_}: band_hz must be [low, high] with 0 < low < high");
+                    }
+                }
+            }
+            if v.kind != "random" && !(v.freq_hz > 0.0) {
+                bail!("{where_}: freq_hz must be positive");
+            }
+            for w in v.schedule.iter().flatten() {
+                if !(w[1] > w[0]) {
+                    bail!("{where_}: schedule window {w:?} must have end > start");
+                }
+            }
+        }
+        let mut errors = Vec::new();
+        for (name, value) in &raw.errors {
+            let at_e = at(&format!("{name} "));
+            let k = common::TERMS
+                .iter()
+                .position(|t| t.name == name)
+                .ok_or_else(|| {
+                    anyhow!("{at_e}: [errors]: unknown term `{name}` (see `sinsmodel model list`)")
+                })?;
+            let si = units::parse_quantity_as(value, common::TERMS[k].unit).map_err(|e| {
+                anyhow!(
+                    "{at_e}: [errors] {name}: {e} (unit of {name}: {})",
+                    common::TERMS[k].unit
+                )
+            })?;
+            errors.push((k, si));
+        }
+        let q = |v: &Option<String>, unit: &str, key: &str| -> Result<f64> {
+            match v {
+                Some(s) => units::parse_quantity_as(s, unit)
+                    .map_err(|e| anyhow!("{}: [noise] {key}: {e}", at(key))),
+                None => Ok(0.0),
+            }
+        };
+        let n = &raw.noise;
+        let noise = NoiseSi {
+            arw: q(&n.arw, "rad/sqrt(s)", "arw")?,
+            vrw: q(&n.vrw, "m/s/sqrt(s)", "vrw")?,
+            gyro_bias_rw: q(&n.gyro_bias_rw, "rad/s/sqrt(s)", "gyro_bias_rw")?,
+            accel_bias_rw: q(&n.accel_bias_rw, "m/s^2/sqrt(s)", "accel_bias_rw")?,
+            gyro_quantum: q(&n.gyro_quantum, "rad", "gyro_quantum")?,
+            accel_quantum: q(&n.accel_quantum, "m/s", "accel_quantum")?,
+        };
+        let gnss = match &raw.gnss {
+            Some(g) => {
+                if !(g.rate_hz > 0.0 && g.rate_hz <= raw.imu_rate_hz) {
+                    bail!(
+                        "{}: [gnss] rate_hz must be in (0, imu_rate_hz]",
+                        at("rate_hz")
+                    );
+                }
+                let sne = units::parse_quantity_as(&g.sigma_ne, "m")
+                    .map_err(|e| anyhow!("{}: [gnss] sigma_ne: {e}", at("sigma_ne")))?;
+                let sd = units::parse_quantity_as(&g.sigma_d, "m")
+                    .map_err(|e| anyhow!("{}: [gnss] sigma_d: {e}", at("sigma_d")))?;
+                Some((g.rate_hz, sne, sd, g.noisy))
+            }
+            None => None,
+        };
+        Ok(Scenario {
+            name: raw.name,
+            imu_rate_hz: raw.imu_rate_hz,
+            truth_rate_hz: raw.truth_rate_hz,
+            seed: raw.seed,
+            start: raw.start,
+            segments: raw.segment,
+            vibration: raw.vibration,
+            errors,
+            noise,
+            gnss,
+            text: text.to_string(),
+        })
+    }
+}

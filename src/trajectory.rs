@@ -1,0 +1,271 @@
+//! True motion of a scenario as analytic functions of time: base motion (speed and heading by
+//! segments, level attitude), linear vibration (NED or body axes; sine, or random as a seeded sum
+//! of sinusoids with a flat PSD) and angular vibration (sinusoidal Euler angles). Velocity,
+//! acceleration, attitude and body rate are exact derivatives of each other; position is
+//! integrated from the velocity (see `simulator`).
+
+use crate::attitude::dcm_from_euler;
+use crate::rng::Rng;
+use crate::scenario::Scenario;
+use crate::units;
+use nalgebra::{Matrix3, Vector3};
+use std::f64::consts::PI;
+
+/// Frame of a linear vibration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Frame {
+    Ned,
+    Body,
+}
+
+/// A linear vibration along one axis: Σ A_i cos(ω_i t + φ_i), switched by windows.
+#[derive(Debug, Clone)]
+struct Linear {
+    frame: Frame,
+    axis: usize,
+    comps: Vec<(f64, f64, f64)>,
+    windows: Vec<[f64; 3]>,
+}
+
+impl Linear {
+    /// (velocity, acceleration) along the axis: the velocity is the exact integral of the
+    /// acceleration from the start of each window (continuous, frozen after the window).
+    fn eval(&self, t: f64) -> (f64, f64) {
+        let (mut v, mut a) = (0.0, 0.0);
+        for w in &self.windows {
+            if t < w[0] {
+                continue;
+            }
+            let te = t.min(w[1]);
+            for &(amp, om, ph) in &self.comps {
+                v += w[2] * amp / om * ((om * te + ph).sin() - (om * w[0] + ph).sin());
+                if t <= w[1] {
+                    a += w[2] * amp * (om * t + ph).cos();
+                }
+            }
+        }
+        (v, a)
+    }
+}
+
+/// Angular vibration of one Euler angle: Θ sin(ω (t − t0) + φ) − Θ sin φ inside each window.
+#[derive(Debug, Clone)]
+struct Angular {
+    axis: usize,
+    amp: f64,
+    om: f64,
+    ph: f64,
+    windows: Vec<[f64; 3]>,
+}
+
+impl Angular {
+    fn eval(&self, t: f64) -> (f64, f64) {
+        let (mut ang, mut rate) = (0.0, 0.0);
+        for w in &self.windows {
+            if t < w[0] || t > w[1] {
+                continue;
+            }
+            let x = self.om * (t - w[0]) + self.ph;
+            ang += w[2] * self.amp * (x.sin() - self.ph.sin());
+            rate += w[2] * self.amp * self.om * x.cos();
+        }
+        (ang, rate)
+    }
+}
+
+/// Kinematic state at one instant.
+#[derive(Debug, Clone, Copy)]
+pub struct Kinematics {
+    /// NED velocity [m/s].
+    pub v: Vector3<f64>,
+    /// NED acceleration dv/dt [m/s²].
+    pub a: Vector3<f64>,
+    /// C_b^n.
+    pub c: Matrix3<f64>,
+    /// Body rate relative to NED, ω_nb^b [rad/s].
+    pub w_nb: Vector3<f64>,
+    /// Roll, pitch, yaw [rad].
+    pub euler: Vector3<f64>,
+}
+
+/// The analytic motion of a scenario.
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    seg_start: Vec<f64>,
+    seg_speed0: Vec<f64>,
+    seg_yaw0: Vec<f64>,
+    seg_accel: Vec<f64>,
+    seg_yaw_rate: Vec<f64>,
+    roll0: f64,
+    pitch0: f64,
+    linear: Vec<Linear>,
+    angular: Vec<Angular>,
+    /// Highest vibration frequency [Hz] (0 without vibration).
+    pub max_freq_hz: f64,
+    /// Total duration [s].
+    pub duration: f64,
+}
+
+fn windows(s: &Option<Vec<[f64; 3]>>) -> Vec<[f64; 3]> {
+    s.clone().unwrap_or_else(|| vec![[0.0, f64::INFINITY, 1.0]])
+}
+
+impl Trajectory {
+    /// Builds the motion of a validated scenario (random vibration draws from its seed).
+    pub fn new(sc: &Scenario) -> Trajectory {
+        let d = PI / 180.0;
+        let (mut t, mut speed, mut yaw) = (0.0, sc.start.speed_mps, sc.start.euler_deg[2] * d);
+        let (mut seg_start, mut seg_speed0, mut seg_yaw0, mut seg_accel, mut seg_yaw_rate) =
+            (vec![], vec![], vec![], vec![], vec![]);
+        for s in &sc.segments {
+            let (acc, yr) = match s.kind.as_str() {
+                "accelerate" => (s.accel_mps2, 0.0),
+                "turn" => (0.0, s.yaw_rate_deg_s * d),
+                _ => (0.0, 0.0),
+            };
+            seg_start.push(t);
+            seg_speed0.push(speed);
+            seg_yaw0.push(yaw);
+            seg_accel.push(acc);
+            seg_yaw_rate.push(yr);
+            speed += acc * s.duration_s;
+            yaw += yr * s.duration_s;
+            t += s.duration_s;
+        }
+        let mut rng = Rng::new(sc.seed ^ 0x5eed_0f_7a_b1e);
+        let mut linear = Vec::new();
+        let mut angular = Vec::new();
+        let mut max_freq: f64 = 0.0;
+        for v in &sc.vibration {
+            let axis_idx = |a: &str| {
+                ["n", "e", "d", "x", "y", "z", "roll", "pitch", "yaw"]
+                    .iter()
+                    .position(|x| *x == a)
+                    .unwrap_or(0)
+            };
+            let k = axis_idx(&v.axis);
+            match v.kind.as_str() {
+                "sine" => {
+                    let amp =
+                        units::parse_quantity_as(v.amplitude.as_deref().unwrap_or("0"), "m/s^2")
+                            .unwrap_or(0.0);
+                    max_freq = max_freq.max(v.freq_hz);
+                    linear.push(Linear {
+                        frame: if k < 3 { Frame::Ned } else { Frame::Body },
+                        axis: k % 3,
+                        comps: vec![(amp, 2.0 * PI * v.freq_hz, v.phase_deg * d)],
+                        windows: windows(&v.schedule),
+                    });
+                }
+                "random" => {
+                    let psd =
+                        units::parse_quantity_as(v.psd.as_deref().unwrap_or("0"), "m^2/s^4/Hz")
+                            .unwrap_or(0.0);
+                    let [lo, hi] = v.band_hz.unwrap_or([1.0, 2.0]);
+                    let n = v.components.unwrap_or(200).max(1);
+                    let df = (hi - lo) / n as f64;
+                    let amp = (2.0 * psd * df).sqrt();
+                    let comps = (0..n)
+                        .map(|i| {
+                            let f = lo + (i as f64 + rng.uniform()) * df;
+                            (amp, 2.0 * PI * f, 2.0 * PI * rng.uniform())
+                        })
+                        .collect();
+                    max_freq = max_freq.max(hi);
+                    linear.push(Linear {
+                        frame: if k < 3 { Frame::Ned } else { Frame::Body },
+                        axis: k % 3,
+                        comps,
+                        windows: windows(&v.schedule),
+                    });
+                }
+                _ => {
+                    let amp =
+                        units::parse_quantity_as(v.amplitude.as_deref().unwrap_or("0"), "rad")
+                            .unwrap_or(0.0);
+                    max_freq = max_freq.max(v.freq_hz);
+                    angular.push(Angular {
+                        axis: k - 6,
+                        amp,
+                        om: 2.0 * PI * v.freq_hz,
+                        ph: v.phase_deg * d,
+                        windows: windows(&v.schedule),
+                    });
+                }
+            }
+        }
+        Trajectory {
+            seg_start,
+            seg_speed0,
+            seg_yaw0,
+            seg_accel,
+            seg_yaw_rate,
+            roll0: sc.start.euler_deg[0] * d,
+            pitch0: sc.start.euler_deg[1] * d,
+            linear,
+            angular,
+            max_freq_hz: max_freq,
+            duration: t,
+        }
+    }
+
+    /// The kinematic state at time `t` [s].
+    pub fn at(&self, t: f64) -> Kinematics {
+        let i = match self.seg_start.iter().rposition(|&s| s <= t) {
+            Some(i) => i,
+            None => 0,
+        };
+        let tau = t - self.seg_start[i];
+        let speed = self.seg_speed0[i] + self.seg_accel[i] * tau;
+        let yaw_base = self.seg_yaw0[i] + self.seg_yaw_rate[i] * tau;
+        let (sy, cy) = yaw_base.sin_cos();
+        let mut v = Vector3::new(speed * cy, speed * sy, 0.0);
+        let mut a = Vector3::new(
+            self.seg_accel[i] * cy - speed * self.seg_yaw_rate[i] * sy,
+            self.seg_accel[i] * sy + speed * self.seg_yaw_rate[i] * cy,
+            0.0,
+        );
+        let mut euler = Vector3::new(self.roll0, self.pitch0, yaw_base);
+        let mut euler_rate = Vector3::new(0.0, 0.0, self.seg_yaw_rate[i]);
+        for ang in &self.angular {
+            let (x, r) = ang.eval(t);
+            euler[ang.axis] += x;
+            euler_rate[ang.axis] += r;
+        }
+        let c = dcm_from_euler(euler.x, euler.y, euler.z);
+        let (sr, cr) = euler.x.sin_cos();
+        let (sp, cp) = euler.y.sin_cos();
+        let w_nb = Vector3::new(
+            euler_rate.x - euler_rate.z * sp,
+            euler_rate.y * cr + euler_rate.z * sr * cp,
+            -euler_rate.y * sr + euler_rate.z * cr * cp,
+        );
+        let mut vb = Vector3::zeros();
+        let mut ab = Vector3::zeros();
+        for l in &self.linear {
+            let (lv, la) = l.eval(t);
+            match l.frame {
+                Frame::Ned => {
+                    v[l.axis] += lv;
+                    a[l.axis] += la;
+                }
+                Frame::Body => {
+                    vb[l.axis] += lv;
+                    ab[l.axis] += la;
+                }
+            }
+        }
+        if vb != Vector3::zeros() || ab != Vector3::zeros() {
+            // v^n = C v^b  →  dv^n/dt = C (a^b + ω_nb^b × v^b)
+            v += c * vb;
+            a += c * (ab + w_nb.cross(&vb));
+        }
+        Kinematics {
+            v,
+            a,
+            c,
+            w_nb,
+            euler,
+        }
+    }
+}
