@@ -11,6 +11,7 @@ pub mod imu;
 pub mod jacobian;
 pub mod model;
 pub mod nav_point;
+pub mod readers;
 pub mod rng;
 pub mod scenario;
 pub mod simulator;

@@ -1,0 +1,158 @@
+//! The rtklibexplorer GNSS_IMU logs: `imu_*.csv` with rows `acc_x acc_y acc_z [g]
+//! gyro_x gyro_y gyro_z [deg/s] t [ms since power-up]`, and the RTKLIB time-tag file
+//! `imu_*.csv.tag` (60-byte text header, u32 tick_f, u32 time [s], f64 sec — the GPST start,
+//! seconds since 1970 — then records u32 tick [ms since start], u32 file position).
+//!
+//! Rates are turned into increments over each sample interval (rate × Δt). The IMU's body axes
+//! are not documented: samples stay in the sensor's own axes (the mounting is found from the
+//! data elsewhere). A malformed first or last line (partial write) is skipped with a warning; a
+//! malformed line elsewhere is an error.
+
+use crate::imu::{ImuData, ImuSample};
+use crate::units::STANDARD_GRAVITY;
+use anyhow::{bail, Context, Result};
+use nalgebra::Vector3;
+use std::path::Path;
+
+/// A GNSS_IMU log on GPST.
+#[derive(Debug, Clone)]
+pub struct GnssImuLog {
+    /// Increments in the sensor axes, times in GPST seconds since 1970.
+    pub imu: ImuData,
+    /// GPST − IMU clock [s], from the time-tag file.
+    pub clock_offset: f64,
+    /// Lines skipped with a warning (line numbers).
+    pub skipped: Vec<usize>,
+}
+
+fn parse_row(l: &str) -> Option<[f64; 7]> {
+    let f: Vec<&str> = l.split(',').map(str::trim).collect();
+    if f.len() != 7 || f.iter().any(|x| x.is_empty()) {
+        return None;
+    }
+    let mut out = [0.0; 7];
+    for (o, s) in out.iter_mut().zip(&f) {
+        *o = s.parse().ok().filter(|v: &f64| v.is_finite())?;
+    }
+    Some(out)
+}
+
+/// Reads `path` and, for GPST, `path` + `.tag`.
+pub fn read(path: &Path) -> Result<GnssImuLog> {
+    let bytes =
+        std::fs::read(path).with_context(|| format!("cannot read IMU log {}", path.display()))?;
+    let text = String::from_utf8_lossy(&bytes);
+    let lines: Vec<&str> = text.split('\n').collect();
+    let n_lines = lines
+        .iter()
+        .rposition(|l| !l.trim().is_empty())
+        .map(|k| k + 1)
+        .unwrap_or(0);
+    // The tag's file positions count the bytes as logged; this file was stored with LF line ends
+    // where the logger wrote CR LF when the last tag position lies beyond the file's end.
+    let tag_path = path.with_extension("csv.tag");
+    let tag = read_tag(&tag_path)?;
+    let last_pos = tag.records.last().map(|r| r.1).unwrap_or(0);
+    let line_end_bytes = if last_pos > bytes.len() { 2 } else { 1 };
+    let mut rows: Vec<([f64; 7], usize)> = Vec::new(); // (row, byte offset of the line end)
+    let mut skipped = Vec::new();
+    let mut offset = 0usize;
+    for (i, line) in lines.iter().enumerate().take(n_lines) {
+        let line = line.trim_end_matches('\r');
+        offset += line.len() + line_end_bytes;
+        let l = line.trim();
+        match parse_row(l) {
+            Some(r) => rows.push((r, offset)),
+            None if i == 0 || i + 1 == n_lines => {
+                eprintln!(
+                    "warning: {}:{}: partial or malformed line skipped: `{l}`",
+                    path.display(),
+                    i + 1
+                );
+                skipped.push(i + 1);
+            }
+            None => bail!(
+                "{}:{}: malformed row `{l}` (expected 7 comma-separated numbers)",
+                path.display(),
+                i + 1
+            ),
+        }
+    }
+    if rows.len() < 2 {
+        bail!("{}: fewer than two valid rows", path.display());
+    }
+    let clock_offset = clock_offset(&tag, &tag_path, &rows)?;
+    let d2r = std::f64::consts::PI / 180.0;
+    let mut samples = Vec::with_capacity(rows.len());
+    for (k, w) in rows.windows(2).enumerate() {
+        let (prev, cur) = (&w[0].0, &w[1].0);
+        let dt = (cur[6] - prev[6]) * 1e-3;
+        if dt <= 0.0 {
+            bail!(
+                "{}: row {}: time {} ms does not increase (previous {} ms)",
+                path.display(),
+                k + 2,
+                cur[6],
+                prev[6]
+            );
+        }
+        samples.push(ImuSample {
+            t: cur[6] * 1e-3 + clock_offset,
+            dtheta: Vector3::new(cur[3], cur[4], cur[5]) * (d2r * dt),
+            dv: Vector3::new(cur[0], cur[1], cur[2]) * (STANDARD_GRAVITY * dt),
+        });
+    }
+    Ok(GnssImuLog {
+        imu: ImuData { samples },
+        clock_offset,
+        skipped,
+    })
+}
+
+/// The parsed time-tag file: GPST start [s since 1970] and (tick [ms], file position) records.
+struct Tag {
+    start: f64,
+    records: Vec<(f64, usize)>,
+}
+
+fn read_tag(tag: &Path) -> Result<Tag> {
+    let b = std::fs::read(tag)
+        .with_context(|| format!("cannot read time-tag file {}", tag.display()))?;
+    if b.len() < 76 || !b.starts_with(b"TIMETAG") {
+        bail!("{}: not an RTKLIB time-tag file", tag.display());
+    }
+    let time = u32::from_le_bytes(b[64..68].try_into().expect("4 bytes")) as f64;
+    let sec = f64::from_le_bytes(b[68..76].try_into().expect("8 bytes"));
+    let records = b[76..]
+        .chunks_exact(8)
+        .map(|r| {
+            let tick = u32::from_le_bytes(r[0..4].try_into().expect("4 bytes")) as f64;
+            let fpos = u32::from_le_bytes(r[4..8].try_into().expect("4 bytes")) as usize;
+            (tick, fpos)
+        })
+        .collect();
+    Ok(Tag {
+        start: time + sec,
+        records,
+    })
+}
+
+/// GPST − IMU clock: each tag record says the bytes up to its file position had arrived by
+/// start + tick; a line ending before that position was sampled no later, so every record bounds
+/// the offset from above and the smallest bound (least latency) is taken.
+fn clock_offset(tag: &Tag, path: &Path, rows: &[([f64; 7], usize)]) -> Result<f64> {
+    let mut best = f64::INFINITY;
+    let mut k = 0usize;
+    for &(tick, fpos) in &tag.records {
+        while k + 1 < rows.len() && rows[k + 1].1 <= fpos {
+            k += 1;
+        }
+        if rows[k].1 <= fpos {
+            best = best.min(tag.start + tick * 1e-3 - rows[k].0[6] * 1e-3);
+        }
+    }
+    if !best.is_finite() {
+        bail!("{}: no record covers a complete IMU line", path.display());
+    }
+    Ok(best)
+}

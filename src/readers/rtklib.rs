@@ -1,0 +1,92 @@
+//! RTKLIB `.pos` solutions: `%` header lines, then `YYYY/MM/DD HH:MM:SS.sss lat lon h Q ns
+//! sdn sde sdu sdne sdeu sdun age ratio [vn ve vu sdvn sdve sdvu sdvne sdveu sdvun]` in GPST.
+
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// One RTKLIB epoch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PosEpoch {
+    /// GPST, seconds since 1970-01-01 (GPST calendar, no leap seconds applied).
+    pub t: f64,
+    /// Latitude [deg].
+    pub lat_deg: f64,
+    /// Longitude [deg].
+    pub lon_deg: f64,
+    /// Ellipsoidal height [m].
+    pub h: f64,
+    /// Quality flag (1 fix, 2 float, …).
+    pub q: u8,
+    /// 1-σ north, east, up [m].
+    pub sigma_neu: [f64; 3],
+    /// NED velocity [m/s] when the file has it.
+    pub v_ned: Option<[f64; 3]>,
+}
+
+/// Days since 1970-01-01 of a proleptic Gregorian date.
+pub fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
+    let y = if m <= 2 { y - 1 } else { y };
+    let era = if y >= 0 { y } else { y - 399 } / 400;
+    let yoe = y - era * 400;
+    let doy = (153 * (m + if m > 2 { -3 } else { 9 }) + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    era * 146_097 + doe - 719_468
+}
+
+/// Reads a `.pos` file.
+pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read RTKLIB solution {}", path.display()))?;
+    let mut out: Vec<PosEpoch> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('%') {
+            continue;
+        }
+        let at = || format!("{}:{}", path.display(), i + 1);
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if f.len() < 14 {
+            bail!("{}: expected at least 14 columns, found {}", at(), f.len());
+        }
+        let date: Vec<i64> = f[0].split('/').filter_map(|x| x.parse().ok()).collect();
+        let time: Vec<f64> = f[1].split(':').filter_map(|x| x.parse().ok()).collect();
+        if date.len() != 3 || time.len() != 3 {
+            bail!("{}: bad GPST date/time `{} {}`", at(), f[0], f[1]);
+        }
+        let num = |k: usize| -> Result<f64> {
+            f[k].parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    anyhow::anyhow!("{}: column {}: `{}` is not a number", at(), k + 1, f[k])
+                })
+        };
+        let t = days_from_civil(date[0], date[1], date[2]) as f64 * 86400.0
+            + time[0] * 3600.0
+            + time[1] * 60.0
+            + time[2];
+        if let Some(prev) = out.last() {
+            if t <= prev.t {
+                bail!("{}: time does not increase", at());
+            }
+        }
+        let v_ned = if f.len() >= 18 {
+            Some([num(15)?, num(16)?, -num(17)?])
+        } else {
+            None
+        };
+        out.push(PosEpoch {
+            t,
+            lat_deg: num(2)?,
+            lon_deg: num(3)?,
+            h: num(4)?,
+            q: num(5)? as u8,
+            sigma_neu: [num(7)?, num(8)?, num(9)?],
+            v_ned,
+        });
+    }
+    if out.is_empty() {
+        bail!("{}: no solution epochs", path.display());
+    }
+    Ok(out)
+}

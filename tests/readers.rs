@@ -1,0 +1,95 @@
+//! Readers against the real measured data in ../shared/data (see its README).
+
+use sinsmodel::readers::{gnss_imu, psins, rtklib};
+use std::path::PathBuf;
+
+fn data(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(rel)
+}
+
+#[test]
+fn psins_lasergyro_log() {
+    let log = psins::read(&data("psins-lasergyro/lasergyro.imu")).unwrap();
+    let imu = &log.imu;
+    assert_eq!(imu.samples.len(), 184_718);
+    assert!((imu.rate_hz() - 100.0).abs() < 1e-6);
+    imu.check_time("lasergyro", 1.5).unwrap();
+    let (f, w) = imu.mean_rates();
+    let w_degh = w.norm().to_degrees() * 3600.0;
+    eprintln!(
+        "lasergyro: |mean f| = {:.4} m/s^2, |mean w| = {w_degh:.3} deg/h, f = {f:?}",
+        f.norm()
+    );
+    assert!((f.norm() - 9.795).abs() < 0.005, "{}", f.norm());
+    assert!((w_degh - 14.9).abs() < 0.1, "{w_degh}");
+    // FRD: gravity reaction points up, i.e. along -z for a near-level vehicle
+    assert!(f.z < -9.7);
+    assert!((log.lat_deg - 34.246048).abs() < 1e-9);
+    assert!(
+        (log.euler_deg[2] - 90.6).abs() < 1e-9,
+        "NED yaw from PSINS yaw -90.6"
+    );
+}
+
+#[test]
+fn gnss_imu_drive_on_gpst_with_rtk_aligned() {
+    let log = gnss_imu::read(&data("gnss-imu-drive/imu_1934.csv")).unwrap();
+    let imu = &log.imu;
+    let n = imu.samples.len();
+    eprintln!(
+        "gnss_imu: {n} samples, skipped lines {:?}, GPST {:.3} .. {:.3}",
+        log.skipped,
+        imu.samples[0].t,
+        imu.samples[n - 1].t
+    );
+    assert!((54_800..54_900).contains(&n), "{n}");
+    assert!((imu.rate_hz() - 100.0).abs() < 1.0);
+    let pos = rtklib::read(&data("gnss-imu-drive/gnss_1934_sf.pos")).unwrap();
+    assert_eq!(pos.len(), 2197);
+    let fixed = pos.iter().filter(|p| p.q == 1).count() as f64 / pos.len() as f64;
+    assert!(fixed > 0.99);
+    // both on GPST 2025-07-08 19:34 .. 19:43, overlapping by more than 540 s
+    let (i0, i1) = (imu.samples[0].t, imu.samples[n - 1].t);
+    let (p0, p1) = (pos[0].t, pos[pos.len() - 1].t);
+    let day = rtklib::days_from_civil(2025, 7, 8) as f64 * 86400.0;
+    assert!((p0 - (day + 19.0 * 3600.0 + 34.0 * 60.0 + 18.499)).abs() < 1e-6);
+    let overlap = i1.min(p1) - i0.max(p0);
+    assert!(overlap > 540.0, "overlap {overlap} s");
+    // alignment: the car drives off in both records at the same time (within 0.5 s):
+    // RTK speed first exceeds 1 m/s; IMU horizontal specific force (sensor x, y) first departs
+    // from its static mean by 1 m/s² for 0.5 s.
+    let t_rtk = pos
+        .iter()
+        .find(|p| p.v_ned.map(|v| v[0].hypot(v[1])).unwrap_or(0.0) > 1.0)
+        .unwrap()
+        .t;
+    let dt = imu.interval();
+    let static_n = 3000;
+    let mean = imu.samples[..static_n]
+        .iter()
+        .map(|s| s.dv / dt)
+        .sum::<nalgebra::Vector3<f64>>()
+        / static_n as f64;
+    let filt: Vec<(f64, f64)> = imu
+        .samples
+        .windows(50)
+        .map(|w| {
+            let m = w.iter().map(|s| s.dv / dt).sum::<nalgebra::Vector3<f64>>() / 50.0 - mean;
+            (w[49].t, m.x.hypot(m.y))
+        })
+        .collect();
+    let t_imu = filt
+        .iter()
+        .find(|x| x.0 > t_rtk - 30.0 && x.1 > 1.0)
+        .map(|x| x.0)
+        .unwrap();
+    eprintln!(
+        "drive-off: RTK speed > 1 m/s at {t_rtk:.2}, IMU horizontal accel > 1 m/s^2 at {t_imu:.2}"
+    );
+    assert!(
+        t_imu < t_rtk + 0.5 && t_imu > t_rtk - 5.0,
+        "IMU {t_imu} vs RTK {t_rtk}"
+    );
+}
