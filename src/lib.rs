@@ -1,6 +1,7 @@
 //! sinsmodel: an error-model compiler and model-discovery tool for strapdown inertial
 //! navigation systems. Frames: NED navigation, FRD body; SI units and radians inside.
 
+pub mod aiding;
 pub mod atomic_file;
 pub mod attitude;
 pub mod catalog;
@@ -11,10 +12,12 @@ pub mod imu;
 pub mod jacobian;
 pub mod model;
 pub mod nav_point;
+pub mod progress;
 pub mod readers;
 pub mod rng;
 pub mod scenario;
 pub mod simulator;
 pub mod strapdown;
 pub mod trajectory;
+pub mod truth;
 pub mod units;

@@ -22,6 +22,10 @@ enum Command {
     },
     /// Print A(t) and H of a model at one point (JSON), for the CasADi check.
     Jacobian(cli::jacobian::JacobianArgs),
+    /// Simulate a scenario: IMU increments with injected errors, GNSS fixes and truth.
+    Simulate(cli::simulate::SimulateArgs),
+    /// Run the strapdown navigator on an IMU file.
+    Navigate(cli::navigate::NavigateArgs),
 }
 
 fn main() -> ExitCode {
@@ -29,6 +33,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Model { action } => cli::model::run(action),
         Command::Jacobian(args) => cli::jacobian::run(&args),
+        Command::Simulate(args) => cli::simulate::run(&args),
+        Command::Navigate(args) => cli::navigate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -301,11 +301,11 @@ impl Scenario {
                     }
                 }
             }
-            if v.kind != "random" && !(v.freq_hz > 0.0) {
+            if v.kind != "random" && (v.freq_hz.is_nan() || v.freq_hz <= 0.0) {
                 bail!("{where_}: freq_hz must be positive");
             }
             for w in v.schedule.iter().flatten() {
-                if !(w[1] > w[0]) {
+                if w[1].is_nan() || w[0].is_nan() || w[1] <= w[0] {
                     bail!("{where_}: schedule window {w:?} must have end > start");
                 }
             }

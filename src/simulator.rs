@@ -3,6 +3,7 @@
 //! any spec term by name (applied to the instantaneous signals, then integrated), white noise,
 //! bias random walk and quantisation. Seeded and bit-reproducible.
 
+use crate::aiding::PositionFix;
 use crate::catalog::Sensor;
 use crate::earth;
 use crate::generated::common;
@@ -11,39 +12,8 @@ use crate::rng::Rng;
 use crate::scenario::Scenario;
 use crate::strapdown::NavState;
 use crate::trajectory::Trajectory;
+use crate::truth::TruthRow;
 use nalgebra::{UnitQuaternion, Vector3};
-
-/// A truth record (DESIGN §9 truth layout; angles in radians here).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TruthRow {
-    /// Time [s].
-    pub t: f64,
-    /// Latitude [rad].
-    pub lat: f64,
-    /// Longitude [rad].
-    pub lon: f64,
-    /// Height [m].
-    pub h: f64,
-    /// NED velocity [m/s].
-    pub v: Vector3<f64>,
-    /// Roll, pitch, yaw [rad].
-    pub euler: Vector3<f64>,
-}
-
-/// A GNSS position fix with its σ (DESIGN §9 aiding layout; angles in radians here).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GnssRow {
-    /// Time [s].
-    pub t: f64,
-    /// Latitude [rad].
-    pub lat: f64,
-    /// Longitude [rad].
-    pub lon: f64,
-    /// Height [m].
-    pub h: f64,
-    /// 1-σ north, east, down [m].
-    pub sigma: [f64; 3],
-}
 
 /// Everything a simulation produces.
 #[derive(Debug, Clone)]
@@ -53,7 +23,7 @@ pub struct SimOutput {
     /// Truth at the truth rate, starting at t = 0.
     pub truth: Vec<TruthRow>,
     /// GNSS fixes.
-    pub gnss: Vec<GnssRow>,
+    pub gnss: Vec<PositionFix>,
     /// True navigation state at t = 0 (to start a navigator).
     pub start: NavState,
 }
@@ -68,23 +38,41 @@ struct Injected {
     value: f64,
 }
 
-fn pos_rate(lat: f64, h: f64, v: &Vector3<f64>) -> Vector3<f64> {
-    let rm = earth::radius_meridian(lat) + h;
-    let rn = earth::radius_transverse(lat) + h;
-    Vector3::new(v.x / rm, v.y / (rn * lat.cos()), -v.z)
+/// Earth quantities at one position, frozen over an IMU interval (their change within one
+/// interval is below 1e-9 relative even at 300 m/s).
+struct EarthAt {
+    rm: f64,
+    rn: f64,
+    tan: f64,
+    cos: f64,
+    w_ie: Vector3<f64>,
+    g: Vector3<f64>,
 }
 
-/// True specific force f^b [m/s²] and body rate ω_ib^b [rad/s] at position (lat, h).
-fn body_signals(
-    k: &crate::trajectory::Kinematics,
-    lat: f64,
-    h: f64,
-) -> (Vector3<f64>, Vector3<f64>) {
-    let w_ie = earth::omega_ie_ned(lat);
-    let w_en = earth::omega_en_ned(lat, h, &k.v);
-    let f_n = k.a + (2.0 * w_ie + w_en).cross(&k.v) - earth::gravity_ned(lat, h);
-    let ct = k.c.transpose();
-    (ct * f_n, ct * (w_ie + w_en) + k.w_nb)
+impl EarthAt {
+    fn new(lat: f64, h: f64) -> EarthAt {
+        EarthAt {
+            rm: earth::radius_meridian(lat) + h,
+            rn: earth::radius_transverse(lat) + h,
+            tan: lat.tan(),
+            cos: lat.cos(),
+            w_ie: earth::omega_ie_ned(lat),
+            g: earth::gravity_ned(lat, h),
+        }
+    }
+
+    /// (f^b [m/s²], ω_ib^b [rad/s], d(lat, lon, h)/dt) for the kinematic state `k`.
+    fn signals(
+        &self,
+        k: &crate::trajectory::Kinematics,
+    ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let v = &k.v;
+        let w_en = Vector3::new(v.y / self.rn, -v.x / self.rm, -v.y * self.tan / self.rn);
+        let f_n = k.a + (2.0 * self.w_ie + w_en).cross(v) - self.g;
+        let ct = k.c.transpose();
+        let rate = Vector3::new(v.x / self.rm, v.y / (self.rn * self.cos), -v.z);
+        (ct * f_n, ct * (self.w_ie + w_en) + k.w_nb, rate)
+    }
 }
 
 /// Runs a scenario. `progress` is called with the fraction done (for a progress bar).
@@ -136,43 +124,42 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
     let noise = sc.noise;
     let sqdt = dt.sqrt();
     let report_every = (n / 200).max(1);
+    let mut e = EarthAt::new(lat, h);
+    let mut e_at = (lat, h);
     for i in 0..n {
         let t0 = i as f64 * dt;
         let t1 = (i + 1) as f64 * dt;
-        // position: Simpson over the interval with the analytic velocity
-        let km = traj.at(0.5 * (t0 + t1));
-        let k1 = traj.at(t1);
-        let k0v = traj.at(t0).v;
-        let r0 = pos_rate(lat, h, &k0v);
-        let mid = Vector3::new(lat, lon, h) + 0.5 * dt * r0;
-        let rm_ = pos_rate(mid.x, mid.z, &km.v);
-        let end = Vector3::new(lat, lon, h) + dt * rm_;
-        let r1 = pos_rate(end.x, end.z, &k1.v);
-        let dpos = dt / 6.0 * (r0 + 4.0 * rm_ + r1);
-        let (lat1, lon1, h1) = (lat + dpos.x, lon + dpos.y, h + dpos.z);
-        // increments: Gauss–Legendre on `sub` sub-intervals
+        // increments and position: Gauss–Legendre on `sub` sub-intervals
+        // Earth quantities are refreshed when the position has moved by more than 1e-9 rad
+        // (6 mm) or 1 mm in height: below that their change is under 1e-11 relative.
+        if (lat - e_at.0).abs() > 1e-9 || (h - e_at.1).abs() > 1e-3 {
+            e = EarthAt::new(lat, h);
+            e_at = (lat, h);
+        }
         let mut dth = Vector3::zeros();
         let mut dvel = Vector3::zeros();
+        let mut dpos = Vector3::zeros();
         let hsub = dt / sub as f64;
         for s in 0..sub {
             let a = t0 + s as f64 * hsub;
             for (x, w) in GL_NODES.iter().zip(GL_WEIGHTS) {
-                let t = a + 0.5 * hsub * (x + 1.0);
-                let frac = (t - t0) / dt;
-                let k = traj.at(t);
-                let (f, mut om) = body_signals(&k, lat + frac * (lat1 - lat), h + frac * (h1 - h));
+                let k = traj.at(a + 0.5 * hsub * (x + 1.0));
+                let (f, mut om, rate) = e.signals(&k);
                 let mut fm = f;
-                for e in &injected {
-                    let r = common::regressor_value(e.regressor, &f, &om);
-                    match e.sensor {
-                        Sensor::Gyro => om[e.axis] += e.value * r,
-                        Sensor::Accel => fm[e.axis] += e.value * r,
+                for inj in &injected {
+                    let r = common::regressor_value(inj.regressor, &f, &om);
+                    match inj.sensor {
+                        Sensor::Gyro => om[inj.axis] += inj.value * r,
+                        Sensor::Accel => fm[inj.axis] += inj.value * r,
                     }
                 }
-                dth += (0.5 * hsub * w) * om;
-                dvel += (0.5 * hsub * w) * fm;
+                let wt = 0.5 * hsub * w;
+                dth += wt * om;
+                dvel += wt * fm;
+                dpos += wt * rate;
             }
         }
+        let (lat1, lon1, h1) = (lat + dpos.x, lon + dpos.y, h + dpos.z);
         // noise, bias random walk, quantisation
         if noise.arw > 0.0 || noise.vrw > 0.0 {
             for j in 0..3 {
@@ -207,6 +194,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         lon = lon1;
         h = h1;
         if (i + 1) % truth_every == 0 {
+            let k1 = traj.at(t1);
             truth.push(TruthRow {
                 t: t1,
                 lat,
@@ -224,7 +212,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                     glon += sne * rng.normal() / ((earth::radius_transverse(lat) + h) * lat.cos());
                     gh += sd * rng.normal();
                 }
-                gnss.push(GnssRow {
+                gnss.push(PositionFix {
                     t: t1,
                     lat: glat,
                     lon: glon,

@@ -28,19 +28,27 @@ struct Linear {
 }
 
 impl Linear {
-    /// (velocity, acceleration) along the axis: the velocity is the exact integral of the
-    /// acceleration from the start of each window (continuous, frozen after the window).
+    /// (velocity, acceleration) along the axis. In a window starting at t = 0 the velocity is the
+    /// zero-mean (A/ω) sin(ωt + φ) (the start state moves with it); a later window integrates the
+    /// acceleration from its start, so velocity is continuous. After a window it stays frozen.
     fn eval(&self, t: f64) -> (f64, f64) {
         let (mut v, mut a) = (0.0, 0.0);
         for w in &self.windows {
             if t < w[0] {
                 continue;
             }
+            let inside = t <= w[1];
             let te = t.min(w[1]);
             for &(amp, om, ph) in &self.comps {
-                v += w[2] * amp / om * ((om * te + ph).sin() - (om * w[0] + ph).sin());
-                if t <= w[1] {
-                    a += w[2] * amp * (om * t + ph).cos();
+                let base = if w[0] <= 0.0 {
+                    0.0
+                } else {
+                    (om * w[0] + ph).sin()
+                };
+                let (s, c) = (om * te + ph).sin_cos();
+                v += w[2] * amp / om * (s - base);
+                if inside {
+                    a += w[2] * amp * c;
                 }
             }
         }
@@ -96,6 +104,7 @@ pub struct Trajectory {
     seg_yaw0: Vec<f64>,
     seg_accel: Vec<f64>,
     seg_yaw_rate: Vec<f64>,
+    seg_dcm: Vec<Matrix3<f64>>,
     roll0: f64,
     pitch0: f64,
     linear: Vec<Linear>,
@@ -132,7 +141,7 @@ impl Trajectory {
             yaw += yr * s.duration_s;
             t += s.duration_s;
         }
-        let mut rng = Rng::new(sc.seed ^ 0x5eed_0f_7a_b1e);
+        let mut rng = Rng::new(sc.seed ^ 0x05ee_d0f7_ab1e);
         let mut linear = Vec::new();
         let mut angular = Vec::new();
         let mut max_freq: f64 = 0.0;
@@ -194,7 +203,12 @@ impl Trajectory {
                 }
             }
         }
+        let seg_dcm = seg_yaw0
+            .iter()
+            .map(|&y| dcm_from_euler(sc.start.euler_deg[0] * d, sc.start.euler_deg[1] * d, y))
+            .collect();
         Trajectory {
+            seg_dcm,
             seg_start,
             seg_speed0,
             seg_yaw0,
@@ -211,35 +225,44 @@ impl Trajectory {
 
     /// The kinematic state at time `t` [s].
     pub fn at(&self, t: f64) -> Kinematics {
-        let i = match self.seg_start.iter().rposition(|&s| s <= t) {
-            Some(i) => i,
-            None => 0,
-        };
+        let i = self
+            .seg_start
+            .iter()
+            .rposition(|&s| s <= t)
+            .unwrap_or_default();
         let tau = t - self.seg_start[i];
         let speed = self.seg_speed0[i] + self.seg_accel[i] * tau;
-        let yaw_base = self.seg_yaw0[i] + self.seg_yaw_rate[i] * tau;
-        let (sy, cy) = yaw_base.sin_cos();
-        let mut v = Vector3::new(speed * cy, speed * sy, 0.0);
-        let mut a = Vector3::new(
-            self.seg_accel[i] * cy - speed * self.seg_yaw_rate[i] * sy,
-            self.seg_accel[i] * sy + speed * self.seg_yaw_rate[i] * cy,
-            0.0,
-        );
-        let mut euler = Vector3::new(self.roll0, self.pitch0, yaw_base);
-        let mut euler_rate = Vector3::new(0.0, 0.0, self.seg_yaw_rate[i]);
-        for ang in &self.angular {
-            let (x, r) = ang.eval(t);
-            euler[ang.axis] += x;
-            euler_rate[ang.axis] += r;
+        let yaw_rate = self.seg_yaw_rate[i];
+        let yaw_base = self.seg_yaw0[i] + yaw_rate * tau;
+        let (mut v, mut a) = (Vector3::zeros(), Vector3::zeros());
+        if speed != 0.0 || self.seg_accel[i] != 0.0 {
+            let (sy, cy) = yaw_base.sin_cos();
+            v = Vector3::new(speed * cy, speed * sy, 0.0);
+            a = Vector3::new(
+                self.seg_accel[i] * cy - speed * yaw_rate * sy,
+                self.seg_accel[i] * sy + speed * yaw_rate * cy,
+                0.0,
+            );
         }
-        let c = dcm_from_euler(euler.x, euler.y, euler.z);
-        let (sr, cr) = euler.x.sin_cos();
-        let (sp, cp) = euler.y.sin_cos();
-        let w_nb = Vector3::new(
-            euler_rate.x - euler_rate.z * sp,
-            euler_rate.y * cr + euler_rate.z * sr * cp,
-            -euler_rate.y * sr + euler_rate.z * cr * cp,
-        );
+        let mut euler = Vector3::new(self.roll0, self.pitch0, yaw_base);
+        let (c, w_nb) = if self.angular.is_empty() && yaw_rate == 0.0 {
+            (self.seg_dcm[i], Vector3::zeros())
+        } else {
+            let mut euler_rate = Vector3::new(0.0, 0.0, yaw_rate);
+            for ang in &self.angular {
+                let (x, r) = ang.eval(t);
+                euler[ang.axis] += x;
+                euler_rate[ang.axis] += r;
+            }
+            let (sr, cr) = euler.x.sin_cos();
+            let (sp, cp) = euler.y.sin_cos();
+            let w_nb = Vector3::new(
+                euler_rate.x - euler_rate.z * sp,
+                euler_rate.y * cr + euler_rate.z * sr * cp,
+                -euler_rate.y * sr + euler_rate.z * cr * cp,
+            );
+            (dcm_from_euler(euler.x, euler.y, euler.z), w_nb)
+        };
         let mut vb = Vector3::zeros();
         let mut ab = Vector3::zeros();
         for l in &self.linear {

@@ -4,13 +4,17 @@ use nalgebra::Vector3;
 use sinsmodel::attitude::{attitude_error, dcm_from_euler};
 use sinsmodel::earth;
 use sinsmodel::scenario::Scenario;
-use sinsmodel::simulator::{simulate, SimOutput, TruthRow};
+use sinsmodel::simulator::{simulate, SimOutput};
 use sinsmodel::strapdown::{Navigator, Vertical};
+use sinsmodel::truth::TruthRow;
 
 const ARCSEC: f64 = std::f64::consts::PI / 180.0 / 3600.0;
 
-/// Errors of the navigator against truth at each truth row: (t, north m, east m, |phi| rad, phi).
-fn navigate_errors(sim: &SimOutput) -> Vec<(f64, f64, f64, Vector3<f64>, Vector3<f64>)> {
+/// Navigator error at one truth row: (t [s], north [m], east [m], phi [rad], velocity error [m/s]).
+type NavError = (f64, f64, f64, Vector3<f64>, Vector3<f64>);
+
+/// Errors of the navigator against truth at each truth row.
+fn navigate_errors(sim: &SimOutput) -> Vec<NavError> {
     let mut nav = Navigator::new(sim.start, Vertical::Fixed);
     let mut out = Vec::new();
     let mut ti = 1;
@@ -94,7 +98,7 @@ fn perfect_sensors_under_strong_sine_vibration_do_not_drift() {
                [[vibration]]\nkind = \"sine\"\naxis = \"d\"\namplitude = \"6 g\"\nfreq_hz = 90.0\n";
     let floor = navigate_errors(&simulate(&rest_scenario(2000.0, 600.0, ""), |_| {}));
     let vibr = navigate_errors(&simulate(&rest_scenario(2000.0, 600.0, vib), |_| {}));
-    let worst = |e: &[(f64, f64, f64, Vector3<f64>, Vector3<f64>)]| {
+    let worst = |e: &[NavError]| {
         (
             e.iter().map(|x| x.1.hypot(x.2)).fold(0.0, f64::max),
             e.iter().map(|x| x.3.norm()).fold(0.0, f64::max),

@@ -2,3 +2,5 @@
 
 pub mod jacobian;
 pub mod model;
+pub mod navigate;
+pub mod simulate;

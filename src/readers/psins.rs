@@ -54,7 +54,7 @@ pub fn read(path: &Path) -> Result<PsinsLog> {
                 t0 = header[1][3];
                 dt = header[1][4] * 1e-3;
                 g = header[1][5];
-                if !(dt > 0.0) || !(g > 9.0 && g < 10.5) {
+                if dt.is_nan() || dt <= 0.0 || g.is_nan() || g <= 9.0 || g >= 10.5 {
                     bail!(
                         "{}:{}: header: bad sample interval {} ms or g {}",
                         path.display(),

@@ -1,0 +1,111 @@
+//! `sinsmodel navigate --imu FILE --lat --lon --h --att R,P,Y [--vel N,E,D] [--vertical] --out FILE`.
+
+use anyhow::{bail, Result};
+use clap::Args;
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use sinsmodel::attitude::dcm_from_euler;
+use sinsmodel::strapdown::{NavState, Navigator, Vertical};
+use sinsmodel::truth::TruthRow;
+use sinsmodel::{progress, readers, truth};
+use std::path::PathBuf;
+
+/// Arguments of `navigate`.
+#[derive(Args)]
+pub struct NavigateArgs {
+    /// IMU file: project text format, PSINS `.imu` or GNSS_IMU `.csv`.
+    #[arg(long)]
+    imu: PathBuf,
+    /// Initial latitude [deg].
+    #[arg(long, allow_hyphen_values = true)]
+    lat: f64,
+    /// Initial longitude [deg].
+    #[arg(long, allow_hyphen_values = true)]
+    lon: f64,
+    /// Initial height [m].
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    h: f64,
+    /// Initial roll,pitch,yaw [deg] (NED/FRD).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    att: Vec<f64>,
+    /// Initial NED velocity N,E,D [m/s].
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    vel: Option<Vec<f64>>,
+    /// Vertical channel: fixed (default), damped, free.
+    #[arg(long, default_value = "fixed")]
+    vertical: Vertical,
+    /// Output rate [Hz].
+    #[arg(long, default_value_t = 10.0)]
+    out_rate: f64,
+    /// Output file (truth layout of DESIGN §9).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs the command.
+pub fn run(args: &NavigateArgs) -> Result<()> {
+    if args.lat.abs() >= 89.0 || !args.lat.is_finite() {
+        bail!("--lat {} must be within ±89°", args.lat);
+    }
+    if args.att.len() != 3 || args.vel.as_ref().is_some_and(|v| v.len() != 3) {
+        bail!("--att and --vel take three comma-separated numbers");
+    }
+    if !(args.out_rate > 0.0) {
+        bail!("--out-rate must be positive");
+    }
+    let data = readers::read_any_imu(&args.imu)?;
+    data.check_time(&args.imu.display().to_string(), 5.0)?;
+    let d = std::f64::consts::PI / 180.0;
+    let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
+    let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
+    let t0 = data.samples[0].t - data.interval();
+    let start = NavState {
+        t: t0,
+        lat: args.lat * d,
+        lon: args.lon * d,
+        h: args.h,
+        v: Vector3::new(v[0], v[1], v[2]),
+        q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
+    };
+    let mut nav = Navigator::new(start, args.vertical);
+    let every = (data.rate_hz() / args.out_rate).round().max(1.0) as usize;
+    let row = |s: &NavState| TruthRow {
+        t: s.t,
+        lat: s.lat,
+        lon: s.lon,
+        h: s.h,
+        v: s.v,
+        euler: s.euler(),
+    };
+    let mut rows = vec![row(&nav.state)];
+    let pb = progress::bar(data.samples.len() as u64, "navigate");
+    let mut prev_t = t0;
+    for (k, s) in data.samples.iter().enumerate() {
+        nav.step(&s.dtheta, &s.dv, s.t - prev_t);
+        nav.state.t = s.t;
+        prev_t = s.t;
+        if (k + 1) % every == 0 {
+            rows.push(row(&nav.state));
+        }
+        if k % 100_000 == 0 {
+            pb.set_position(k as u64);
+        }
+    }
+    pb.finish_and_clear();
+    truth::write(
+        &args.out,
+        &rows,
+        &format!(
+            "sinsmodel navigate --imu {} (vertical {:?})",
+            args.imu.display(),
+            args.vertical
+        ),
+    )?;
+    eprintln!(
+        "navigated {} samples ({:.1} s), wrote {} rows to {}",
+        data.samples.len(),
+        data.duration(),
+        rows.len(),
+        args.out.display()
+    );
+    Ok(())
+}
