@@ -49,7 +49,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.att.len() != 3 || args.vel.as_ref().is_some_and(|v| v.len() != 3) {
         bail!("--att and --vel take three comma-separated numbers");
     }
-    if !(args.out_rate > 0.0) {
+    if args.out_rate.is_nan() || args.out_rate <= 0.0 {
         bail!("--out-rate must be positive");
     }
     let data = readers::read_any_imu(&args.imu)?;
