@@ -123,7 +123,8 @@ pub struct NoiseSpec {
 #[serde(deny_unknown_fields)]
 struct RawScenario {
     name: String,
-    imu_rate_hz: f64,
+    #[serde(default)]
+    imu_rate_hz: Option<f64>,
     #[serde(default = "default_truth_rate")]
     truth_rate_hz: f64,
     #[serde(default)]
@@ -218,10 +219,18 @@ impl Scenario {
             anyhow!("{origin}:{line}: {}", e.message().trim())
         })?;
         let at = |needle: &str| format!("{origin}:{}", line_of(text, needle));
-        if !(raw.imu_rate_hz > 0.0 && raw.imu_rate_hz.is_finite()) {
+        // default IMU rate: 2 kHz with vibration (DESIGN §2: increments attenuate <f^2>), else 100 Hz
+
+        let imu_rate_hz = raw.imu_rate_hz.unwrap_or(if raw.vibration.is_empty() {
+            100.0
+        } else {
+            2000.0
+        });
+
+        if !(imu_rate_hz > 0.0 && imu_rate_hz.is_finite()) {
             bail!("{}: imu_rate_hz must be positive", at("imu_rate_hz"));
         }
-        if !(raw.truth_rate_hz > 0.0 && raw.truth_rate_hz <= raw.imu_rate_hz) {
+        if !(raw.truth_rate_hz > 0.0 && raw.truth_rate_hz <= imu_rate_hz) {
             bail!(
                 "{}: truth_rate_hz must be in (0, imu_rate_hz]",
                 at("truth_rate_hz")
@@ -345,7 +354,7 @@ impl Scenario {
         };
         let gnss = match &raw.gnss {
             Some(g) => {
-                if !(g.rate_hz > 0.0 && g.rate_hz <= raw.imu_rate_hz) {
+                if !(g.rate_hz > 0.0 && g.rate_hz <= imu_rate_hz) {
                     bail!(
                         "{}: [gnss] rate_hz must be in (0, imu_rate_hz]",
                         at("rate_hz")
@@ -361,7 +370,7 @@ impl Scenario {
         };
         Ok(Scenario {
             name: raw.name,
-            imu_rate_hz: raw.imu_rate_hz,
+            imu_rate_hz,
             truth_rate_hz: raw.truth_rate_hz,
             seed: raw.seed,
             start: raw.start,
