@@ -26,6 +26,8 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Run the strapdown navigator on an IMU file.
     Navigate(cli::navigate::NavigateArgs),
+    /// Reproduce the paper's experiments (P28 vs P31), with figures, priors study, consistency.
+    Reproduce(cli::reproduce::ReproduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
         Command::Jacobian(args) => cli::jacobian::run(&args),
         Command::Simulate(args) => cli::simulate::run(&args),
         Command::Navigate(args) => cli::navigate::run(&args),
+        Command::Reproduce(args) => cli::reproduce::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

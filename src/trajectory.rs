@@ -25,13 +25,81 @@ struct Linear {
     axis: usize,
     comps: Vec<(f64, f64, f64)>,
     windows: Vec<[f64; 3]>,
+    phasor: std::cell::RefCell<Phasor>,
+}
+
+/// Sums of many sinusoids evaluated at increasing times by rotating each component's
+/// (sin, cos) from the last time instead of calling sin_cos; rotations for the few distinct
+/// steps the simulator uses are cached, and every 4096 evaluations the phasors are recomputed
+/// exactly so rounding cannot accumulate.
+#[derive(Debug, Clone, Default)]
+struct Phasor {
+    t: f64,
+    sc: Vec<(f64, f64)>,
+    steps: Vec<(u64, Vec<(f64, f64)>)>,
+    uses: u32,
 }
 
 impl Linear {
+    /// Fast path for a source that is always on (one window from t = 0 to ∞): (v, a).
+    fn eval_always_on(&self, t: f64) -> (f64, f64) {
+        let mut ph = self.phasor.borrow_mut();
+        let delta = t - ph.t;
+        let exact = ph.sc.is_empty() || ph.uses >= 4096 || delta < 0.0;
+        if exact {
+            ph.sc = self
+                .comps
+                .iter()
+                .map(|&(_, om, p)| (om * t + p).sin_cos())
+                .collect();
+            ph.uses = 0;
+        } else if delta != 0.0 {
+            let key = delta.to_bits();
+            let k = match ph.steps.iter().position(|(b, _)| *b == key) {
+                Some(k) => k,
+                None => {
+                    if ph.steps.len() >= 16 {
+                        ph.steps.remove(0);
+                    }
+                    let rot = self
+                        .comps
+                        .iter()
+                        .map(|&(_, om, _)| (om * delta).sin_cos())
+                        .collect();
+                    ph.steps.push((key, rot));
+                    ph.steps.len() - 1
+                }
+            };
+            let Phasor { sc, steps, .. } = &mut *ph;
+            for ((s, c), (rs, rc)) in sc.iter_mut().zip(&steps[k].1) {
+                let (s0, c0) = (*s, *c);
+                *s = s0 * rc + c0 * rs;
+                *c = c0 * rc - s0 * rs;
+            }
+            ph.uses += 1;
+        }
+        ph.t = t;
+        let w = self.windows[0][2];
+        let (mut v, mut a) = (0.0, 0.0);
+        for (&(amp, om, _), &(s, c)) in self.comps.iter().zip(&ph.sc) {
+            v += w * amp / om * s;
+            a += w * amp * c;
+        }
+        (v, a)
+    }
+
     /// (velocity, acceleration) along the axis. In a window starting at t = 0 the velocity is the
     /// zero-mean (A/ω) sin(ωt + φ) (the start state moves with it); a later window integrates the
     /// acceleration from its start, so velocity is continuous. After a window it stays frozen.
     fn eval(&self, t: f64) -> (f64, f64) {
+        if self.comps.len() > 4
+            && self.windows.len() == 1
+            && self.windows[0][0] == 0.0
+            && self.windows[0][1] == f64::INFINITY
+            && t >= 0.0
+        {
+            return self.eval_always_on(t);
+        }
         let (mut v, mut a) = (0.0, 0.0);
         for w in &self.windows {
             if t < w[0] {
@@ -164,6 +232,7 @@ impl Trajectory {
                         axis: k % 3,
                         comps: vec![(amp, 2.0 * PI * v.freq_hz, v.phase_deg * d)],
                         windows: windows(&v.schedule),
+                        phasor: Default::default(),
                     });
                 }
                 "random" => {
@@ -186,6 +255,7 @@ impl Trajectory {
                         axis: k % 3,
                         comps,
                         windows: windows(&v.schedule),
+                        phasor: Default::default(),
                     });
                 }
                 _ => {

@@ -3,4 +3,5 @@
 pub mod jacobian;
 pub mod model;
 pub mod navigate;
+pub mod reproduce;
 pub mod simulate;
