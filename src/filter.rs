@@ -458,8 +458,8 @@ fn feedback(
     let s = &mut nav.state;
     // C~ = (I − [φ×]) C  ⇒  C = exp([φ×]) C~
     s.q = UnitQuaternion::from_scaled_axis(phi) * s.q;
-    for c in 0..3 {
-        s.v[c] -= take(x, i_dv[c]);
+    for (c, &i) in i_dv.iter().enumerate() {
+        s.v[c] -= take(x, i);
     }
     s.lat -= take(x, i_lat);
     s.lon -= take(x, i_lon);
