@@ -43,7 +43,7 @@ impl Default for Priors {
         Priors {
             phi0: "60 arcsec".into(),
             nabla: "100 ug".into(),
-            d: "100 ug/g^2".into(),
+            d: "1000 ug/g^2".into(),
             sigma_v: "0.01 m/s".into(),
             sigma_p: "0.5 m".into(),
         }

@@ -272,42 +272,49 @@ struct Consistency {
     nis_fraction_in_band: f64,
 }
 
-/// 20-seed Monte Carlo with the true model (P31 on data with exactly P31's errors).
+/// 20-seed Monte Carlo with the true model: every seed draws the initial navigation errors and
+/// all 24 instrument parameters of P31 from the filter's prior N(0, P0), injects them, and runs P31.
 fn consistency(args: &ReproduceArgs) -> Result<()> {
     let seeds = 20usize;
     let secs = if args.quick { 600.0 } else { 3600.0 };
     let priors = Priors::default();
     let model = Model::parse("P31")?;
     let n = model.n();
-    let text = reproduce::cases(true, 0)[0]
+    let cfg0 = reproduce::config(&model, &priors)?;
+    let base = reproduce::cases(true, 0)[0]
         .scenario
         .replace("duration_s = 600", &format!("duration_s = {secs}"));
-    let truth_params: Vec<(usize, f64)> = Scenario::parse(&text, "consistency")?
-        .errors
-        .iter()
-        .filter_map(|&(k, v)| {
-            model
-                .index_of(sinsmodel::generated::common::TERMS[k].name)
-                .map(|i| (i, v))
-        })
-        .collect();
+    let base = &base[..base.find("[errors]").context("errors table")?];
     let mut nees_sum: Vec<f64> = Vec::new();
     let mut nis_sum: Vec<f64> = Vec::new();
     let pb = progress::bar(seeds as u64, "monte carlo");
     for s in 0..seeds {
-        let sc = Scenario::parse(
-            &text.replace("seed = 0", &format!("seed = {}", 100 + s)),
-            "consistency",
-        )?;
+        let mut rng = sinsmodel::rng::Rng::new(1000 + s as u64);
+        let x0: Vec<f64> = (0..n).map(|i| cfg0.prior_sigma[i] * rng.normal()).collect();
+        let mut text = base.replace("seed = 0", &format!("seed = {}", 100 + s));
+        text.push_str("[errors]\n");
+        for (i, name) in model.names.iter().enumerate().skip(7) {
+            text.push_str(&format!("{name} = \"{:e} {}\"\n", x0[i], model.unit(i)));
+        }
+        text.push_str(reproduce::PAPER_NOISE);
+        let sc = Scenario::parse(&text, "consistency")?;
         let sim = simulate(&sc, |_| {});
         let aid = reproduce::aiding_from_truth(&sim, &priors, true, 100 + s as u64)?;
-        let mut cfg = reproduce::config(&model, &priors)?;
+        let mut start = sim.start;
+        start.q = nalgebra::UnitQuaternion::from_scaled_axis(-nalgebra::Vector3::new(
+            x0[0], x0[1], x0[2],
+        )) * start.q;
+        start.v.x += x0[3];
+        start.v.y += x0[4];
+        start.lat += x0[5];
+        start.lon += x0[6];
+        let mut cfg = cfg0.clone();
         cfg.keep_covariance = true;
         let run = filter::run(
             &model,
             &cfg,
             &sim.imu,
-            sim.start,
+            start,
             &aid,
             Some(&sim.truth),
             |_| {},
@@ -322,8 +329,7 @@ fn consistency(args: &ReproduceArgs) -> Result<()> {
                 .iter()
                 .find(|t| (t.t - r.t).abs() < 1e-6)
                 .context("truth row")?;
-            let mut e = r.x.clone();
-            let mut xt = vec![0.0; n];
+            let mut xt = x0.clone();
             xt[0] = phi.x;
             xt[1] = phi.y;
             xt[2] = phi.z;
@@ -331,12 +337,7 @@ fn consistency(args: &ReproduceArgs) -> Result<()> {
             xt[4] = r.nav.v.y - tr.v.y;
             xt[5] = r.nav.lat - tr.lat;
             xt[6] = r.nav.lon - tr.lon;
-            for &(i, v) in &truth_params {
-                xt[i] = v;
-            }
-            for i in 0..n {
-                e[i] -= xt[i];
-            }
+            let e: Vec<f64> = (0..n).map(|i| r.x[i] - xt[i]).collect();
             let p = nalgebra::DMatrix::from_row_slice(n, n, cov);
             let ev = nalgebra::DVector::from_vec(e);
             let nees = match p.cholesky() {
