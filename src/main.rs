@@ -26,6 +26,8 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Run the strapdown navigator on an IMU file.
     Navigate(cli::navigate::NavigateArgs),
+    /// Run navigator + error-state Kalman filter with any model on IMU and position aiding files.
+    Filter(cli::filter::FilterArgs),
     /// Reproduce the paper's experiments (P28 vs P31), with figures, priors study, consistency.
     Reproduce(cli::reproduce::ReproduceArgs),
 }
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => cli::simulate::run(&args),
         Command::Navigate(args) => cli::navigate::run(&args),
         Command::Reproduce(args) => cli::reproduce::run(&args),
+        Command::Filter(args) => cli::filter::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,213 @@
+//! `sinsmodel filter --model MODEL --imu FILE --aid FILE [--truth FILE] [--init …] --out DIR`.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use sinsmodel::atomic_file::AtomicFile;
+use sinsmodel::attitude::dcm_from_euler;
+use sinsmodel::filter::{self, AidingEpoch, FilterConfig, Mode};
+use sinsmodel::model::Model;
+use sinsmodel::strapdown::{NavState, Vertical};
+use sinsmodel::{aiding, progress, readers, truth};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `filter`.
+#[derive(Args)]
+pub struct FilterArgs {
+    /// Model, e.g. P31, P28+kaq_x_xy, P31+vertical.
+    #[arg(long)]
+    model: String,
+    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
+    #[arg(long)]
+    imu: PathBuf,
+    /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d).
+    #[arg(long)]
+    aid: PathBuf,
+    /// Truth file (t lat lon h vn ve vd roll pitch yaw): adds the true φ and the model error.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// Initial lat,lon [deg],h [m],roll,pitch,yaw [deg][,vn,ve,vd m/s]; default: the first truth row.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    init: Option<Vec<f64>>,
+    /// open (errors estimated only) or closed (fed back).
+    #[arg(long, default_value = "open")]
+    mode: String,
+    /// Filter step [s].
+    #[arg(long, default_value_t = 0.01)]
+    step: f64,
+    /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
+    #[arg(long)]
+    zupt: Option<f64>,
+    /// Output directory: states.txt, innovations.txt, model_error.txt (with truth).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs the command.
+pub fn run(args: &FilterArgs) -> Result<()> {
+    let model = Model::parse(&args.model)?;
+    let mut cfg = FilterConfig::new(&model);
+    cfg.mode = match args.mode.as_str() {
+        "open" => Mode::OpenLoop,
+        "closed" => Mode::ClosedLoop,
+        m => bail!("--mode `{m}`: expected open or closed"),
+    };
+    if args.step.is_nan() || args.step <= 0.0 {
+        bail!("--step must be positive");
+    }
+    cfg.step_s = args.step;
+    if !model.vertical {
+        cfg.vertical = Vertical::Fixed;
+    }
+    let imu = readers::read_any_imu(&args.imu)?;
+    imu.check_time(&args.imu.display().to_string(), 5.0)?;
+    let fixes = aiding::read(&args.aid)?;
+    let truth_rows = match &args.truth {
+        Some(p) => Some(truth::read(p)?),
+        None => None,
+    };
+    let t0 = imu.samples[0].t - imu.interval();
+    let d = std::f64::consts::PI / 180.0;
+    let start = match (&args.init, &truth_rows) {
+        (Some(v), _) => {
+            if v.len() != 6 && v.len() != 9 {
+                bail!(
+                    "--init takes lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (6 or 9 numbers), got {}",
+                    v.len()
+                );
+            }
+            let c = dcm_from_euler(v[3] * d, v[4] * d, v[5] * d);
+            NavState {
+                t: t0,
+                lat: v[0] * d,
+                lon: v[1] * d,
+                h: v[2],
+                v: if v.len() == 9 {
+                    Vector3::new(v[6], v[7], v[8])
+                } else {
+                    Vector3::zeros()
+                },
+                q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
+            }
+        }
+        (None, Some(tr)) => {
+            let r = tr
+                .iter()
+                .find(|r| (r.t - t0).abs() < 1e-6)
+                .context("no truth row at the IMU start time; give --init")?;
+            let c = dcm_from_euler(r.euler.x, r.euler.y, r.euler.z);
+            NavState {
+                t: t0,
+                lat: r.lat,
+                lon: r.lon,
+                h: r.h,
+                v: r.v,
+                q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
+            }
+        }
+        (None, None) => bail!("give --init or --truth for the initial state"),
+    };
+    let aid: Vec<AidingEpoch> = fixes
+        .iter()
+        .filter(|f| f.t > t0)
+        .map(|f| AidingEpoch {
+            t: f.t,
+            vel: args.zupt.map(|s| (Vector3::zeros(), s)),
+            pos: Some((f.lat, f.lon, f.h, f.sigma)),
+        })
+        .collect();
+    let pb = progress::bar(1000, "filter");
+    let run = filter::run(
+        &model,
+        &cfg,
+        &imu,
+        start,
+        &aid,
+        truth_rows.as_deref(),
+        |f| pb.set_position((f * 1000.0) as u64),
+    );
+    pb.finish_and_clear();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+
+    let mut f = AtomicFile::create(&args.out.join("states.txt"))?;
+    let w = f.writer();
+    writeln!(
+        w,
+        "# sinsmodel filter --model {} ({:?}); SI units (rad, m/s, rad/s, m/s^2, 1, s^2/m …)",
+        model.name, cfg.mode
+    )?;
+    write!(w, "# t")?;
+    for (i, n) in model.names.iter().enumerate() {
+        write!(w, " {n}[{}]", model.unit(i))?;
+    }
+    for n in &model.names {
+        write!(w, " sigma_{n}")?;
+    }
+    writeln!(w)?;
+    for r in &run.records {
+        write!(w, "{:.4}", r.t)?;
+        for v in r.x.iter().chain(&r.sigma) {
+            write!(w, " {v:.6e}")?;
+        }
+        writeln!(w)?;
+    }
+    f.commit()?;
+
+    let mut f = AtomicFile::create(&args.out.join("innovations.txt"))?;
+    let w = f.writer();
+    writeln!(w, "# t measurement component nu S (SI; nu = z - H x)")?;
+    for i in &run.innovations {
+        writeln!(
+            w,
+            "{:.4} {} {} {:.6e} {:.6e}",
+            i.t, i.meas, i.component, i.nu, i.s
+        )?;
+    }
+    f.commit()?;
+
+    if truth_rows.is_some() {
+        let mut f = AtomicFile::create(&args.out.join("model_error.txt"))?;
+        let w = f.writer();
+        let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
+        writeln!(
+            w,
+            "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
+        )?;
+        for r in &run.records {
+            if let Some(p) = r.phi_true {
+                let e = r.phi_est - p;
+                writeln!(
+                    w,
+                    "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
+                    r.t,
+                    p.x * arcsec,
+                    p.y * arcsec,
+                    p.z * arcsec,
+                    r.phi_est.x * arcsec,
+                    r.phi_est.y * arcsec,
+                    r.phi_est.z * arcsec,
+                    e.x * arcsec,
+                    e.y * arcsec
+                )?;
+            }
+        }
+        f.commit()?;
+    }
+    let nis = run
+        .innovations
+        .iter()
+        .map(|i| i.nu * i.nu / i.s)
+        .sum::<f64>()
+        / run.innovations.len().max(1) as f64;
+    eprintln!(
+        "filtered {} samples with {} ({} states), {} updates, mean NIS {nis:.3}; wrote {}",
+        imu.samples.len(),
+        model.name,
+        model.n(),
+        run.records.len(),
+        args.out.display()
+    );
+    Ok(())
+}
