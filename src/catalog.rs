@@ -118,4 +118,6 @@ pub struct PresetKernels {
     pub fill_h: fn(&str, &NavPoint, &mut [f64]) -> bool,
     /// P ← Φ P Φᵀ + diag(q)·dt (N×N row-major).
     pub propagate_cov: fn(&[f64], f64, &[f64], &mut [f64]),
+    /// Adds one sample's regressors (f [m/s²], w [rad/s]) to running sums.
+    pub accumulate: fn(&mut [f64], &nalgebra::Vector3<f64>, &nalgebra::Vector3<f64>),
 }

@@ -62,12 +62,12 @@ impl SparsePropagator {
         }
         let mut m = vec![0.0; nd * n];
         for r in 0..nd {
-            for j in 0..n {
-                let mut s = 0.0;
-                for &k in &self.b_cols[r] {
-                    s += b[r * n + k] * p[k * n + j];
+            let mr = &mut m[r * n..(r + 1) * n];
+            for &k in &self.b_cols[r] {
+                let bk = b[r * n + k];
+                for (mj, pj) in mr.iter_mut().zip(&p[k * n..(k + 1) * n]) {
+                    *mj += bk * pj;
                 }
-                m[r * n + j] = s;
             }
         }
         for r in 0..nd {

@@ -50,6 +50,8 @@ pub struct FilterConfig {
     pub vertical: Vertical,
     /// Keep the full covariance in every record (for NEES).
     pub keep_covariance: bool,
+    /// Propagate P with dense nalgebra matrices instead of the sparse kernels (benchmark baseline).
+    pub dense_reference: bool,
 }
 
 impl FilterConfig {
@@ -81,6 +83,7 @@ impl FilterConfig {
                 Vertical::Fixed
             },
             keep_covariance: false,
+            dense_reference: false,
         }
     }
 
@@ -172,6 +175,7 @@ pub struct FilterRun {
 enum Kernel {
     Preset(fn(&[f64], f64, &[f64], &mut [f64])),
     Runtime(SparsePropagator),
+    Dense,
 }
 
 /// Runs navigator + filter over `imu` from `start`, updating at `aiding` epochs; `truth` (same
@@ -183,7 +187,22 @@ pub fn run(
     start: NavState,
     aiding: &[AidingEpoch],
     truth: Option<&[TruthRow]>,
+    progress: impl FnMut(f64),
+) -> FilterRun {
+    run_with(model, cfg, imu, start, aiding, truth, progress, &mut |_| {})
+}
+
+/// [`run`] with a callback after every IMU sample (e.g. to write a navigation row per epoch).
+#[allow(clippy::too_many_arguments)]
+pub fn run_with(
+    model: &Model,
+    cfg: &FilterConfig,
+    imu: &ImuData,
+    start: NavState,
+    aiding: &[AidingEpoch],
+    truth: Option<&[TruthRow]>,
     mut progress: impl FnMut(f64),
+    on_sample: &mut dyn FnMut(&NavState),
 ) -> FilterRun {
     let n = model.n();
     let mut nav = Navigator::new(start, cfg.vertical);
@@ -193,6 +212,7 @@ pub fn run(
         p[i * n + i] = cfg.prior_sigma[i].powi(2);
     }
     let kernel = match model.preset {
+        _ if cfg.dense_reference => Kernel::Dense,
         Some(k) => Kernel::Preset(k.propagate_cov),
         None => Kernel::Runtime(SparsePropagator::new(n, model.a_pattern())),
     };
@@ -226,6 +246,7 @@ pub fn run(
     );
     let (i_lat, i_lon, i_h) = (idx("dlat"), idx("dlon"), idx("dh"));
     let mut h_row = vec![0.0; n];
+    let (mut ax, mut a2x) = (vec![0.0; n], vec![0.0; n]);
     let mut u = vec![0.0; n];
     for (k, smp) in imu.samples.iter().enumerate() {
         let dt = smp.t - prev_t;
@@ -247,6 +268,7 @@ pub fn run(
         }
         nav.step(&dth, &dvel, dt);
         nav.state.t = smp.t;
+        on_sample(&nav.state);
         let (f_c, w_c) = (dvel / dt, dth / dt);
         acc.add(&f_c, &w_c);
         f_sum += f_c;
@@ -264,10 +286,16 @@ pub fn run(
             a[i * n + j] = 0.0;
         }
         model.fill_a(&np, &acc.mean(), &mut a);
-        propagate_state(&pattern, &a, step_dt, &mut x);
+        propagate_state(&pattern, &a, step_dt, &mut x, &mut ax, &mut a2x);
         match &kernel {
             Kernel::Preset(f) => f(&a, step_dt, &cfg.q, &mut p),
             Kernel::Runtime(sp) => sp.propagate(&a, step_dt, &cfg.q, &mut p),
+            Kernel::Dense => {
+                let am = nalgebra::DMatrix::from_row_slice(n, n, &a);
+                let pm = nalgebra::DMatrix::from_row_slice(n, n, &p);
+                let out = crate::covariance::propagate_dense(&am, step_dt, &cfg.q, &pm);
+                p.copy_from_slice(out.transpose().as_slice());
+            }
         }
         acc.reset();
         f_sum = Vector3::zeros();
@@ -383,13 +411,20 @@ pub fn run(
 }
 
 /// x ← Φ x with Φ = I + A dt + A² dt²/2, using A's pattern.
-fn propagate_state(pattern: &[(usize, usize)], a: &[f64], dt: f64, x: &mut [f64]) {
+fn propagate_state(
+    pattern: &[(usize, usize)],
+    a: &[f64],
+    dt: f64,
+    x: &mut [f64],
+    ax: &mut [f64],
+    a2x: &mut [f64],
+) {
     let n = x.len();
-    let mut ax = vec![0.0; n];
+    ax.iter_mut().for_each(|v| *v = 0.0);
+    a2x.iter_mut().for_each(|v| *v = 0.0);
     for &(i, j) in pattern {
         ax[i] += a[i * n + j] * x[j];
     }
-    let mut a2x = vec![0.0; n];
     for &(i, j) in pattern {
         a2x[i] += a[i * n + j] * ax[j];
     }

@@ -220,6 +220,7 @@ impl Model {
             ids: self.regressor_ids.clone(),
             sum: vec![0.0; self.regressor_ids.len()],
             count: 0,
+            generated: self.preset.map(|k| k.accumulate),
         }
     }
 
@@ -321,13 +322,19 @@ pub struct RegressorAccumulator {
     ids: Vec<usize>,
     sum: Vec<f64>,
     count: u32,
+    generated: Option<fn(&mut [f64], &Vector3<f64>, &Vector3<f64>)>,
 }
 
 impl RegressorAccumulator {
     /// Adds one sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
     pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
-        for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
-            *s += common::regressor_value(id, f, w);
+        match self.generated {
+            Some(acc) => acc(&mut self.sum, f, w),
+            None => {
+                for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
+                    *s += common::regressor_value(id, f, w);
+                }
+            }
         }
         self.count += 1;
     }

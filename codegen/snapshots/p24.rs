@@ -811,13 +811,13 @@ pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]
     fill_b(a, dt, &mut b);
     let mut m = [[0.0; N]; ND];
     for r in 0..ND {
-        let cols = B_COLS[r];
-        for j in 0..N {
-            let mut s = 0.0;
-            for &k in cols {
-                s += b[r][k] * p[k][j];
+        let mr = &mut m[r];
+        for &k in B_COLS[r] {
+            let bk = b[r][k];
+            let pk = &p[k];
+            for j in 0..N {
+                mr[j] += bk * pk[j];
             }
-            m[r][j] = s;
         }
     }
     for r in 0..ND {
@@ -855,11 +855,21 @@ pub fn propagate_state(b: &[[f64; N]; ND], x: &mut [f64; N]) {
 /// `fill_a` on slices: `r` holds NR step means, `a` is N×N row-major (zeroed by the caller).
 pub fn fill_a_dyn(nav: &NavPoint, r: &[f64], a: &mut [f64]) {
     let r: &[f64; NR] = r.try_into().expect("regressor means of length NR");
-    let mut m = [[0.0; N]; N];
-    fill_a(nav, r, &mut m);
-    for (i, row) in m.iter().enumerate() {
-        a[i * N..(i + 1) * N].copy_from_slice(row);
-    }
+    let a: &mut [[f64; N]; N] = a.as_chunks_mut::<N>().0.try_into().expect("A of N×N");
+    fill_a(nav, r, a);
+}
+
+/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
+pub fn accumulate_dyn(sum: &mut [f64], f: &Vector3<f64>, w: &Vector3<f64>) {
+    let _ = (f, w);
+    let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");
+    let _ = &sum;
+    sum[0] += w.x;
+    sum[1] += w.y;
+    sum[2] += w.z;
+    sum[3] += f.x;
+    sum[4] += f.y;
+    sum[5] += f.z;
 }
 
 /// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
@@ -886,17 +896,10 @@ pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
 
 /// `propagate_cov` on slices: `a` and `p` are N×N row-major, `q` has N entries.
 pub fn propagate_cov_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
-    let mut am = [[0.0; N]; N];
-    let mut pm = [[0.0; N]; N];
-    for i in 0..N {
-        am[i].copy_from_slice(&a[i * N..(i + 1) * N]);
-        pm[i].copy_from_slice(&p[i * N..(i + 1) * N]);
-    }
+    let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
+    let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
     let q: &[f64; N] = q.try_into().expect("q of length N");
-    propagate_cov(&am, dt, q, &mut pm);
-    for i in 0..N {
-        p[i * N..(i + 1) * N].copy_from_slice(&pm[i]);
-    }
+    propagate_cov(a, dt, q, p);
 }
 
 const _: () = assert!(ND <= NAV_COUNT);

@@ -84,7 +84,8 @@ fn preset_table(spec: &Spec) -> String {
                 "    crate::catalog::PresetKernels {{ name: {m}::NAME, doc: {doc:?}, vertical: {m}::VERTICAL, \
                  states: &{m}::STATES, state_refs: &{m}::STATE_REFS, a_pattern: &{m}::A_PATTERN, \
                  regressor_ids: &{m}::REGRESSOR_IDS, measurements: &{m}::MEASUREMENTS, \
-                 fill_a: {m}::fill_a_dyn, fill_h: {m}::fill_h_dyn, propagate_cov: {m}::propagate_cov_dyn }},\n",
+                 fill_a: {m}::fill_a_dyn, fill_h: {m}::fill_h_dyn, propagate_cov: {m}::propagate_cov_dyn, \
+                 accumulate: {m}::accumulate_dyn }},\n",
                 doc = p.doc,
             ));
         }

@@ -1,0 +1,161 @@
+//! `sinsmodel bench [--seconds S]`: throughput of navigation + filter jobs, generated sparse
+//! kernels against a dense-nalgebra filter on the same data in the same process, and peak memory.
+
+use anyhow::Result;
+use clap::Args;
+use sinsmodel::filter::{self, AidingEpoch, FilterConfig};
+use sinsmodel::model::Model;
+use sinsmodel::reproduce::{self, Priors};
+use sinsmodel::scenario::Scenario;
+use sinsmodel::simulator::{simulate, SimOutput};
+use std::io::Write;
+use std::time::Instant;
+
+/// Arguments of `bench`.
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Seconds of simulated IMU data per job (results are scaled to hours of data per second).
+    #[arg(long, default_value_t = 600.0)]
+    seconds: f64,
+}
+
+fn data(rate: f64, seconds: f64) -> Result<(SimOutput, Vec<AidingEpoch>)> {
+    let text = format!(
+        "name = \"bench\"\nimu_rate_hz = {rate}\ntruth_rate_hz = 1.0\nseed = 9\n[start]\nlat_deg = 28.22\nlon_deg = 112.99\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = {seconds}\n{}{}",
+        reproduce::PAPER_ERRORS,
+        reproduce::PAPER_NOISE
+    );
+    let sim = simulate(&Scenario::parse(&text, "bench")?, |_| {});
+    let aid = reproduce::aiding_from_truth(&sim, &Priors::default(), false, 9)?;
+    Ok((sim, aid))
+}
+
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(|l| l.to_string())
+        })
+        .and_then(|l| {
+            l.split_whitespace()
+                .nth(1)
+                .and_then(|k| k.parse::<f64>().ok())
+        })
+        .map(|kb| kb / 1024.0)
+        .unwrap_or(f64::NAN)
+}
+
+/// Runs the command.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let model = Model::parse("P31")?;
+    let hours = args.seconds / 3600.0;
+
+    // Job 1: 1 kHz IMU, 100 Hz filter step, 1 Hz position updates, navigation + P31.
+    let (sim, aid) = data(1000.0, args.seconds)?;
+    let mut cfg = reproduce::config(&model, &Priors::default())?;
+    let time = |cfg: &FilterConfig| {
+        let t = Instant::now();
+        let r = filter::run(&model, cfg, &sim.imu, sim.start, &aid, None, |_| {});
+        (t.elapsed().as_secs_f64(), r.records.len())
+    };
+    let (t_gen, n1) = time(&cfg);
+    cfg.dense_reference = true;
+    let (t_dense, n2) = time(&cfg);
+    assert_eq!(n1, n2);
+    println!(
+        "job 1: {:.0} s of 1 kHz IMU, P31, 100 Hz step, 1 Hz updates",
+        args.seconds
+    );
+    println!(
+        "  generated sparse kernels: {:.3} s = {:.0} h of data per second ({:.0}x real time)",
+        t_gen,
+        hours / t_gen,
+        args.seconds / t_gen
+    );
+    println!(
+        "  dense nalgebra filter:    {:.3} s = {:.0} h of data per second",
+        t_dense,
+        hours / t_dense
+    );
+    println!("  ratio dense / generated:  {:.2}", t_dense / t_gen);
+
+    // Job 2 (the KF-GINS job): 200 Hz IMU, 1 Hz GNSS positions, covariance at every IMU epoch,
+    // a navigation row written per epoch.
+    let (sim, aid) = data(200.0, args.seconds)?;
+    let mut cfg = reproduce::config(&model, &Priors::default())?;
+    cfg.step_s = 1.0 / 200.0;
+    let dir = tempfile_dir()?;
+    let job2 = |cfg: &FilterConfig, name: &str| -> Result<f64> {
+        let path = dir.join(name);
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&path)?);
+        let t = Instant::now();
+        let mut err = None;
+        filter::run_with(
+            &model,
+            cfg,
+            &sim.imu,
+            sim.start,
+            &aid,
+            None,
+            |_| {},
+            &mut |s| {
+                let e = s.euler();
+                if let Err(e2) = writeln!(
+                    w,
+                    "{:.3} {:.9} {:.9} {:.3} {:.4} {:.4} {:.4} {:.5} {:.5} {:.5}",
+                    s.t,
+                    s.lat.to_degrees(),
+                    s.lon.to_degrees(),
+                    s.h,
+                    s.v.x,
+                    s.v.y,
+                    s.v.z,
+                    e.x.to_degrees(),
+                    e.y.to_degrees(),
+                    e.z.to_degrees()
+                ) {
+                    err = Some(e2);
+                }
+            },
+        );
+        w.flush()?;
+        if let Some(e) = err {
+            return Err(e.into());
+        }
+        let el = t.elapsed().as_secs_f64();
+        std::fs::remove_file(&path)?;
+        Ok(el)
+    };
+    let epochs = sim.imu.samples.len() as f64;
+    let t2 = job2(&cfg, "nav_generated.txt")?;
+    cfg.dense_reference = true;
+    let t2d = job2(&cfg, "nav_dense.txt")?;
+    println!("job 2 (KF-GINS layout): {:.0} s of 200 Hz IMU, P31 covariance every epoch, 1 Hz GNSS, a row written per epoch", args.seconds);
+    println!(
+        "  generated: {:.3} s = {:.0} epochs/s; dense: {:.3} s = {:.0} epochs/s; ratio {:.2}",
+        t2,
+        epochs / t2,
+        t2d,
+        epochs / t2d,
+        t2d / t2
+    );
+    println!(
+        "  KF-GINS reference (issue 4): ~57 k epochs/s; ratio to it {:.1}x",
+        epochs / t2 / 57_000.0
+    );
+    println!(
+        "peak resident memory: {:.1} MiB (includes the simulated data held in memory)",
+        peak_rss_mib()
+    );
+    let _ = std::fs::remove_dir(&dir);
+    Ok(())
+}
+
+fn tempfile_dir() -> Result<std::path::PathBuf> {
+    let d = std::env::temp_dir().join(format!("sinsmodel-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&d)?;
+    Ok(d)
+}
