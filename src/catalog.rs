@@ -119,5 +119,5 @@ pub struct PresetKernels {
     /// P ← Φ P Φᵀ + diag(q)·dt (N×N row-major).
     pub propagate_cov: fn(&[f64], f64, &[f64], &mut [f64]),
     /// Adds one sample's regressors (f [m/s²], w [rad/s]) to running sums.
-    pub accumulate: fn(&mut [f64], &nalgebra::Vector3<f64>, &nalgebra::Vector3<f64>),
+    pub accumulate: crate::model::AccumulateFn,
 }

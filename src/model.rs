@@ -322,8 +322,11 @@ pub struct RegressorAccumulator {
     ids: Vec<usize>,
     sum: Vec<f64>,
     count: u32,
-    generated: Option<fn(&mut [f64], &Vector3<f64>, &Vector3<f64>)>,
+    generated: Option<AccumulateFn>,
 }
+
+/// A generated regressor accumulator: adds one sample (f [m/s²], w [rad/s]) to running sums.
+pub type AccumulateFn = fn(&mut [f64], &Vector3<f64>, &Vector3<f64>);
 
 impl RegressorAccumulator {
     /// Adds one sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
