@@ -2,8 +2,8 @@
 //! `t [s]  lat lon [deg]  h [m]  sigma_n sigma_e sigma_d [m]`.
 
 use crate::atomic_file::AtomicFile;
-use crate::imu::parse_numbers;
-use anyhow::{bail, Context, Result};
+use crate::imu::read_table;
+use anyhow::{bail, Result};
 use std::io::Write;
 use std::path::Path;
 
@@ -48,41 +48,22 @@ pub fn write(path: &Path, rows: &[PositionFix], header: &str) -> Result<()> {
 
 /// Reads a position aiding file; σ must be positive, time increasing.
 pub fn read(path: &Path) -> Result<Vec<PositionFix>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read aiding file {}", path.display()))?;
-    let mut out: Vec<PositionFix> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let l = line.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
-        let v = parse_numbers(l, 7, path, i + 1)?;
-        if out.last().is_some_and(|p| v[0] <= p.t) {
-            bail!(
-                "{}:{}: time {} does not increase",
-                path.display(),
-                i + 1,
-                v[0]
-            );
-        }
-        if v[4] <= 0.0 || v[5] <= 0.0 || v[6] <= 0.0 {
-            bail!("{}:{}: sigma must be positive", path.display(), i + 1);
-        }
-        if v[1].abs() > 90.0 {
-            bail!(
-                "{}:{}: latitude {} outside ±90°",
-                path.display(),
-                i + 1,
-                v[1]
-            );
-        }
-        out.push(PositionFix {
-            t: v[0],
-            lat: v[1].to_radians(),
-            lon: v[2].to_radians(),
-            h: v[3],
-            sigma: [v[4], v[5], v[6]],
-        });
-    }
-    Ok(out)
+    read_table(path, 7, "aiding file")?
+        .into_iter()
+        .map(|(line, v)| {
+            if v[4] <= 0.0 || v[5] <= 0.0 || v[6] <= 0.0 {
+                bail!("{}:{line}: sigma must be positive", path.display());
+            }
+            if v[1].abs() > 90.0 {
+                bail!("{}:{line}: latitude {} outside ±90°", path.display(), v[1]);
+            }
+            Ok(PositionFix {
+                t: v[0],
+                lat: v[1].to_radians(),
+                lon: v[2].to_radians(),
+                h: v[3],
+                sigma: [v[4], v[5], v[6]],
+            })
+        })
+        .collect()
 }

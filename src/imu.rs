@@ -116,37 +116,48 @@ pub fn parse_numbers(line: &str, n: usize, file: &Path, lineno: usize) -> Result
         .collect()
 }
 
-/// Reads the text IMU format; any malformed row, NaN, non-increasing time or gap longer than 5
-/// intervals is an error naming the file and line.
-pub fn read_text(path: &Path) -> Result<ImuData> {
+/// Reads a whitespace/comma separated numeric table with `ncols` columns whose first column is a
+/// strictly increasing time; `#` comment and blank lines are skipped. Returns (line, values) rows;
+/// every problem names the file and line. `what` names the kind of file in messages.
+pub fn read_table(path: &Path, ncols: usize, what: &str) -> Result<Vec<(usize, Vec<f64>)>> {
     let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read IMU file {}", path.display()))?;
-    let mut samples: Vec<ImuSample> = Vec::new();
-    let mut lines_of: Vec<usize> = Vec::new();
+        .with_context(|| format!("cannot read {what} {}", path.display()))?;
+    let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let l = line.trim();
         if l.is_empty() || l.starts_with('#') {
             continue;
         }
-        let v = parse_numbers(l, 7, path, i + 1)?;
-        if let Some(prev) = samples.last() {
-            if v[0] <= prev.t {
+        let v = parse_numbers(l, ncols, path, i + 1)?;
+        if let Some((_, prev)) = rows.last() {
+            if v[0] <= prev[0] {
                 bail!(
                     "{}:{}: time {} does not increase (previous {})",
                     path.display(),
                     i + 1,
                     v[0],
-                    prev.t
+                    prev[0]
                 );
             }
         }
-        samples.push(ImuSample {
+        rows.push((i + 1, v));
+    }
+    Ok(rows)
+}
+
+/// Reads the text IMU format; any malformed row, NaN, non-increasing time or gap longer than 5
+/// intervals is an error naming the file and line.
+pub fn read_text(path: &Path) -> Result<ImuData> {
+    let rows = read_table(path, 7, "IMU file")?;
+    let lines_of: Vec<usize> = rows.iter().map(|r| r.0).collect();
+    let samples: Vec<ImuSample> = rows
+        .iter()
+        .map(|(_, v)| ImuSample {
             t: v[0],
             dtheta: Vector3::new(v[1], v[2], v[3]),
             dv: Vector3::new(v[4], v[5], v[6]),
-        });
-        lines_of.push(i + 1);
-    }
+        })
+        .collect();
     if samples.len() < 2 {
         bail!("{}: fewer than two IMU samples", path.display());
     }

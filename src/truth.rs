@@ -1,8 +1,8 @@
 //! Truth files (DESIGN §9): `t [s]  lat lon [deg]  h [m]  v_n v_e v_d [m/s]  roll pitch yaw [deg]`.
 
 use crate::atomic_file::AtomicFile;
-use crate::imu::parse_numbers;
-use anyhow::{bail, Context, Result};
+use crate::imu::read_table;
+use anyhow::Result;
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::Path;
@@ -56,31 +56,15 @@ pub fn write(path: &Path, rows: &[TruthRow], header: &str) -> Result<()> {
 
 /// Reads a truth file (errors name file and line; time must increase).
 pub fn read(path: &Path) -> Result<Vec<TruthRow>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read truth file {}", path.display()))?;
-    let mut out: Vec<TruthRow> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let l = line.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
-        let v = parse_numbers(l, 10, path, i + 1)?;
-        if out.last().is_some_and(|p| v[0] <= p.t) {
-            bail!(
-                "{}:{}: time {} does not increase",
-                path.display(),
-                i + 1,
-                v[0]
-            );
-        }
-        out.push(TruthRow {
+    Ok(read_table(path, 10, "truth file")?
+        .into_iter()
+        .map(|(_, v)| TruthRow {
             t: v[0],
             lat: v[1].to_radians(),
             lon: v[2].to_radians(),
             h: v[3],
             v: Vector3::new(v[4], v[5], v[6]),
             euler: Vector3::new(v[7].to_radians(), v[8].to_radians(), v[9].to_radians()),
-        });
-    }
-    Ok(out)
+        })
+        .collect())
 }
