@@ -28,6 +28,8 @@ enum Command {
     Navigate(cli::navigate::NavigateArgs),
     /// Run navigator + error-state Kalman filter with any model on IMU and position aiding files.
     Filter(cli::filter::FilterArgs),
+    /// Overlapping Allan deviation of the six IMU channels, noise fit and plots.
+    Allan(cli::allan::AllanArgs),
     /// Throughput of navigation + filter jobs (generated kernels vs dense), peak memory.
     Bench(cli::bench::BenchArgs),
     /// Reproduce the paper's experiments (P28 vs P31), with figures, priors study, consistency.
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => cli::reproduce::run(&args),
         Command::Filter(args) => cli::filter::run(&args),
         Command::Bench(args) => cli::bench::run(&args),
+        Command::Allan(args) => cli::allan::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

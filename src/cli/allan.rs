@@ -1,0 +1,147 @@
+//! `sinsmodel allan --imu FILE [--json OUT] [--plot PREFIX]`: overlapping Allan deviation of the
+//! six channels (rates Δθ/T [rad/s], Δv/T [m/s²], FRD body) with uncertainties, the noise fit, and
+//! log-log plots.
+
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use sinsmodel::allan::{fit, oadev, AllanCurve, NoiseFit};
+use sinsmodel::plot::{line_plot, Scale, Series};
+use sinsmodel::{atomic_file, readers};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Arguments of `allan`.
+#[derive(Args)]
+pub struct AllanArgs {
+    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
+    #[arg(long)]
+    imu: PathBuf,
+    /// Skip this many seconds at the start (e.g. a disturbed start).
+    #[arg(long, default_value_t = 0.0)]
+    skip: f64,
+    /// JSON output.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Plot prefix: writes PREFIX_gyro.png and PREFIX_accel.png (default: next to --json).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct Out {
+    rate_hz: f64,
+    tau_s: Vec<f64>,
+    adev: BTreeMap<String, Vec<f64>>,
+    adev_err: BTreeMap<String, Vec<f64>>,
+    fit: BTreeMap<String, NoiseFit>,
+    units: BTreeMap<String, &'static str>,
+}
+
+const NAMES: [&str; 6] = [
+    "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+];
+
+/// Runs the command.
+pub fn run(args: &AllanArgs) -> Result<()> {
+    let data = readers::read_any_imu(&args.imu)?;
+    let dt = data.interval();
+    let t0 = data.samples[0].t + args.skip;
+    let samples: Vec<_> = data.samples.iter().filter(|s| s.t >= t0).collect();
+    let curves: Vec<AllanCurve> = (0..6)
+        .map(|c| {
+            let y: Vec<f64> = samples
+                .iter()
+                .map(|s| {
+                    if c < 3 {
+                        s.dtheta[c] / dt
+                    } else {
+                        s.dv[c - 3] / dt
+                    }
+                })
+                .collect();
+            oadev(&y, dt)
+        })
+        .collect();
+    let mut out = Out {
+        rate_hz: 1.0 / dt,
+        tau_s: curves[0].tau_s.clone(),
+        adev: BTreeMap::new(),
+        adev_err: BTreeMap::new(),
+        fit: BTreeMap::new(),
+        units: BTreeMap::new(),
+    };
+    let r2dh = 180.0 / std::f64::consts::PI * 3600.0;
+    for (k, c) in curves.iter().enumerate() {
+        let f = fit(c);
+        out.adev.insert(NAMES[k].into(), c.adev.clone());
+        out.adev_err.insert(NAMES[k].into(), c.adev_err.clone());
+        out.fit.insert(NAMES[k].into(), f);
+        out.units.insert(
+            NAMES[k].into(),
+            if k < 3 {
+                "rad/s (fit: white rad/sqrt(s), random_walk rad/s/sqrt(s))"
+            } else {
+                "m/s^2 (fit: white m/s/sqrt(s), random_walk m/s^2/sqrt(s))"
+            },
+        );
+        if k < 3 {
+            println!(
+                "{:<8} ARW {:.4} deg/sqrt(h)  bias instability {:.4} deg/h  RRW {:.4} deg/h/sqrt(h)",
+                NAMES[k],
+                f.white * r2dh / 60.0,
+                f.bias_instability * r2dh,
+                f.random_walk * r2dh * 60.0
+            );
+        } else {
+            let ug = 1e6 / sinsmodel::units::STANDARD_GRAVITY;
+            println!(
+                "{:<8} VRW {:.2} ug/sqrt(Hz)  bias instability {:.2} ug  RRW {:.3} ug/sqrt(s)",
+                NAMES[k],
+                f.white * ug,
+                f.bias_instability * ug,
+                f.random_walk * ug
+            );
+        }
+    }
+    if let Some(j) = &args.json {
+        atomic_file::write_text(j, &serde_json::to_string_pretty(&out)?)?;
+    }
+    let prefix = args
+        .plot
+        .clone()
+        .or_else(|| args.json.as_ref().map(|j| j.with_extension("")));
+    if let Some(p) = prefix {
+        let series = |range: std::ops::Range<usize>, scale: f64| -> Vec<Series> {
+            range
+                .map(|k| Series {
+                    label: NAMES[k].into(),
+                    points: curves[k]
+                        .tau_s
+                        .iter()
+                        .zip(&curves[k].adev)
+                        .map(|(t, a)| (*t, a * scale))
+                        .collect(),
+                })
+                .collect()
+        };
+        let png = |suffix: &str| PathBuf::from(format!("{}_{suffix}.png", p.display()));
+        line_plot(
+            &png("gyro"),
+            "Allan deviation, gyros",
+            "tau [s]",
+            "ADEV [deg/h]",
+            &series(0..3, r2dh),
+            Scale::LogLog,
+        )?;
+        line_plot(
+            &png("accel"),
+            "Allan deviation, accelerometers",
+            "tau [s]",
+            "ADEV [ug]",
+            &series(3..6, 1e6 / sinsmodel::units::STANDARD_GRAVITY),
+            Scale::LogLog,
+        )?;
+    }
+    Ok(())
+}
