@@ -2,6 +2,7 @@
 //! navigation systems. Frames: NED navigation, FRD body; SI units and radians inside.
 
 pub mod aiding;
+pub mod align;
 pub mod allan;
 pub mod atomic_file;
 pub mod attitude;

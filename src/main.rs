@@ -28,6 +28,8 @@ enum Command {
     Navigate(cli::navigate::NavigateArgs),
     /// Run navigator + error-state Kalman filter with any model on IMU and position aiding files.
     Filter(cli::filter::FilterArgs),
+    /// Static alignment: roll, pitch, heading with σ, latitude when not given.
+    Align(cli::align::AlignArgs),
     /// Overlapping Allan deviation of the six IMU channels, noise fit and plots.
     Allan(cli::allan::AllanArgs),
     /// Throughput of navigation + filter jobs (generated kernels vs dense), peak memory.
@@ -47,6 +49,7 @@ fn main() -> ExitCode {
         Command::Filter(args) => cli::filter::run(&args),
         Command::Bench(args) => cli::bench::run(&args),
         Command::Allan(args) => cli::allan::run(&args),
+        Command::Align(args) => cli::align::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,81 @@
+//! `sinsmodel align --imu FILE [--lat DEG] [--seconds N] [--json OUT]`.
+
+use anyhow::Result;
+use clap::Args;
+use sinsmodel::{align, atomic_file, readers};
+use std::path::PathBuf;
+
+/// Arguments of `align`.
+#[derive(Args)]
+pub struct AlignArgs {
+    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
+    #[arg(long)]
+    imu: PathBuf,
+    /// Latitude [deg]; estimated from the Earth-rate and gravity directions when omitted.
+    #[arg(long, allow_hyphen_values = true)]
+    lat: Option<f64>,
+    /// Longitude [deg] (for the known-position updates).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    lon: f64,
+    /// Height [m].
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    h: f64,
+    /// Prior 1-σ of the gyro biases in the fine alignment [deg/h] (bounds the heading σ).
+    #[arg(long, default_value_t = 0.2)]
+    gyro_bias_sigma: f64,
+    /// Use at most this many seconds after the disturbed start.
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// JSON output {roll_deg, pitch_deg, heading_deg, heading_sigma_deg, lat_deg, lat_sigma_deg, …}.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+/// Runs the command.
+pub fn run(args: &AlignArgs) -> Result<()> {
+    if let Some(l) = args.lat {
+        if !(-89.0..=89.0).contains(&l) {
+            anyhow::bail!("--lat {l} must be within ±89°");
+        }
+    }
+    let data = readers::read_any_imu(&args.imu)?;
+    let d = std::f64::consts::PI / 180.0;
+    let a = align::align(
+        &data,
+        args.lat.map(|l| l * d),
+        args.seconds,
+        args.lon * d,
+        args.h,
+        args.gyro_bias_sigma * d / 3600.0,
+    )?;
+    println!("skipped disturbed start: {:.0} s", a.skipped_s);
+    println!(
+        "roll {:.4} deg  pitch {:.4} deg  heading {:.3} deg (1-sigma {:.3} deg)",
+        a.roll_deg, a.pitch_deg, a.heading_deg, a.heading_sigma_deg
+    );
+    println!(
+        "latitude {:.4} deg{}",
+        a.lat_deg,
+        if a.lat_sigma_deg > 0.0 {
+            format!(" (estimated, 1-sigma {:.4} deg)", a.lat_sigma_deg)
+        } else {
+            " (given)".into()
+        }
+    );
+    let (lo, hi) = a
+        .heading_windows_deg
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    println!(
+        "coarse heading over {} one-minute windows: {lo:.3} .. {hi:.3} deg",
+        a.heading_windows_deg.len()
+    );
+    println!(
+        "gyro bias estimates [deg/h]: {:.4} {:.4} {:.4}",
+        a.gyro_bias_deg_h[0], a.gyro_bias_deg_h[1], a.gyro_bias_deg_h[2]
+    );
+    if let Some(j) = &args.json {
+        atomic_file::write_text(j, &serde_json::to_string_pretty(&a)?)?;
+    }
+    Ok(())
+}
