@@ -14,6 +14,7 @@ pub mod generated;
 pub mod imu;
 pub mod jacobian;
 pub mod model;
+pub mod mounting;
 pub mod nav_point;
 pub mod plot;
 pub mod progress;

@@ -20,6 +20,9 @@ pub struct AllanArgs {
     /// Skip this many seconds at the start (e.g. a disturbed start).
     #[arg(long, default_value_t = 0.0)]
     skip: f64,
+    /// Use at most this many seconds after --skip (e.g. the static part of a drive).
+    #[arg(long)]
+    seconds: Option<f64>,
     /// JSON output.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -47,7 +50,18 @@ pub fn run(args: &AllanArgs) -> Result<()> {
     let data = readers::read_any_imu(&args.imu)?;
     let dt = data.interval();
     let t0 = data.samples[0].t + args.skip;
-    let samples: Vec<_> = data.samples.iter().filter(|s| s.t >= t0).collect();
+    let t1 = args.seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);
+    let samples: Vec<_> = data
+        .samples
+        .iter()
+        .filter(|s| s.t >= t0 && s.t < t1)
+        .collect();
+    if samples.len() < 16 {
+        anyhow::bail!(
+            "{}: fewer than 16 samples in the chosen span",
+            args.imu.display()
+        );
+    }
     let curves: Vec<AllanCurve> = (0..6)
         .map(|c| {
             let y: Vec<f64> = samples

@@ -21,9 +21,21 @@ pub struct FilterArgs {
     /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
     #[arg(long)]
     imu: PathBuf,
-    /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d).
+    /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
     #[arg(long)]
-    aid: PathBuf,
+    aid: Option<PathBuf>,
+    /// A static vehicle at a known position: lat,lon [deg],h [m]; position updates (σ 0.1 m) and
+    /// zero-velocity updates (σ from --zupt, default 0.01 m/s) at 1 Hz instead of --aid.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    static_aid: Option<Vec<f64>>,
+    /// Prior 1-σ of a state, NAME=QUANTITY with units (repeatable); a trailing `*` matches a
+    /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`.
+    #[arg(long)]
+    prior: Vec<String>,
+    /// Sensor white noise from `sinsmodel allan --json` (mean ARW of the gyros, VRW of the
+    /// accelerometers) instead of the spec defaults.
+    #[arg(long)]
+    noise: Option<PathBuf>,
     /// Truth file (t lat lon h vn ve vd roll pitch yaw): adds the true φ and the model error.
     #[arg(long)]
     truth: Option<PathBuf>,
@@ -62,7 +74,74 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     let imu = readers::read_any_imu(&args.imu)?;
     imu.check_time(&args.imu.display().to_string(), 5.0)?;
-    let fixes = aiding::read(&args.aid)?;
+    for spec in &args.prior {
+        let (name, value) = spec
+            .split_once('=')
+            .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
+        let (name, value) = (name.trim(), value.trim());
+        let matches: Vec<usize> = (0..model.n())
+            .filter(|&i| match name.strip_suffix('*') {
+                Some(prefix) => model.names[i].starts_with(prefix),
+                None => model.names[i] == name,
+            })
+            .collect();
+        if matches.is_empty() {
+            bail!(
+                "--prior `{spec}`: no state `{name}` in model {}",
+                model.name
+            );
+        }
+        for i in matches {
+            let si = sinsmodel::units::parse_quantity_as(value, model.unit(i))
+                .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+            cfg.prior_sigma[i] = si;
+        }
+    }
+    if let Some(path) = &args.noise {
+        let (arw, vrw) = noise_from_allan(path)?;
+        cfg = cfg.with_sensor_noise(&model, arw, vrw);
+        eprintln!(
+            "noise from {}: ARW {:.3e} rad/sqrt(s), VRW {:.3e} m/s/sqrt(s)",
+            path.display(),
+            arw,
+            vrw
+        );
+    }
+    let fixes = match (&args.aid, &args.static_aid) {
+        (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {
+            sinsmodel::readers::rtklib::read(p)?
+                .iter()
+                .map(|e| aiding::PositionFix {
+                    t: e.t,
+                    lat: e.lat_deg.to_radians(),
+                    lon: e.lon_deg.to_radians(),
+                    h: e.h,
+                    sigma: [
+                        e.sigma_neu[0].max(0.02),
+                        e.sigma_neu[1].max(0.02),
+                        e.sigma_neu[2].max(0.05),
+                    ],
+                })
+                .collect()
+        }
+        (Some(p), None) => aiding::read(p)?,
+        (None, Some(v)) if v.len() == 3 => {
+            let (t_first, t_last) = (imu.samples[0].t, imu.samples[imu.samples.len() - 1].t);
+            (1..)
+                .map(|k| t_first.floor() + k as f64)
+                .take_while(|t| *t <= t_last)
+                .map(|t| aiding::PositionFix {
+                    t,
+                    lat: v[0].to_radians(),
+                    lon: v[1].to_radians(),
+                    h: v[2],
+                    sigma: [0.1, 0.1, 0.1],
+                })
+                .collect()
+        }
+        _ => bail!("give either --aid FILE or --static-aid LAT,LON,H"),
+    };
+    let zupt = args.zupt.or(args.static_aid.as_ref().map(|_| 0.01));
     let truth_rows = match &args.truth {
         Some(p) => Some(truth::read(p)?),
         None => None,
@@ -113,7 +192,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         .filter(|f| f.t > t0)
         .map(|f| AidingEpoch {
             t: f.t,
-            vel: args.zupt.map(|s| (Vector3::zeros(), s)),
+            vel: zupt.map(|s| (Vector3::zeros(), s)),
             pos: Some((f.lat, f.lon, f.h, f.sigma)),
         })
         .collect();
@@ -210,4 +289,32 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Mean gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from an `allan --json` file.
+fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not valid JSON", path.display()))?;
+    let white = |names: [&str; 3]| -> Result<f64> {
+        let mut s = 0.0;
+        for n in names {
+            let w = v["fit"][n]["white"]
+                .as_f64()
+                .with_context(|| format!("{}: fit.{n}.white missing", path.display()))?;
+            if !w.is_finite() || w <= 0.0 {
+                bail!(
+                    "{}: fit.{n}.white = {w} is not a positive density",
+                    path.display()
+                );
+            }
+            s += w * w;
+        }
+        Ok((s / 3.0).sqrt())
+    };
+    Ok((
+        white(["gyro_x", "gyro_y", "gyro_z"])?,
+        white(["accel_x", "accel_y", "accel_z"])?,
+    ))
 }

@@ -1,0 +1,127 @@
+//! The MEMS drive end to end: mounting found from the data, the filter with RTK positions and
+//! the vertical channel, with the spec's default noise and with the noise identified by Allan
+//! deviation on the static start.
+
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use sinsmodel::allan::{fit, oadev};
+use sinsmodel::attitude::dcm_from_euler;
+use sinsmodel::filter::{self, AidingEpoch, FilterConfig, Mode};
+use sinsmodel::model::Model;
+use sinsmodel::readers::{gnss_imu, rtklib};
+use sinsmodel::strapdown::{NavState, Vertical};
+use std::path::PathBuf;
+
+#[test]
+fn mems_drive_mounting_and_noise_identification() {
+    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
+    let log = gnss_imu::read(&d.join("imu_1934.csv")).unwrap();
+    let pos = rtklib::read(&d.join("gnss_1934_sf.pos")).unwrap();
+    let m = sinsmodel::mounting::from_drive_off(&log.imu, &pos, 30.0).unwrap();
+    // sensor z points up (gravity reaction along +z) and the car drives off along sensor -x
+    assert!(m.f_static.z > 9.5, "{:?}", m.f_static);
+    assert!(m.forward_sensor.x < -0.9, "{:?}", m.forward_sensor);
+    eprintln!(
+        "mounting: euler {:?} deg, static |f| = {:.3} m/s^2",
+        m.euler.map(f64::to_degrees),
+        m.f_static.norm()
+    );
+
+    // Allan on the static start: white-noise densities for q
+    let dt = log.imu.interval();
+    let t0 = log.imu.samples[0].t;
+    let stat: Vec<_> = log.imu.samples.iter().filter(|s| s.t < t0 + 30.0).collect();
+    let dens = |c: usize| {
+        let y: Vec<f64> = stat
+            .iter()
+            .map(|s| {
+                if c < 3 {
+                    s.dtheta[c] / dt
+                } else {
+                    s.dv[c - 3] / dt
+                }
+            })
+            .collect();
+        fit(&oadev(&y, dt)).white
+    };
+    let arw = ((0..3).map(|c| dens(c).powi(2)).sum::<f64>() / 3.0).sqrt();
+    let vrw = ((3..6).map(|c| dens(c).powi(2)).sum::<f64>() / 3.0).sqrt();
+
+    let model = Model::parse("P13+vertical").unwrap();
+    let p0 = pos
+        .iter()
+        .min_by(|a, b| (a.t - (t0 - dt)).abs().total_cmp(&(b.t - (t0 - dt)).abs()))
+        .unwrap();
+    let c = dcm_from_euler(m.euler.x, m.euler.y, m.euler.z);
+    let start = NavState {
+        t: t0 - dt,
+        lat: p0.lat_deg.to_radians(),
+        lon: p0.lon_deg.to_radians(),
+        h: p0.h,
+        v: Vector3::zeros(),
+        q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
+    };
+    let aid: Vec<AidingEpoch> = pos
+        .iter()
+        .filter(|p| p.t > t0)
+        .map(|p| AidingEpoch {
+            t: p.t,
+            vel: None,
+            pos: Some((
+                p.lat_deg.to_radians(),
+                p.lon_deg.to_radians(),
+                p.h,
+                [
+                    p.sigma_neu[0].max(0.02),
+                    p.sigma_neu[1].max(0.02),
+                    p.sigma_neu[2].max(0.05),
+                ],
+            )),
+        })
+        .collect();
+    let base = || {
+        let mut cfg = FilterConfig::new(&model);
+        cfg.mode = Mode::ClosedLoop;
+        cfg.vertical = Vertical::Free;
+        let d2r = std::f64::consts::PI / 180.0;
+        for (n, s) in [
+            ("eps_", 0.5 * d2r),
+            ("nabla_", 0.5),
+            ("phi_n", 2.0 * d2r),
+            ("phi_e", 2.0 * d2r),
+            ("phi_d", 10.0 * d2r),
+        ] {
+            for i in 0..model.n() {
+                if model.names[i].starts_with(n) {
+                    cfg.prior_sigma[i] = s;
+                }
+            }
+        }
+        cfg
+    };
+    let nis = |cfg: &FilterConfig| {
+        let run = filter::run(&model, cfg, &log.imu, start, &aid, None, |_| {});
+        let i = model.index_of("nabla_z").unwrap();
+        let nz = run.records.last().unwrap().x[i];
+        (
+            run.innovations
+                .iter()
+                .map(|x| x.nu * x.nu / x.s)
+                .sum::<f64>()
+                / run.innovations.len() as f64,
+            nz,
+        )
+    };
+    let (nis_default, _) = nis(&base());
+    let (nis_allan, nabla_z) = nis(&base().with_sensor_noise(&model, arw, vrw));
+    eprintln!("MEMS drive, P13+vertical: mean NIS {nis_default:.1} with the spec's noise, {nis_allan:.2} with Allan noise (ARW {arw:.2e}, VRW {vrw:.2e}); nabla_z {nabla_z:.3} m/s^2");
+    assert!(
+        nis_default > 100.0,
+        "navigation-grade default noise is far too optimistic for a MEMS IMU"
+    );
+    assert!(
+        nis_allan < 10.0,
+        "identified noise brings the innovations near their predicted size"
+    );
+    // the static |f| is ~1.3 % above gravity: along sensor z (up) the accelerometer reads high
+    assert!(nabla_z > 0.05 && nabla_z < 0.3, "{nabla_z}");
+}
