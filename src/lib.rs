@@ -10,6 +10,7 @@ pub mod catalog;
 pub mod covariance;
 pub mod earth;
 pub mod filter;
+pub mod fixed;
 pub mod generated;
 pub mod imu;
 pub mod jacobian;

@@ -82,6 +82,35 @@ pub struct Navigator {
     prev_lat: f64,
     prev_h: f64,
     damp_int: f64,
+    earth: EarthCache,
+}
+
+/// Earth quantities at one latitude and height.
+#[derive(Debug, Clone, Copy)]
+struct EarthCache {
+    lat: f64,
+    h: f64,
+    rm: f64,
+    rn: f64,
+    tan: f64,
+    cos: f64,
+    w_ie: Vector3<f64>,
+    g: Vector3<f64>,
+}
+
+impl EarthCache {
+    fn new(lat: f64, h: f64) -> EarthCache {
+        EarthCache {
+            lat,
+            h,
+            rm: earth::radius_meridian(lat) + h,
+            rn: earth::radius_transverse(lat) + h,
+            tan: lat.tan(),
+            cos: lat.cos(),
+            w_ie: earth::omega_ie_ned(lat),
+            g: earth::gravity_ned(lat, h),
+        }
+    }
 }
 
 const DAMP_TAU: f64 = 100.0;
@@ -99,6 +128,7 @@ impl Navigator {
             prev_lat: state.lat,
             prev_h: state.h,
             damp_int: 0.0,
+            earth: EarthCache::new(state.lat, state.h),
         }
     }
 
@@ -108,10 +138,16 @@ impl Navigator {
         let lat_mid = s.lat + 0.5 * (s.lat - self.prev_lat);
         let h_mid = s.h + 0.5 * (s.h - self.prev_h);
         let v_mid = s.v + 0.5 * (s.v - self.prev_v);
-        let w_ie = earth::omega_ie_ned(lat_mid);
-        let w_en = earth::omega_en_ned(lat_mid, h_mid, &v_mid);
+        // Earth quantities, refreshed when latitude moved by > 1e-9 rad (6 mm) or height by
+        // > 1 mm: below that their change is under 1e-11 relative
+        if (lat_mid - self.earth.lat).abs() > 1e-9 || (h_mid - self.earth.h).abs() > 1e-3 {
+            self.earth = EarthCache::new(lat_mid, h_mid);
+        }
+        let e = self.earth;
+        let w_ie = e.w_ie;
+        let w_en = Vector3::new(v_mid.y / e.rn, -v_mid.x / e.rm, -v_mid.y * e.tan / e.rn);
         let zeta = (w_ie + w_en) * dt;
-        let g = earth::gravity_ned(lat_mid, h_mid);
+        let g = e.g;
 
         // velocity
         let dv_rot = 0.5 * dtheta.cross(dv);
@@ -138,10 +174,8 @@ impl Navigator {
 
         // position (trapezoid, radii at mid-interval)
         let v_avg = 0.5 * (s.v + v_new);
-        let rm = earth::radius_meridian(lat_mid) + h_mid;
-        let rn = earth::radius_transverse(lat_mid) + h_mid;
-        let lat_new = s.lat + v_avg.x / rm * dt;
-        let lon_new = s.lon + v_avg.y / (rn * lat_mid.cos()) * dt;
+        let lat_new = s.lat + v_avg.x / e.rm * dt;
+        let lon_new = s.lon + v_avg.y / (e.rn * e.cos) * dt;
 
         // attitude
         let phi = dtheta + self.prev_dtheta.cross(dtheta) / 12.0;

@@ -1,6 +1,7 @@
 //! Truth files (DESIGN §9): `t [s]  lat lon [deg]  h [m]  v_n v_e v_d [m/s]  roll pitch yaw [deg]`.
 
 use crate::atomic_file::AtomicFile;
+use crate::fixed::write_fixed;
 use crate::imu::read_table;
 use anyhow::Result;
 use nalgebra::Vector3;
@@ -36,22 +37,33 @@ pub fn write(path: &Path, rows: &[TruthRow], header: &str) -> Result<()> {
         "# t[s] lat lon [deg] h[m] v_n v_e v_d [m/s] roll pitch yaw [deg] (NED, FRD)"
     )?;
     for r in rows {
-        writeln!(
-            w,
-            "{:.4} {:.11} {:.11} {:.4} {:.6} {:.6} {:.6} {:.9} {:.9} {:.9}",
-            r.t,
-            r.lat.to_degrees(),
-            r.lon.to_degrees(),
-            r.h,
-            r.v.x,
-            r.v.y,
-            r.v.z,
-            r.euler.x.to_degrees(),
-            r.euler.y.to_degrees(),
-            r.euler.z.to_degrees()
-        )?;
+        write_row(w, r)?;
     }
     f.commit()
+}
+
+/// Writes one row of the truth layout (`t lat lon h v_n v_e v_d roll pitch yaw`, degrees).
+pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
+    let d = 180.0 / std::f64::consts::PI;
+    let cols: [(f64, usize); 10] = [
+        (r.t, 4),
+        (r.lat * d, 11),
+        (r.lon * d, 11),
+        (r.h, 4),
+        (r.v.x, 6),
+        (r.v.y, 6),
+        (r.v.z, 6),
+        (r.euler.x * d, 9),
+        (r.euler.y * d, 9),
+        (r.euler.z * d, 9),
+    ];
+    for (k, (v, dec)) in cols.iter().enumerate() {
+        if k > 0 {
+            w.write_all(b" ")?;
+        }
+        write_fixed(w, *v, *dec)?;
+    }
+    w.write_all(b"\n")
 }
 
 /// Reads a truth file (errors name file and line; time must increase).

@@ -522,8 +522,27 @@ pub fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
 }
 
 /// P ← Φ P Φᵀ + diag(q)·dt with Φ = I + B: P + BP + (BP)ᵀ + BPBᵀ on the pattern only.
-/// `q` is the continuous white-noise density of each state (SI²/s).
+/// `q` is the continuous white-noise density of each state (SI²/s). Uses AVX2 when the CPU
+/// has it (same arithmetic, wider registers: results are identical).
 pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            unsafe { propagate_cov_avx2(a, dt, q, p) };
+            return;
+        }
+    }
+    propagate_cov_body(a, dt, q, p)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn propagate_cov_avx2(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
+    propagate_cov_body(a, dt, q, p)
+}
+
+#[inline(always)]
+fn propagate_cov_body(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
     let mut b = [[0.0; N]; ND];
     fill_b(a, dt, &mut b);
     let mut m = [[0.0; N]; ND];

@@ -8,7 +8,7 @@ use sinsmodel::model::Model;
 use sinsmodel::reproduce::{self, Priors};
 use sinsmodel::scenario::Scenario;
 use sinsmodel::simulator::{simulate, SimOutput};
-use std::io::Write;
+use std::io::Write as _;
 use std::time::Instant;
 
 /// Arguments of `bench`.
@@ -102,21 +102,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             None,
             |_| {},
             &mut |s| {
-                let e = s.euler();
-                if let Err(e2) = writeln!(
-                    w,
-                    "{:.3} {:.9} {:.9} {:.3} {:.4} {:.4} {:.4} {:.5} {:.5} {:.5}",
-                    s.t,
-                    s.lat.to_degrees(),
-                    s.lon.to_degrees(),
-                    s.h,
-                    s.v.x,
-                    s.v.y,
-                    s.v.z,
-                    e.x.to_degrees(),
-                    e.y.to_degrees(),
-                    e.z.to_degrees()
-                ) {
+                let row = sinsmodel::truth::TruthRow {
+                    t: s.t,
+                    lat: s.lat,
+                    lon: s.lon,
+                    h: s.h,
+                    v: s.v,
+                    euler: s.euler(),
+                };
+                if let Err(e2) = sinsmodel::truth::write_row(&mut w, &row) {
                     err = Some(e2);
                 }
             },
