@@ -246,15 +246,16 @@ pub fn run_with(
     );
     let (i_lat, i_lon, i_h) = (idx("dlat"), idx("dlon"), idx("dh"));
     let mut h_row = vec![0.0; n];
+    let mut np = NavPoint::new(start.lat, start.h, start.v, &start.dcm(), &Vector3::zeros());
     let (mut ax, mut a2x) = (vec![0.0; n], vec![0.0; n]);
     let mut u = vec![0.0; n];
     for (k, smp) in imu.samples.iter().enumerate() {
         let dt = smp.t - prev_t;
         prev_t = smp.t;
         let (mut dth, mut dvel) = (smp.dtheta, smp.dv);
-        let f_meas = dvel / dt;
-        let w_meas = dth / dt;
         if cfg.mode == Mode::ClosedLoop {
+            let f_meas = dvel / dt;
+            let w_meas = dth / dt;
             for &(i, t) in &terms {
                 if correction[i] != 0.0 {
                     let info = &common::TERMS[t];
@@ -281,7 +282,7 @@ pub fn run_with(
         // ---- propagation over the step
         let s = nav.state;
         let f_mean = f_sum / in_step as f64;
-        let np = NavPoint::new(s.lat, s.h, s.v, &s.dcm(), &f_mean);
+        np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
         for &(i, j) in &pattern {
             a[i * n + j] = 0.0;
         }

@@ -30,6 +30,31 @@ pub struct NavPoint {
 }
 
 impl NavPoint {
+    /// Moves the point to a new navigation state, recomputing the radii and gravity derivatives
+    /// only when latitude changed by more than 1e-9 rad (6 mm) or height by more than 1 mm
+    /// (their change below that is under 1e-11 relative).
+    pub fn update(
+        &mut self,
+        lat: f64,
+        h: f64,
+        v_ned: Vector3<f64>,
+        c_bn: &Matrix3<f64>,
+        f_b: &Vector3<f64>,
+    ) {
+        if (lat - self.lat).abs() > 1e-9 || (h - self.h).abs() > 1e-3 {
+            *self = NavPoint::new(lat, h, v_ned, c_bn, f_b);
+            return;
+        }
+        let f_n = c_bn * f_b;
+        self.v_ned = [v_ned.x, v_ned.y, v_ned.z];
+        self.f_ned = [f_n.x, f_n.y, f_n.z];
+        for (i, row) in self.c.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = c_bn[(i, j)];
+            }
+        }
+    }
+
     /// Builds the point from latitude [rad], height [m], NED velocity [m/s], C_b^n and the
     /// body-frame specific force f^b [m/s²].
     pub fn new(

@@ -56,10 +56,18 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // Job 1: 1 kHz IMU, 100 Hz filter step, 1 Hz position updates, navigation + P31.
     let (sim, aid) = data(1000.0, args.seconds)?;
     let mut cfg = reproduce::config(&model, &Priors::default())?;
+    // fastest of three runs each (the machine is shared; the minimum is the least disturbed)
     let time = |cfg: &FilterConfig| {
-        let t = Instant::now();
-        let r = filter::run(&model, cfg, &sim.imu, sim.start, &aid, None, |_| {});
-        (t.elapsed().as_secs_f64(), r.records.len())
+        let mut best = (f64::INFINITY, 0);
+        for _ in 0..3 {
+            let t = Instant::now();
+            let r = filter::run(&model, cfg, &sim.imu, sim.start, &aid, None, |_| {});
+            let el = t.elapsed().as_secs_f64();
+            if el < best.0 {
+                best = (el, r.records.len());
+            }
+        }
+        best
     };
     let (t_gen, n1) = time(&cfg);
     cfg.dense_reference = true;
@@ -124,9 +132,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         Ok(el)
     };
     let epochs = sim.imu.samples.len() as f64;
-    let t2 = job2(&cfg, "nav_generated.txt")?;
+    let best3 = |cfg: &FilterConfig, name: &str| -> Result<f64> {
+        Ok(job2(cfg, name)?.min(job2(cfg, name)?).min(job2(cfg, name)?))
+    };
+    let t2 = best3(&cfg, "nav_generated.txt")?;
     cfg.dense_reference = true;
-    let t2d = job2(&cfg, "nav_dense.txt")?;
+    let t2d = best3(&cfg, "nav_dense.txt")?;
     println!("job 2 (KF-GINS layout): {:.0} s of 200 Hz IMU, P31 covariance every epoch, 1 Hz GNSS, a row written per epoch", args.seconds);
     println!(
         "  generated: {:.3} s = {:.0} epochs/s; dense: {:.3} s = {:.0} epochs/s; ratio {:.2}",
