@@ -82,6 +82,57 @@ pub fn gravity_ned(lat: f64, h: f64) -> nalgebra::Vector3<f64> {
     nalgebra::Vector3::new(0.0, 0.0, gravity(lat, h))
 }
 
+/// Earth quantities at one latitude [rad] and height [m], for loops that step through many
+/// nearby positions: radii plus height, tan and cos of latitude, Earth rate and gravity (NED).
+#[derive(Debug, Clone, Copy)]
+pub struct LocalEarth {
+    /// Latitude [rad].
+    pub lat: f64,
+    /// Height [m].
+    pub h: f64,
+    /// R_M + h [m].
+    pub rm: f64,
+    /// R_N + h [m].
+    pub rn: f64,
+    /// tan(lat).
+    pub tan: f64,
+    /// cos(lat).
+    pub cos: f64,
+    /// Earth rate, NED [rad/s].
+    pub w_ie: nalgebra::Vector3<f64>,
+    /// Gravity, NED [m/s²].
+    pub g: nalgebra::Vector3<f64>,
+}
+
+impl LocalEarth {
+    /// The quantities at (lat, h).
+    pub fn new(lat: f64, h: f64) -> LocalEarth {
+        LocalEarth {
+            lat,
+            h,
+            rm: radius_meridian(lat) + h,
+            rn: radius_transverse(lat) + h,
+            tan: lat.tan(),
+            cos: lat.cos(),
+            w_ie: omega_ie_ned(lat),
+            g: gravity_ned(lat, h),
+        }
+    }
+
+    /// Refreshes when latitude moved by more than 1e-9 rad (6 mm) or height by more than 1 mm;
+    /// below that the quantities change by less than 1e-11 relative.
+    pub fn follow(&mut self, lat: f64, h: f64) {
+        if (lat - self.lat).abs() > 1e-9 || (h - self.h).abs() > 1e-3 {
+            *self = LocalEarth::new(lat, h);
+        }
+    }
+
+    /// Transport rate ω_en, NED [rad/s], for NED velocity `v` [m/s].
+    pub fn omega_en(&self, v: &nalgebra::Vector3<f64>) -> nalgebra::Vector3<f64> {
+        nalgebra::Vector3::new(v.y / self.rn, -v.x / self.rm, -v.y * self.tan / self.rn)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

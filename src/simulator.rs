@@ -38,41 +38,17 @@ struct Injected {
     value: f64,
 }
 
-/// Earth quantities at one position, frozen over an IMU interval (their change within one
-/// interval is below 1e-9 relative even at 300 m/s).
-struct EarthAt {
-    rm: f64,
-    rn: f64,
-    tan: f64,
-    cos: f64,
-    w_ie: Vector3<f64>,
-    g: Vector3<f64>,
-}
-
-impl EarthAt {
-    fn new(lat: f64, h: f64) -> EarthAt {
-        EarthAt {
-            rm: earth::radius_meridian(lat) + h,
-            rn: earth::radius_transverse(lat) + h,
-            tan: lat.tan(),
-            cos: lat.cos(),
-            w_ie: earth::omega_ie_ned(lat),
-            g: earth::gravity_ned(lat, h),
-        }
-    }
-
-    /// (f^b [m/s²], ω_ib^b [rad/s], d(lat, lon, h)/dt) for the kinematic state `k`.
-    fn signals(
-        &self,
-        k: &crate::trajectory::Kinematics,
-    ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
-        let v = &k.v;
-        let w_en = Vector3::new(v.y / self.rn, -v.x / self.rm, -v.y * self.tan / self.rn);
-        let f_n = k.a + (2.0 * self.w_ie + w_en).cross(v) - self.g;
-        let ct = k.c.transpose();
-        let rate = Vector3::new(v.x / self.rm, v.y / (self.rn * self.cos), -v.z);
-        (ct * f_n, ct * (self.w_ie + w_en) + k.w_nb, rate)
-    }
+/// (f^b [m/s²], ω_ib^b [rad/s], d(lat, lon, h)/dt) for the kinematic state `k` at position `e`.
+fn body_signals(
+    e: &earth::LocalEarth,
+    k: &crate::trajectory::Kinematics,
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let v = &k.v;
+    let w_en = e.omega_en(v);
+    let f_n = k.a + (2.0 * e.w_ie + w_en).cross(v) - e.g;
+    let ct = k.c.transpose();
+    let rate = Vector3::new(v.x / e.rm, v.y / (e.rn * e.cos), -v.z);
+    (ct * f_n, ct * (e.w_ie + w_en) + k.w_nb, rate)
 }
 
 /// Runs a scenario. `progress` is called with the fraction done (for a progress bar).
@@ -124,18 +100,12 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
     let noise = sc.noise;
     let sqdt = dt.sqrt();
     let report_every = (n / 200).max(1);
-    let mut e = EarthAt::new(lat, h);
-    let mut e_at = (lat, h);
+    let mut e = earth::LocalEarth::new(lat, h);
     for i in 0..n {
         let t0 = i as f64 * dt;
         let t1 = (i + 1) as f64 * dt;
         // increments and position: Gauss–Legendre on `sub` sub-intervals
-        // Earth quantities are refreshed when the position has moved by more than 1e-9 rad
-        // (6 mm) or 1 mm in height: below that their change is under 1e-11 relative.
-        if (lat - e_at.0).abs() > 1e-9 || (h - e_at.1).abs() > 1e-3 {
-            e = EarthAt::new(lat, h);
-            e_at = (lat, h);
-        }
+        e.follow(lat, h);
         let mut dth = Vector3::zeros();
         let mut dvel = Vector3::zeros();
         let mut dpos = Vector3::zeros();
@@ -144,7 +114,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
             let a = t0 + s as f64 * hsub;
             for (x, w) in GL_NODES.iter().zip(GL_WEIGHTS) {
                 let k = traj.at(a + 0.5 * hsub * (x + 1.0));
-                let (f, mut om, rate) = e.signals(&k);
+                let (f, mut om, rate) = body_signals(&e, &k);
                 let mut fm = f;
                 for inj in &injected {
                     let r = common::regressor_value(inj.regressor, &f, &om);

@@ -82,35 +82,7 @@ pub struct Navigator {
     prev_lat: f64,
     prev_h: f64,
     damp_int: f64,
-    earth: EarthCache,
-}
-
-/// Earth quantities at one latitude and height.
-#[derive(Debug, Clone, Copy)]
-struct EarthCache {
-    lat: f64,
-    h: f64,
-    rm: f64,
-    rn: f64,
-    tan: f64,
-    cos: f64,
-    w_ie: Vector3<f64>,
-    g: Vector3<f64>,
-}
-
-impl EarthCache {
-    fn new(lat: f64, h: f64) -> EarthCache {
-        EarthCache {
-            lat,
-            h,
-            rm: earth::radius_meridian(lat) + h,
-            rn: earth::radius_transverse(lat) + h,
-            tan: lat.tan(),
-            cos: lat.cos(),
-            w_ie: earth::omega_ie_ned(lat),
-            g: earth::gravity_ned(lat, h),
-        }
-    }
+    earth: earth::LocalEarth,
 }
 
 const DAMP_TAU: f64 = 100.0;
@@ -128,7 +100,7 @@ impl Navigator {
             prev_lat: state.lat,
             prev_h: state.h,
             damp_int: 0.0,
-            earth: EarthCache::new(state.lat, state.h),
+            earth: earth::LocalEarth::new(state.lat, state.h),
         }
     }
 
@@ -138,14 +110,10 @@ impl Navigator {
         let lat_mid = s.lat + 0.5 * (s.lat - self.prev_lat);
         let h_mid = s.h + 0.5 * (s.h - self.prev_h);
         let v_mid = s.v + 0.5 * (s.v - self.prev_v);
-        // Earth quantities, refreshed when latitude moved by > 1e-9 rad (6 mm) or height by
-        // > 1 mm: below that their change is under 1e-11 relative
-        if (lat_mid - self.earth.lat).abs() > 1e-9 || (h_mid - self.earth.h).abs() > 1e-3 {
-            self.earth = EarthCache::new(lat_mid, h_mid);
-        }
+        self.earth.follow(lat_mid, h_mid);
         let e = self.earth;
         let w_ie = e.w_ie;
-        let w_en = Vector3::new(v_mid.y / e.rn, -v_mid.x / e.rm, -v_mid.y * e.tan / e.rn);
+        let w_en = e.omega_en(&v_mid);
         let zeta = (w_ie + w_en) * dt;
         let g = e.g;
 
