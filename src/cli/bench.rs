@@ -78,13 +78,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         args.seconds
     );
     println!(
-        "  generated sparse kernels: {:.3} s = {:.0} h of data per second ({:.0}x real time)",
+        "  generated sparse kernels: {:.3} s = {:.2} h of data per second ({:.0}x real time)",
         t_gen,
         hours / t_gen,
         args.seconds / t_gen
     );
     println!(
-        "  dense nalgebra filter:    {:.3} s = {:.0} h of data per second",
+        "  dense nalgebra filter:    {:.3} s = {:.2} h of data per second",
         t_dense,
         hours / t_dense
     );
