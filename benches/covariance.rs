@@ -58,6 +58,13 @@ fn bench(c: &mut Criterion) {
     g.bench_function("dense_nalgebra_smatrix", |b| {
         b.iter(|| black_box(dense_propagate(black_box(&am), &pm, &q, dt)))
     });
+    g.bench_function("generated_fill_b_only", |b| {
+        b.iter(|| {
+            let mut bb = [[0.0; 31]; p31::ND];
+            p31::fill_b(black_box(&a), dt, &mut bb);
+            black_box(bb)
+        })
+    });
     let flat_a: Vec<f64> = a.iter().flatten().copied().collect();
     let flat_p: Vec<f64> = p.iter().flatten().copied().collect();
     let prop = SparsePropagator::new(31, &p31::A_PATTERN);

@@ -270,7 +270,8 @@ pub fn run_with(
         nav.step(&dth, &dvel, dt);
         nav.state.t = smp.t;
         on_sample(&nav.state);
-        let (f_c, w_c) = (dvel / dt, dth / dt);
+        let inv_dt = 1.0 / dt;
+        let (f_c, w_c) = (dvel * inv_dt, dth * inv_dt);
         acc.add(&f_c, &w_c);
         f_sum += f_c;
         in_step += 1;

@@ -120,9 +120,9 @@ impl Navigator {
         // velocity
         let dv_rot = 0.5 * dtheta.cross(dv);
         let dv_scul = (self.prev_dtheta.cross(dv) + self.prev_dv.cross(dtheta)) / 12.0;
-        let c_prev = s.dcm();
-        let zx = crate::attitude::skew(&zeta);
-        let dv_sf = (Matrix3::identity() - 0.5 * zx) * (c_prev * (dv + dv_rot + dv_scul));
+        // (I − ½[ζ×]) C_{k−1} (Δv + rotation + sculling), with the skew product as a cross product
+        let u = s.q * (dv + dv_rot + dv_scul);
+        let dv_sf = u - 0.5 * zeta.cross(&u);
         let dv_gcor = (g - (2.0 * w_ie + w_en).cross(&v_mid)) * dt;
         let mut v_new = s.v + dv_sf + dv_gcor;
 

@@ -987,21 +987,34 @@ fn propagate_cov_body(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N
     fill_b(a, dt, &mut b);
     let mut m = [[0.0; N]; ND];
     for r in 0..ND {
-        let mr = &mut m[r];
+        let mut acc = [0.0; N];
         for &k in B_COLS[r] {
             let bk = b[r][k];
             let pk = &p[k];
             for j in 0..N {
-                mr[j] += bk * pk[j];
+                acc[j] += bk * pk[j];
             }
         }
+        m[r] = acc;
     }
     for r in 0..ND {
         let i = DYN_ROWS[r];
         for s in 0..ND {
-            let mut v = 0.0;
-            for &k in B_COLS[s] {
-                v += m[r][k] * b[s][k];
+            let (mr, bs) = (&m[r], &b[s]);
+            let mut lanes = [0.0; 4];
+            for (mc, bc) in mr.chunks_exact(4).zip(bs.chunks_exact(4)) {
+                for l in 0..4 {
+                    lanes[l] += mc[l] * bc[l];
+                }
+            }
+            let mut v = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+            for (mk, bk) in mr
+                .chunks_exact(4)
+                .remainder()
+                .iter()
+                .zip(bs.chunks_exact(4).remainder())
+            {
+                v += mk * bk;
             }
             p[i][DYN_ROWS[s]] += v;
         }
