@@ -93,6 +93,10 @@ pub enum StateRef {
     Term(usize),
 }
 
+/// A generated step kernel: (A, dt, q, P, x) with A and P N×N row-major; P ← Φ P Φᵀ + diag(q)·dt
+/// and x ← Φ x.
+pub type PropagateFn = fn(&[f64], f64, &[f64], &mut [f64], &mut [f64]);
+
 /// The generated kernels of one preset, reachable by name at run time.
 #[derive(Debug, Clone, Copy)]
 pub struct PresetKernels {
@@ -118,6 +122,8 @@ pub struct PresetKernels {
     pub fill_h: fn(&str, &NavPoint, &mut [f64]) -> bool,
     /// P ← Φ P Φᵀ + diag(q)·dt (N×N row-major).
     pub propagate_cov: fn(&[f64], f64, &[f64], &mut [f64]),
+    /// P ← Φ P Φᵀ + diag(q)·dt and x ← Φ x (N×N row-major, N).
+    pub propagate: PropagateFn,
     /// Adds one sample's regressors (f [m/s²], w [rad/s]) to running sums.
     pub accumulate: crate::model::AccumulateFn,
 }

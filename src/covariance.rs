@@ -47,6 +47,18 @@ impl SparsePropagator {
 
     /// P ← Φ P Φᵀ + diag(q)·dt; `a`, `p` n×n row-major, `q` [SI²/s], `dt` [s].
     pub fn propagate(&self, a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
+        self.propagate_with_state(a, dt, q, p, None)
+    }
+
+    /// [`SparsePropagator::propagate`] and, when given, x ← Φ x with the same Φ.
+    pub fn propagate_with_state(
+        &self,
+        a: &[f64],
+        dt: f64,
+        q: &[f64],
+        p: &mut [f64],
+        x: Option<&mut [f64]>,
+    ) {
         let n = self.n;
         let nd = self.dyn_rows.len();
         let half_dt2 = 0.5 * dt * dt;
@@ -58,6 +70,14 @@ impl SparsePropagator {
                     second += a[i * n + k] * a[k * n + j];
                 }
                 b[r * n + j] = a[i * n + j] * dt + half_dt2 * second;
+            }
+        }
+        if let Some(x) = x {
+            let dx: Vec<f64> = (0..nd)
+                .map(|r| self.b_cols[r].iter().map(|&k| b[r * n + k] * x[k]).sum())
+                .collect();
+            for (r, &i) in self.dyn_rows.iter().enumerate() {
+                x[i] += dx[r];
             }
         }
         let mut m = vec![0.0; nd * n];
@@ -88,6 +108,12 @@ impl SparsePropagator {
             p[i * n + i] += q[i] * dt;
         }
     }
+}
+
+/// Dense Φ = I + A dt + A² dt²/2.
+pub fn dense_phi(a: &DMatrix<f64>, dt: f64) -> DMatrix<f64> {
+    let n = a.nrows();
+    DMatrix::<f64>::identity(n, n) + a * dt + (a * a) * (0.5 * dt * dt)
 }
 
 /// Dense reference: Φ = I + A dt + A² dt²/2, P ← Φ P Φᵀ + diag(q)·dt.

@@ -173,7 +173,7 @@ pub struct FilterRun {
 }
 
 enum Kernel {
-    Preset(fn(&[f64], f64, &[f64], &mut [f64])),
+    Preset(crate::catalog::PropagateFn),
     Runtime(SparsePropagator),
     Dense,
 }
@@ -213,7 +213,7 @@ pub fn run_with(
     }
     let kernel = match model.preset {
         _ if cfg.dense_reference => Kernel::Dense,
-        Some(k) => Kernel::Preset(k.propagate_cov),
+        Some(k) => Kernel::Preset(k.propagate),
         None => Kernel::Runtime(SparsePropagator::new(n, model.a_pattern())),
     };
     let pattern = model.a_pattern().to_vec();
@@ -247,7 +247,6 @@ pub fn run_with(
     let (i_lat, i_lon, i_h) = (idx("dlat"), idx("dlon"), idx("dh"));
     let mut h_row = vec![0.0; n];
     let mut np = NavPoint::new(start.lat, start.h, start.v, &start.dcm(), &Vector3::zeros());
-    let (mut ax, mut a2x) = (vec![0.0; n], vec![0.0; n]);
     let mut u = vec![0.0; n];
     for (k, smp) in imu.samples.iter().enumerate() {
         let dt = smp.t - prev_t;
@@ -288,15 +287,23 @@ pub fn run_with(
             a[i * n + j] = 0.0;
         }
         model.fill_a(&np, &acc.mean(), &mut a);
-        propagate_state(&pattern, &a, step_dt, &mut x, &mut ax, &mut a2x);
         match &kernel {
-            Kernel::Preset(f) => f(&a, step_dt, &cfg.q, &mut p),
-            Kernel::Runtime(sp) => sp.propagate(&a, step_dt, &cfg.q, &mut p),
+            Kernel::Preset(f) => f(&a, step_dt, &cfg.q, &mut p, &mut x),
+            Kernel::Runtime(sp) => {
+                sp.propagate_with_state(&a, step_dt, &cfg.q, &mut p, Some(&mut x))
+            }
             Kernel::Dense => {
+                // the whole step with dense matrices: Φ, Φ P Φᵀ + Q and Φ x
                 let am = nalgebra::DMatrix::from_row_slice(n, n, &a);
                 let pm = nalgebra::DMatrix::from_row_slice(n, n, &p);
-                let out = crate::covariance::propagate_dense(&am, step_dt, &cfg.q, &pm);
+                let phi = crate::covariance::dense_phi(&am, step_dt);
+                let mut out = &phi * pm * phi.transpose();
+                for i in 0..n {
+                    out[(i, i)] += cfg.q[i] * step_dt;
+                }
                 p.copy_from_slice(out.transpose().as_slice());
+                let xv = &phi * nalgebra::DVector::from_column_slice(&x);
+                x.copy_from_slice(xv.as_slice());
             }
         }
         acc.reset();
@@ -409,29 +416,6 @@ pub fn run_with(
         records,
         innovations,
         final_state: nav.state,
-    }
-}
-
-/// x ← Φ x with Φ = I + A dt + A² dt²/2, using A's pattern.
-fn propagate_state(
-    pattern: &[(usize, usize)],
-    a: &[f64],
-    dt: f64,
-    x: &mut [f64],
-    ax: &mut [f64],
-    a2x: &mut [f64],
-) {
-    let n = x.len();
-    ax.iter_mut().for_each(|v| *v = 0.0);
-    a2x.iter_mut().for_each(|v| *v = 0.0);
-    for &(i, j) in pattern {
-        ax[i] += a[i * n + j] * x[j];
-    }
-    for &(i, j) in pattern {
-        a2x[i] += a[i * n + j] * ax[j];
-    }
-    for i in 0..n {
-        x[i] += ax[i] * dt + 0.5 * dt * dt * a2x[i];
     }
 }
 

@@ -1307,23 +1307,56 @@ pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
-            unsafe { propagate_cov_avx2(a, dt, q, p) };
+            unsafe { propagate_avx2(a, dt, q, p, None) };
             return;
         }
     }
-    propagate_cov_body(a, dt, q, p)
+    propagate_body(a, dt, q, p, None)
+}
+
+/// `propagate_cov` plus the state: x ← Φ x with the same Φ.
+pub fn propagate_cov_and_state(
+    a: &[[f64; N]; N],
+    dt: f64,
+    q: &[f64; N],
+    p: &mut [[f64; N]; N],
+    x: &mut [f64; N],
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            unsafe { propagate_avx2(a, dt, q, p, Some(x)) };
+            return;
+        }
+    }
+    propagate_body(a, dt, q, p, Some(x))
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn propagate_cov_avx2(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
-    propagate_cov_body(a, dt, q, p)
+fn propagate_avx2(
+    a: &[[f64; N]; N],
+    dt: f64,
+    q: &[f64; N],
+    p: &mut [[f64; N]; N],
+    x: Option<&mut [f64; N]>,
+) {
+    propagate_body(a, dt, q, p, x)
 }
 
 #[inline(always)]
-fn propagate_cov_body(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
+fn propagate_body(
+    a: &[[f64; N]; N],
+    dt: f64,
+    q: &[f64; N],
+    p: &mut [[f64; N]; N],
+    x: Option<&mut [f64; N]>,
+) {
     let mut b = [[0.0; N]; ND];
     fill_b(a, dt, &mut b);
+    if let Some(x) = x {
+        propagate_state(&b, x);
+    }
     let mut m = [[0.0; N]; ND];
     for r in 0..ND {
         let mut acc = [0.0; N];
@@ -1439,6 +1472,15 @@ pub fn propagate_cov_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
     let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
     let q: &[f64; N] = q.try_into().expect("q of length N");
     propagate_cov(a, dt, q, p);
+}
+
+/// `propagate_cov_and_state` on slices.
+pub fn propagate_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64], x: &mut [f64]) {
+    let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
+    let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
+    let q: &[f64; N] = q.try_into().expect("q of length N");
+    let x: &mut [f64; N] = x.try_into().expect("x of length N");
+    propagate_cov_and_state(a, dt, q, p, x);
 }
 
 const _: () = assert!(ND <= NAV_COUNT);

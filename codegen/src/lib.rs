@@ -85,7 +85,7 @@ fn preset_table(spec: &Spec) -> String {
                  states: &{m}::STATES, state_refs: &{m}::STATE_REFS, a_pattern: &{m}::A_PATTERN, \
                  regressor_ids: &{m}::REGRESSOR_IDS, measurements: &{m}::MEASUREMENTS, \
                  fill_a: {m}::fill_a_dyn, fill_h: {m}::fill_h_dyn, propagate_cov: {m}::propagate_cov_dyn, \
-                 accumulate: {m}::accumulate_dyn }},\n",
+                 accumulate: {m}::accumulate_dyn, propagate: {m}::propagate_dyn }},\n",
                 doc = p.doc,
             ));
         }
