@@ -98,6 +98,12 @@ pub struct LocalEarth {
     pub tan: f64,
     /// cos(lat).
     pub cos: f64,
+    /// 1 / (R_M + h) [1/m].
+    pub inv_rm: f64,
+    /// 1 / (R_N + h) [1/m].
+    pub inv_rn: f64,
+    /// 1 / ((R_N + h) cos(lat)) [1/m].
+    pub inv_rn_cos: f64,
     /// Earth rate, NED [rad/s].
     pub w_ie: nalgebra::Vector3<f64>,
     /// Gravity, NED [m/s²].
@@ -107,13 +113,18 @@ pub struct LocalEarth {
 impl LocalEarth {
     /// The quantities at (lat, h).
     pub fn new(lat: f64, h: f64) -> LocalEarth {
+        let rm = radius_meridian(lat) + h;
+        let rn = radius_transverse(lat) + h;
         LocalEarth {
             lat,
             h,
-            rm: radius_meridian(lat) + h,
-            rn: radius_transverse(lat) + h,
+            rm,
+            rn,
             tan: lat.tan(),
             cos: lat.cos(),
+            inv_rm: 1.0 / rm,
+            inv_rn: 1.0 / rn,
+            inv_rn_cos: 1.0 / (rn * lat.cos()),
             w_ie: omega_ie_ned(lat),
             g: gravity_ned(lat, h),
         }
@@ -129,7 +140,11 @@ impl LocalEarth {
 
     /// Transport rate ω_en, NED [rad/s], for NED velocity `v` [m/s].
     pub fn omega_en(&self, v: &nalgebra::Vector3<f64>) -> nalgebra::Vector3<f64> {
-        nalgebra::Vector3::new(v.y / self.rn, -v.x / self.rm, -v.y * self.tan / self.rn)
+        nalgebra::Vector3::new(
+            v.y * self.inv_rn,
+            -v.x * self.inv_rm,
+            -v.y * self.tan * self.inv_rn,
+        )
     }
 }
 

@@ -142,8 +142,8 @@ impl Navigator {
 
         // position (trapezoid, radii at mid-interval)
         let v_avg = 0.5 * (s.v + v_new);
-        let lat_new = s.lat + v_avg.x / e.rm * dt;
-        let lon_new = s.lon + v_avg.y / (e.rn * e.cos) * dt;
+        let lat_new = s.lat + v_avg.x * e.inv_rm * dt;
+        let lon_new = s.lon + v_avg.y * e.inv_rn_cos * dt;
 
         // attitude
         let phi = dtheta + self.prev_dtheta.cross(dtheta) / 12.0;
