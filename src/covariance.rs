@@ -118,10 +118,24 @@ pub fn dense_phi(a: &DMatrix<f64>, dt: f64) -> DMatrix<f64> {
 
 /// Dense reference: Φ = I + A dt + A² dt²/2, P ← Φ P Φᵀ + diag(q)·dt.
 pub fn propagate_dense(a: &DMatrix<f64>, dt: f64, q: &[f64], p: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = a.nrows();
-    let phi = DMatrix::<f64>::identity(n, n) + a * dt + (a * a) * (0.5 * dt * dt);
+    propagate_dense_with_state(a, dt, q, p, None)
+}
+
+/// [`propagate_dense`] and, when given, x ← Φ x with the same dense Φ.
+pub fn propagate_dense_with_state(
+    a: &DMatrix<f64>,
+    dt: f64,
+    q: &[f64],
+    p: &DMatrix<f64>,
+    x: Option<&mut [f64]>,
+) -> DMatrix<f64> {
+    let phi = dense_phi(a, dt);
+    if let Some(x) = x {
+        let xv = &phi * nalgebra::DVector::from_column_slice(x);
+        x.copy_from_slice(xv.as_slice());
+    }
     let mut out = &phi * p * phi.transpose();
-    for i in 0..n {
+    for i in 0..a.nrows() {
         out[(i, i)] += q[i] * dt;
     }
     out

@@ -70,13 +70,6 @@ pub fn omega_ie_ned(lat: f64) -> nalgebra::Vector3<f64> {
     nalgebra::Vector3::new(OMEGA * lat.cos(), 0.0, -OMEGA * lat.sin())
 }
 
-/// Transport rate ω_en in NED [rad/s] for latitude [rad], height [m], NED velocity [m/s].
-pub fn omega_en_ned(lat: f64, h: f64, v: &nalgebra::Vector3<f64>) -> nalgebra::Vector3<f64> {
-    let rm = radius_meridian(lat) + h;
-    let rn = radius_transverse(lat) + h;
-    nalgebra::Vector3::new(v.y / rn, -v.x / rm, -v.y * lat.tan() / rn)
-}
-
 /// Normal gravity vector in NED [m/s²] (down positive).
 pub fn gravity_ned(lat: f64, h: f64) -> nalgebra::Vector3<f64> {
     nalgebra::Vector3::new(0.0, 0.0, gravity(lat, h))

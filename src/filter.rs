@@ -219,6 +219,7 @@ pub fn run_with(
     let pattern = model.a_pattern().to_vec();
     let mut a = vec![0.0; n * n];
     let mut acc = model.accumulator();
+    let mut r_mean = vec![0.0; model.regressor_ids.len()];
     let mut f_sum = Vector3::zeros();
     let mut in_step = 0usize;
     let mut step_t0 = start.t;
@@ -286,7 +287,8 @@ pub fn run_with(
         for &(i, j) in &pattern {
             a[i * n + j] = 0.0;
         }
-        model.fill_a(&np, &acc.mean(), &mut a);
+        acc.mean_into(&mut r_mean);
+        model.fill_a(&np, &r_mean, &mut a);
         match &kernel {
             Kernel::Preset(f) => f(&a, step_dt, &cfg.q, &mut p, &mut x),
             Kernel::Runtime(sp) => {
@@ -296,14 +298,14 @@ pub fn run_with(
                 // the whole step with dense matrices: Φ, Φ P Φᵀ + Q and Φ x
                 let am = nalgebra::DMatrix::from_row_slice(n, n, &a);
                 let pm = nalgebra::DMatrix::from_row_slice(n, n, &p);
-                let phi = crate::covariance::dense_phi(&am, step_dt);
-                let mut out = &phi * pm * phi.transpose();
-                for i in 0..n {
-                    out[(i, i)] += cfg.q[i] * step_dt;
-                }
+                let out = crate::covariance::propagate_dense_with_state(
+                    &am,
+                    step_dt,
+                    &cfg.q,
+                    &pm,
+                    Some(&mut x),
+                );
                 p.copy_from_slice(out.transpose().as_slice());
-                let xv = &phi * nalgebra::DVector::from_column_slice(&x);
-                x.copy_from_slice(xv.as_slice());
             }
         }
         acc.reset();

@@ -344,12 +344,21 @@ impl RegressorAccumulator {
 
     /// Means (mean of squares, never square of means); zeros when empty.
     pub fn mean(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.sum.len()];
+        self.mean_into(&mut out);
+        out
+    }
+
+    /// [`RegressorAccumulator::mean`] into a caller's buffer (no allocation per filter step).
+    pub fn mean_into(&self, out: &mut [f64]) {
         let k = if self.count > 0 {
             1.0 / self.count as f64
         } else {
             0.0
         };
-        self.sum.iter().map(|s| s * k).collect()
+        for (o, s) in out.iter_mut().zip(&self.sum) {
+            *o = s * k;
+        }
     }
 
     /// Starts a new step.
