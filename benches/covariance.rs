@@ -4,10 +4,10 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use nalgebra::{SMatrix, Vector3};
-use sinsmodel::attitude::dcm_from_euler;
-use sinsmodel::covariance::SparsePropagator;
-use sinsmodel::generated::p31;
-use sinsmodel::nav_point::NavPoint;
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::model::covariance::SparsePropagator;
+use sinsmodel::model::generated::p31;
+use sinsmodel::nav::nav_point::NavPoint;
 
 type M31 = SMatrix<f64, 31, 31>;
 

@@ -2,9 +2,9 @@
 //! bytes per second (criterion reports them as throughput). Run: `cargo bench --bench navigation`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use sinsmodel::scenario::Scenario;
-use sinsmodel::simulator::simulate;
-use sinsmodel::strapdown::{Navigator, Vertical};
+use sinsmodel::sim::scenario::Scenario;
+use sinsmodel::sim::simulator::simulate;
+use sinsmodel::nav::strapdown::{Navigator, Vertical};
 
 fn scenario(rate: f64, secs: f64, vib: bool) -> Scenario {
     let v = if vib {
@@ -58,13 +58,13 @@ fn bench(c: &mut Criterion) {
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("imu.txt");
-    sinsmodel::imu::write_text(&path, &sim.imu, "bench").unwrap();
+    sinsmodel::io::imu::write_text(&path, &sim.imu, "bench").unwrap();
     let bytes = std::fs::metadata(&path).unwrap().len();
     let mut g = c.benchmark_group("imu_text");
     g.throughput(Throughput::Bytes(bytes));
     g.sample_size(10);
     g.bench_function("read", |b| {
-        b.iter(|| black_box(sinsmodel::imu::read_text(&path).unwrap().samples.len()))
+        b.iter(|| black_box(sinsmodel::io::imu::read_text(&path).unwrap().samples.len()))
     });
     g.finish();
 }

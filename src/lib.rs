@@ -1,30 +1,21 @@
 //! sinsmodel: an error-model compiler and model-discovery tool for strapdown inertial
 //! navigation systems. Frames: NED navigation, FRD body; SI units and radians inside.
+//!
+//! The data path: `model-spec/*.toml` → `codegen/` (build.rs) → [`model::generated`] →
+//! [`model::Model`] → [`estimate::filter`] → [`report`]. Modules are grouped by domain:
+//!
+//! - [`model`]: the compiled error models (catalogue, generated kernels, run-time composition,
+//!   covariance propagation, Jacobians at a point).
+//! - [`nav`]: Earth model, attitude, the linearisation point, the strapdown navigator.
+//! - [`sim`]: scenarios, trajectories, the IMU simulator with error injection, seeded RNG.
+//! - [`estimate`]: the error-state Kalman filter, alignment, Allan deviation, mounting.
+//! - [`io`]: IMU, aiding and truth files, readers of other formats, units at the edges,
+//!   atomic output files.
+//! - [`report`]: the paper's reproduction and its analysis, plots and progress bars.
 
-pub mod aiding;
-pub mod align;
-pub mod allan;
-pub mod atomic_file;
-pub mod attitude;
-pub mod catalog;
-pub mod covariance;
-pub mod earth;
-pub mod filter;
-pub mod fixed;
-pub mod generated;
-pub mod imu;
-pub mod jacobian;
+pub mod estimate;
+pub mod io;
 pub mod model;
-pub mod mounting;
-pub mod nav_point;
-pub mod plot;
-pub mod progress;
-pub mod readers;
-pub mod reproduce;
-pub mod rng;
-pub mod scenario;
-pub mod simulator;
-pub mod strapdown;
-pub mod trajectory;
-pub mod truth;
-pub mod units;
+pub mod nav;
+pub mod report;
+pub mod sim;

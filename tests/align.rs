@@ -1,9 +1,9 @@
 //! Static alignment on simulated data of known attitude and on the real RLG log.
 
-use sinsmodel::align::align;
-use sinsmodel::readers::psins;
-use sinsmodel::scenario::Scenario;
-use sinsmodel::simulator::simulate;
+use sinsmodel::estimate::align::align;
+use sinsmodel::io::readers::psins;
+use sinsmodel::sim::scenario::Scenario;
+use sinsmodel::sim::simulator::simulate;
 use std::path::PathBuf;
 
 const D: f64 = std::f64::consts::PI / 180.0;

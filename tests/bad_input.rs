@@ -161,15 +161,15 @@ fn simulate_then_navigate_round_trip_through_text() {
     for f in ["imu.txt", "truth.txt", "gnss.txt", "scenario.toml"] {
         assert!(out.join(f).exists(), "{f}");
     }
-    let imu = sinsmodel::imu::read_text(&out.join("imu.txt")).unwrap();
+    let imu = sinsmodel::io::imu::read_text(&out.join("imu.txt")).unwrap();
     assert_eq!(imu.samples.len(), 6000);
-    let fixes = sinsmodel::aiding::read(&out.join("gnss.txt")).unwrap();
+    let fixes = sinsmodel::io::aiding::read(&out.join("gnss.txt")).unwrap();
     assert_eq!(fixes.len(), 60);
     let nav = dir.path().join("nav.txt");
     let (ok, err) = navigate(&out.join("imu.txt"), &nav);
     assert!(ok, "{err}");
-    let rows = sinsmodel::truth::read(&nav).unwrap();
-    let truth = sinsmodel::truth::read(&out.join("truth.txt")).unwrap();
+    let rows = sinsmodel::io::truth::read(&nav).unwrap();
+    let truth = sinsmodel::io::truth::read(&out.join("truth.txt")).unwrap();
     let (a, b) = (rows.last().unwrap(), truth.last().unwrap());
     assert!((a.t - b.t).abs() < 1e-9);
     assert!(

@@ -1,11 +1,11 @@
 //! The error-state filter: P24 = P28 horizontally for a level IMU (DESIGN §3), the paper's
 //! experiments in their quick form with the done-when ratios, closed-loop feedback.
 
-use sinsmodel::filter::{self, FilterConfig, Mode};
+use sinsmodel::estimate::filter::{self, FilterConfig, Mode};
 use sinsmodel::model::Model;
-use sinsmodel::reproduce::{self, Priors};
-use sinsmodel::scenario::Scenario;
-use sinsmodel::simulator::simulate;
+use sinsmodel::report::reproduce::{self, Priors};
+use sinsmodel::sim::scenario::Scenario;
+use sinsmodel::sim::simulator::simulate;
 
 #[test]
 fn p24_and_p28_give_the_same_horizontal_solution_for_a_level_imu() {
@@ -13,20 +13,10 @@ fn p24_and_p28_give_the_same_horizontal_solution_for_a_level_imu() {
     let sim = simulate(&Scenario::parse(&case.scenario, "static").unwrap(), |_| {});
     let priors = Priors::default();
     let aid = reproduce::aiding_from_truth(&sim, &priors, true, 3).unwrap();
-    let run = |m: &str| {
-        let model = Model::parse(m).unwrap();
-        let cfg = reproduce::config(&model, &priors).unwrap();
-        filter::run(
-            &model,
-            &cfg,
-            &sim.imu,
-            sim.start,
-            &aid,
-            Some(&sim.truth),
-            |_| {},
-        )
-    };
-    let (a, b) = (run("P24"), run("P28"));
+    let (_, runs) =
+        reproduce::run_models(&sim, &aid, &["P24", "P28"], &priors, case.window, |_, _| {})
+            .unwrap();
+    let (a, b) = (&runs[0], &runs[1]);
     let mut worst: f64 = 0.0;
     for (ra, rb) in a.records.iter().zip(&b.records) {
         for i in 0..7 {

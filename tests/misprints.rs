@@ -3,10 +3,10 @@
 //! where the two differ.
 
 use nalgebra::Vector3;
-use sinsmodel::attitude::dcm_from_euler;
-use sinsmodel::earth::OMEGA;
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::nav::earth::OMEGA;
 use sinsmodel::model::Model;
-use sinsmodel::nav_point::NavPoint;
+use sinsmodel::nav::nav_point::NavPoint;
 
 struct Filled {
     m: Model,

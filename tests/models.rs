@@ -2,11 +2,11 @@
 //! against a dense reference, and the regressor accumulator.
 
 use nalgebra::{DMatrix, Vector3};
-use sinsmodel::attitude::dcm_from_euler;
-use sinsmodel::covariance::{propagate_dense, SparsePropagator};
-use sinsmodel::generated::PRESETS;
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::model::covariance::{propagate_dense, SparsePropagator};
+use sinsmodel::model::generated::PRESETS;
 use sinsmodel::model::Model;
-use sinsmodel::nav_point::NavPoint;
+use sinsmodel::nav::nav_point::NavPoint;
 
 /// Small deterministic generator (xorshift) so the tests need no extra crate.
 struct Rng(u64);
@@ -211,12 +211,12 @@ fn accumulator_uses_mean_of_squares() {
     let k = m
         .regressor_ids
         .iter()
-        .position(|&r| sinsmodel::generated::common::REGRESSORS[r] == "f.x.powi(2)")
+        .position(|&r| sinsmodel::model::generated::common::REGRESSORS[r] == "f.x.powi(2)")
         .unwrap();
     let kx = m
         .regressor_ids
         .iter()
-        .position(|&r| sinsmodel::generated::common::REGRESSORS[r] == "f.x")
+        .position(|&r| sinsmodel::model::generated::common::REGRESSORS[r] == "f.x")
         .unwrap();
     let mut acc = m.accumulator();
     let amp = 6.0 * 9.80665;

@@ -1,6 +1,6 @@
 //! Plots render with the embedded font (no system font libraries) and appear atomically.
 
-use sinsmodel::plot::{line_plot, Scale, Series};
+use sinsmodel::report::plot::{line_plot, Scale, Series};
 
 #[test]
 fn line_plot_writes_a_png() {

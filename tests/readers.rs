@@ -1,6 +1,6 @@
 //! Readers against the real measured data in ../shared/data (see its README).
 
-use sinsmodel::readers::{gnss_imu, psins, rtklib};
+use sinsmodel::io::readers::{gnss_imu, psins, rtklib};
 use std::path::PathBuf;
 
 fn data(rel: &str) -> PathBuf {

@@ -3,12 +3,12 @@
 //! deviation on the static start.
 
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::allan::{fit, oadev};
-use sinsmodel::attitude::dcm_from_euler;
-use sinsmodel::filter::{self, AidingEpoch, FilterConfig, Mode};
+use sinsmodel::estimate::allan::{fit, oadev};
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
 use sinsmodel::model::Model;
-use sinsmodel::readers::{gnss_imu, rtklib};
-use sinsmodel::strapdown::{NavState, Vertical};
+use sinsmodel::io::readers::{gnss_imu, rtklib};
+use sinsmodel::nav::strapdown::{NavState, Vertical};
 use std::path::PathBuf;
 
 #[test]
@@ -16,7 +16,7 @@ fn mems_drive_mounting_and_noise_identification() {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
     let log = gnss_imu::read(&d.join("imu_1934.csv")).unwrap();
     let pos = rtklib::read(&d.join("gnss_1934_sf.pos")).unwrap();
-    let m = sinsmodel::mounting::from_drive_off(&log.imu, &pos, 30.0).unwrap();
+    let m = sinsmodel::estimate::mounting::from_drive_off(&log.imu, &pos, 30.0).unwrap();
     // sensor z points up (gravity reaction along +z) and the car drives off along sensor -x
     assert!(m.f_static.z > 9.5, "{:?}", m.f_static);
     assert!(m.forward_sensor.x < -0.9, "{:?}", m.forward_sensor);

@@ -306,8 +306,8 @@ pub fn common_module(spec: &Spec) -> String {
     let arw = f64_lit(spec.sensor_noise.gyro_arw);
     let vrw = f64_lit(spec.sensor_noise.accel_vrw);
     let tokens = quote! {
-        use crate::catalog::{MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo};
-        use crate::nav_point::NavPoint;
+        use crate::model::catalog::{MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo};
+        use crate::nav::nav_point::NavPoint;
         use nalgebra::Vector3;
 
         /// Number of navigation states with the vertical channel.
@@ -544,8 +544,8 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
 
     let tokens = quote! {
         use super::common::NAV_COUNT;
-        use crate::catalog::StateRef;
-        use crate::nav_point::NavPoint;
+        use crate::model::catalog::StateRef;
+        use crate::nav::nav_point::NavPoint;
         use nalgebra::Vector3;
 
         /// Model name.

@@ -70,7 +70,7 @@ pub fn generate(spec: &Spec) -> Vec<GeneratedFile> {
 fn preset_table(spec: &Spec) -> String {
     let mut s = String::from(
         "\n/// Every generated preset model, by name (with and without `+vertical`).\n\
-         pub const PRESETS: &[crate::catalog::PresetKernels] = &[\n",
+         pub const PRESETS: &[crate::model::catalog::PresetKernels] = &[\n",
     );
     for p in &spec.presets {
         for vertical in [false, true] {
@@ -81,7 +81,7 @@ fn preset_table(spec: &Spec) -> String {
             };
             let m = module_name(&name);
             s.push_str(&format!(
-                "    crate::catalog::PresetKernels {{ name: {m}::NAME, doc: {doc:?}, vertical: {m}::VERTICAL, \
+                "    crate::model::catalog::PresetKernels {{ name: {m}::NAME, doc: {doc:?}, vertical: {m}::VERTICAL, \
                  states: &{m}::STATES, state_refs: &{m}::STATE_REFS, a_pattern: &{m}::A_PATTERN, \
                  regressor_ids: &{m}::REGRESSOR_IDS, measurements: &{m}::MEASUREMENTS, \
                  fill_a: {m}::fill_a_dyn, fill_h: {m}::fill_h_dyn, propagate_cov: {m}::propagate_cov_dyn, \

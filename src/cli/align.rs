@@ -2,7 +2,8 @@
 
 use anyhow::Result;
 use clap::Args;
-use sinsmodel::{align, atomic_file, readers};
+use sinsmodel::estimate::align;
+use sinsmodel::io::{atomic_file, readers};
 use std::path::PathBuf;
 
 /// Arguments of `align`.

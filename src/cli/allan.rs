@@ -5,9 +5,9 @@
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use sinsmodel::allan::{fit, oadev, AllanCurve, NoiseFit};
-use sinsmodel::plot::{line_plot, Scale, Series};
-use sinsmodel::{atomic_file, readers};
+use sinsmodel::estimate::allan::{fit, oadev, AllanCurve, NoiseFit};
+use sinsmodel::report::plot::{line_plot, Scale, Series};
+use sinsmodel::io::{atomic_file, readers};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -108,7 +108,7 @@ pub fn run(args: &AllanArgs) -> Result<()> {
                 f.random_walk * r2dh * 60.0
             );
         } else {
-            let ug = 1e6 / sinsmodel::units::STANDARD_GRAVITY;
+            let ug = 1e6 / sinsmodel::io::units::STANDARD_GRAVITY;
             println!(
                 "{:<8} VRW {:.2} ug/sqrt(Hz)  bias instability {:.2} ug  RRW {:.3} ug/sqrt(s)",
                 NAMES[k],
@@ -153,7 +153,7 @@ pub fn run(args: &AllanArgs) -> Result<()> {
             "Allan deviation, accelerometers",
             "tau [s]",
             "ADEV [ug]",
-            &series(3..6, 1e6 / sinsmodel::units::STANDARD_GRAVITY),
+            &series(3..6, 1e6 / sinsmodel::io::units::STANDARD_GRAVITY),
             Scale::LogLog,
         )?;
     }

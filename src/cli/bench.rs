@@ -3,11 +3,11 @@
 
 use anyhow::Result;
 use clap::Args;
-use sinsmodel::filter::{self, AidingEpoch, FilterConfig};
+use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig};
 use sinsmodel::model::Model;
-use sinsmodel::reproduce::{self, Priors};
-use sinsmodel::scenario::Scenario;
-use sinsmodel::simulator::{simulate, SimOutput};
+use sinsmodel::report::reproduce::{self, Priors};
+use sinsmodel::sim::scenario::Scenario;
+use sinsmodel::sim::simulator::{simulate, SimOutput};
 use std::io::Write as _;
 use std::time::Instant;
 
@@ -110,7 +110,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             None,
             |_| {},
             &mut |s| {
-                let row = sinsmodel::truth::TruthRow {
+                let row = sinsmodel::io::truth::TruthRow {
                     t: s.t,
                     lat: s.lat,
                     lon: s.lon,
@@ -118,7 +118,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     v: s.v,
                     euler: s.euler(),
                 };
-                if let Err(e2) = sinsmodel::truth::write_row(&mut w, &row) {
+                if let Err(e2) = sinsmodel::io::truth::write_row(&mut w, &row) {
                     err = Some(e2);
                 }
             },

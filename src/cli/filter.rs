@@ -3,12 +3,13 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::atomic_file::AtomicFile;
-use sinsmodel::attitude::dcm_from_euler;
-use sinsmodel::filter::{self, AidingEpoch, FilterConfig, Mode};
+use sinsmodel::io::atomic_file::AtomicFile;
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
 use sinsmodel::model::Model;
-use sinsmodel::strapdown::{NavState, Vertical};
-use sinsmodel::{aiding, progress, readers, truth};
+use sinsmodel::nav::strapdown::{NavState, Vertical};
+use sinsmodel::io::{aiding, readers, truth};
+use sinsmodel::report::progress;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -92,7 +93,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
             );
         }
         for i in matches {
-            let si = sinsmodel::units::parse_quantity_as(value, model.unit(i))
+            let si = sinsmodel::io::units::parse_quantity_as(value, model.unit(i))
                 .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
             cfg.prior_sigma[i] = si;
         }
@@ -109,7 +110,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     let fixes = match (&args.aid, &args.static_aid) {
         (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {
-            sinsmodel::readers::rtklib::read(p)?
+            sinsmodel::io::readers::rtklib::read(p)?
                 .iter()
                 .map(|e| aiding::PositionFix {
                     t: e.t,

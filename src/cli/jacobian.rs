@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use sinsmodel::jacobian::{jacobian, PointSpec};
+use sinsmodel::model::jacobian::{jacobian, PointSpec};
 use sinsmodel::model::Model;
 use std::path::PathBuf;
 

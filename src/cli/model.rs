@@ -2,8 +2,8 @@
 
 use anyhow::Result;
 use clap::Subcommand;
-use sinsmodel::catalog::StateRef;
-use sinsmodel::generated::{common, PRESETS};
+use sinsmodel::model::catalog::StateRef;
+use sinsmodel::model::generated::{common, PRESETS};
 use sinsmodel::model::Model;
 
 /// Actions of `model`.
@@ -153,9 +153,9 @@ pub fn show_text(m: &Model) -> String {
 }
 
 /// A point where no structural non-zero of H vanishes by accident.
-fn generic_point() -> sinsmodel::nav_point::NavPoint {
-    let c = sinsmodel::attitude::dcm_from_euler(0.1, 0.2, 0.3);
-    sinsmodel::nav_point::NavPoint::new(
+fn generic_point() -> sinsmodel::nav::nav_point::NavPoint {
+    let c = sinsmodel::nav::attitude::dcm_from_euler(0.1, 0.2, 0.3);
+    sinsmodel::nav::nav_point::NavPoint::new(
         0.5,
         100.0,
         nalgebra::Vector3::new(1.0, 2.0, 0.5),

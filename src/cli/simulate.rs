@@ -2,9 +2,10 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use sinsmodel::scenario::Scenario;
-use sinsmodel::simulator::simulate;
-use sinsmodel::{aiding, atomic_file, imu, progress, truth};
+use sinsmodel::sim::scenario::Scenario;
+use sinsmodel::sim::simulator::simulate;
+use sinsmodel::io::{aiding, atomic_file, imu, truth};
+use sinsmodel::report::progress;
 use std::path::PathBuf;
 
 /// Arguments of `simulate`.

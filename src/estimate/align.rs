@@ -3,12 +3,12 @@
 //! the angle between them, and fine alignment by the error-state Kalman filter (P13, closed loop)
 //! with zero-velocity and known-position updates. NED/FRD, SI inside.
 
-use crate::attitude::dcm_from_euler;
+use crate::nav::attitude::dcm_from_euler;
 
-use crate::filter::{self, AidingEpoch, FilterConfig, Mode};
-use crate::imu::{ImuData, ImuSample};
+use crate::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
+use crate::io::imu::{ImuData, ImuSample};
 use crate::model::Model;
-use crate::strapdown::{NavState, Vertical};
+use crate::nav::strapdown::{NavState, Vertical};
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 
 /// Coarse alignment of one stretch of static data.

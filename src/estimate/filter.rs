@@ -14,16 +14,16 @@
 //!   update attitude, velocity and position are corrected and every instrument term's estimate is
 //!   moved into a correction applied to all later increments (per sample, with its regressor).
 
-use crate::attitude::{attitude_error, dcm_from_euler};
-use crate::catalog::{Sensor, StateRef};
-use crate::covariance::SparsePropagator;
-use crate::earth;
-use crate::generated::common;
-use crate::imu::ImuData;
+use crate::nav::attitude::{attitude_error, dcm_from_euler};
+use crate::model::catalog::{Sensor, StateRef};
+use crate::model::covariance::SparsePropagator;
+use crate::nav::earth;
+use crate::model::generated::common;
+use crate::io::imu::ImuData;
 use crate::model::Model;
-use crate::nav_point::NavPoint;
-use crate::strapdown::{NavState, Navigator, Vertical};
-use crate::truth::TruthRow;
+use crate::nav::nav_point::NavPoint;
+use crate::nav::strapdown::{NavState, Navigator, Vertical};
+use crate::io::truth::TruthRow;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Feedback mode.
@@ -173,7 +173,7 @@ pub struct FilterRun {
 }
 
 enum Kernel {
-    Preset(crate::catalog::PropagateFn),
+    Preset(crate::model::catalog::PropagateFn),
     Runtime(SparsePropagator),
     Dense,
 }
@@ -298,7 +298,7 @@ pub fn run_with(
                 // the whole step with dense matrices: Φ, Φ P Φᵀ + Q and Φ x
                 let am = nalgebra::DMatrix::from_row_slice(n, n, &a);
                 let pm = nalgebra::DMatrix::from_row_slice(n, n, &p);
-                let out = crate::covariance::propagate_dense_with_state(
+                let out = crate::model::covariance::propagate_dense_with_state(
                     &am,
                     step_dt,
                     &cfg.q,

@@ -3,16 +3,16 @@
 //! any spec term by name (applied to the instantaneous signals, then integrated), white noise,
 //! bias random walk and quantisation. Seeded and bit-reproducible.
 
-use crate::aiding::PositionFix;
-use crate::catalog::Sensor;
-use crate::earth;
-use crate::generated::common;
-use crate::imu::{ImuData, ImuSample};
-use crate::rng::Rng;
-use crate::scenario::Scenario;
-use crate::strapdown::NavState;
-use crate::trajectory::Trajectory;
-use crate::truth::TruthRow;
+use crate::io::aiding::PositionFix;
+use crate::model::catalog::Sensor;
+use crate::nav::earth;
+use crate::model::generated::common;
+use crate::io::imu::{ImuData, ImuSample};
+use crate::sim::rng::Rng;
+use crate::sim::scenario::Scenario;
+use crate::nav::strapdown::NavState;
+use crate::sim::trajectory::Trajectory;
+use crate::io::truth::TruthRow;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Everything a simulation produces.
@@ -41,7 +41,7 @@ struct Injected {
 /// (f^b [m/s²], ω_ib^b [rad/s], d(lat, lon, h)/dt) for the kinematic state `k` at position `e`.
 fn body_signals(
     e: &earth::LocalEarth,
-    k: &crate::trajectory::Kinematics,
+    k: &crate::sim::trajectory::Kinematics,
 ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
     let v = &k.v;
     let w_en = e.omega_en(v);

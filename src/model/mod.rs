@@ -2,9 +2,14 @@
 //! state layout, and A(t)/H filling, either through a preset's generated kernels or composed at
 //! run time from the generated navigation block and per-term columns.
 
-use crate::catalog::{MeasurementInfo, PresetKernels, StateRef};
-use crate::generated::{common, PRESETS};
-use crate::nav_point::NavPoint;
+pub mod catalog;
+pub mod covariance;
+pub mod generated;
+pub mod jacobian;
+
+use crate::model::catalog::{MeasurementInfo, PresetKernels, StateRef};
+use crate::model::generated::{common, PRESETS};
+use crate::nav::nav_point::NavPoint;
 use nalgebra::Vector3;
 use std::fmt;
 

@@ -13,8 +13,8 @@
 //! `free` (pure inertial, unstable with time constant √(R/2g) ≈ 9.5 min), or `damped` (a
 //! second-order loop pulling height to the initial height with 100 s time constant).
 
-use crate::attitude::euler_from_dcm;
-use crate::earth;
+use crate::nav::attitude::euler_from_dcm;
+use crate::nav::earth;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 /// How the navigator treats height.

@@ -1,8 +1,8 @@
 //! Truth files (DESIGN §9): `t [s]  lat lon [deg]  h [m]  v_n v_e v_d [m/s]  roll pitch yaw [deg]`.
 
-use crate::atomic_file::AtomicFile;
-use crate::fixed::write_fixed;
-use crate::imu::read_table;
+use crate::io::atomic_file::AtomicFile;
+use crate::io::fixed::write_fixed;
+use crate::io::imu::read_table;
 use anyhow::Result;
 use nalgebra::Vector3;
 use std::io::Write;

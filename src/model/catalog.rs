@@ -1,7 +1,7 @@
 //! Types describing what the model spec declares (states, terms, measurements, presets); the
-//! values themselves are generated from `model-spec/` into [`crate::generated`].
+//! values themselves are generated from `model-spec/` into [`crate::model::generated`].
 
-use crate::nav_point::NavPoint;
+use crate::nav::nav_point::NavPoint;
 
 /// Which instrument a term corrupts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,7 +1,7 @@
 //! The navigation quantities A(t) and H are evaluated at (DESIGN §4): position, velocity,
 //! attitude and specific force, with the WGS-84 radii frozen at the point.
 
-use crate::earth;
+use crate::nav::earth;
 use nalgebra::{Matrix3, Vector3};
 
 /// A linearisation point: every symbol the spec's A and H expressions may use.

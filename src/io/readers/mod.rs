@@ -5,7 +5,7 @@ pub mod gnss_imu;
 pub mod psins;
 pub mod rtklib;
 
-use crate::imu::ImuData;
+use crate::io::imu::ImuData;
 use anyhow::Result;
 use std::path::Path;
 
@@ -15,6 +15,6 @@ pub fn read_any_imu(path: &Path) -> Result<ImuData> {
     match path.extension().and_then(|e| e.to_str()) {
         Some("imu") => Ok(psins::read(path)?.imu),
         Some("csv") => Ok(gnss_imu::read(path)?.imu),
-        _ => crate::imu::read_text(path),
+        _ => crate::io::imu::read_text(path),
     }
 }

@@ -7,7 +7,7 @@
 //! PSINS (ENU, yaw positive west of north) to NED/FRD: roll and pitch kept, yaw = −yaw_PSINS;
 //! velocity ENU → NED.
 
-use crate::imu::{parse_numbers, ImuData, ImuSample};
+use crate::io::imu::{parse_numbers, ImuData, ImuSample};
 use anyhow::{bail, Context, Result};
 use nalgebra::Vector3;
 use std::path::Path;

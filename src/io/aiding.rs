@@ -1,8 +1,8 @@
 //! Position aiding files (DESIGN §9, KF-GINS GNSS layout):
 //! `t [s]  lat lon [deg]  h [m]  sigma_n sigma_e sigma_d [m]`.
 
-use crate::atomic_file::AtomicFile;
-use crate::imu::read_table;
+use crate::io::atomic_file::AtomicFile;
+use crate::io::imu::read_table;
 use anyhow::{bail, Result};
 use std::io::Write;
 use std::path::Path;

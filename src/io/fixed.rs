@@ -54,7 +54,7 @@ mod tests {
 
     #[test]
     fn matches_std_formatting() {
-        let mut rng = crate::rng::Rng::new(3);
+        let mut rng = crate::sim::rng::Rng::new(3);
         for _ in 0..20000 {
             let v = (rng.uniform() - 0.5) * 10f64.powf(rng.uniform() * 8.0 - 3.0);
             for d in [0, 3, 4, 9] {

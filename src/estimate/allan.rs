@@ -132,7 +132,7 @@ pub fn fit(c: &AllanCurve) -> NoiseFit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Rng;
+    use crate::sim::rng::Rng;
 
     #[test]
     fn white_noise_and_random_walk_of_known_level_are_recovered() {

@@ -8,8 +8,8 @@
 //! data elsewhere). A malformed first or last line (partial write) is skipped with a warning; a
 //! malformed line elsewhere is an error.
 
-use crate::imu::{ImuData, ImuSample};
-use crate::units::STANDARD_GRAVITY;
+use crate::io::imu::{ImuData, ImuSample};
+use crate::io::units::STANDARD_GRAVITY;
 use anyhow::{bail, Context, Result};
 use nalgebra::Vector3;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! `t [s]  dtheta_x dtheta_y dtheta_z [rad]  dv_x dv_y dv_z [m/s]`, increments over (t_prev, t],
 //! FRD body frame, whitespace or comma separated, `#` comment lines.
 
-use crate::atomic_file::AtomicFile;
+use crate::io::atomic_file::AtomicFile;
 use anyhow::{bail, Context, Result};
 use nalgebra::Vector3;
 use std::io::Write;

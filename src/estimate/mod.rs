@@ -1,0 +1,8 @@
+//! Estimation on IMU data: the error-state Kalman filter over any model, static alignment,
+//! Allan deviation and noise identification, IMU mounting from the data.
+
+pub mod align;
+pub mod allan;
+pub mod filter;
+pub mod mounting;
+pub mod stats;

@@ -1,0 +1,10 @@
+//! Files in and out: IMU increments, aiding and truth files, readers of other formats (PSINS
+//! `.imu`, GNSS_IMU csv, RTKLIB `.pos`), quantities with units at the edges, atomic outputs.
+
+pub mod aiding;
+pub mod atomic_file;
+pub mod fixed;
+pub mod imu;
+pub mod readers;
+pub mod truth;
+pub mod units;

@@ -1,0 +1,8 @@
+//! Reports: the paper's reproduction and its statistics, PNG plots and progress bars (the
+//! last two with the `cli` feature).
+
+#[cfg(feature = "cli")]
+pub mod plot;
+#[cfg(feature = "cli")]
+pub mod progress;
+pub mod reproduce;
