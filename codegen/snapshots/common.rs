@@ -2,8 +2,11 @@
 // Regenerate: `cargo build` (build.rs writes OUT_DIR); refresh the reviewed snapshots in
 // codegen/snapshots/ with `UPDATE_SNAPSHOTS=1 cargo test -p sinsmodel-codegen --test snapshots`.
 
-use crate::catalog::{MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo};
-use crate::nav_point::NavPoint;
+use crate::model::catalog::{
+    MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo, WhiteNoise,
+};
+
+use crate::nav::nav_point::NavPoint;
 use nalgebra::Vector3;
 
 /// Number of navigation states with the vertical channel.
@@ -45,6 +48,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 4.84813681109536e-6,
         sigma: 0.0002908882086657216,
         vertical: false,
+        white_noise: WhiteNoise::GyroArw,
         doc: "attitude error about north (C~ = (I - [phi x]) C)",
     },
     NavStateInfo {
@@ -54,6 +58,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 4.84813681109536e-6,
         sigma: 0.0002908882086657216,
         vertical: false,
+        white_noise: WhiteNoise::GyroArw,
         doc: "attitude error about east",
     },
     NavStateInfo {
@@ -63,6 +68,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 0.0002908882086657216,
         sigma: 0.002908882086657216,
         vertical: false,
+        white_noise: WhiteNoise::GyroArw,
         doc: "attitude error about down (heading error, sign opposite to yaw error)",
     },
     NavStateInfo {
@@ -72,6 +78,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 1.0,
         sigma: 0.1,
         vertical: false,
+        white_noise: WhiteNoise::AccelVrw,
         doc: "north velocity error",
     },
     NavStateInfo {
@@ -81,6 +88,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 1.0,
         sigma: 0.1,
         vertical: false,
+        white_noise: WhiteNoise::AccelVrw,
         doc: "east velocity error",
     },
     NavStateInfo {
@@ -90,6 +98,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 1.0,
         sigma: 0.1,
         vertical: true,
+        white_noise: WhiteNoise::AccelVrw,
         doc: "down velocity error",
     },
     NavStateInfo {
@@ -99,6 +108,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 4.84813681109536e-6,
         sigma: 4.84813681109536e-7,
         vertical: false,
+        white_noise: WhiteNoise::None,
         doc: "latitude error",
     },
     NavStateInfo {
@@ -108,6 +118,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 4.84813681109536e-6,
         sigma: 4.84813681109536e-7,
         vertical: false,
+        white_noise: WhiteNoise::None,
         doc: "longitude error",
     },
     NavStateInfo {
@@ -117,6 +128,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
         display_to_si: 1.0,
         sigma: 1.0,
         vertical: true,
+        white_noise: WhiteNoise::None,
         doc: "height error (up)",
     },
 ];
@@ -1035,96 +1047,29 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
 
 /// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], FRD body frame).
 pub fn regressor_value(id: usize, f: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
-    let _ = (f, w);
     match id {
-        0 => {
-            // 1
-            1.0
-        }
-        1 => {
-            // w.x
-            w.x
-        }
-        2 => {
-            // w.y
-            w.y
-        }
-        3 => {
-            // w.z
-            w.z
-        }
-        4 => {
-            // f.x
-            f.x
-        }
-        5 => {
-            // f.y
-            f.y
-        }
-        6 => {
-            // f.z
-            f.z
-        }
-        7 => {
-            // f.x.powi(2)
-            f.x.powi(2)
-        }
-        8 => {
-            // f.y.powi(2)
-            f.y.powi(2)
-        }
-        9 => {
-            // f.z.powi(2)
-            f.z.powi(2)
-        }
-        10 => {
-            // f.x * f.y
-            f.x * f.y
-        }
-        11 => {
-            // f.x * f.z
-            f.x * f.z
-        }
-        12 => {
-            // f.y * f.z
-            f.y * f.z
-        }
-        13 => {
-            // f.x.abs()
-            f.x.abs()
-        }
-        14 => {
-            // f.y.abs()
-            f.y.abs()
-        }
-        15 => {
-            // f.z.abs()
-            f.z.abs()
-        }
-        16 => {
-            // f.x * f.x.abs()
-            f.x * f.x.abs()
-        }
-        17 => {
-            // f.y * f.y.abs()
-            f.y * f.y.abs()
-        }
-        18 => {
-            // f.z * f.z.abs()
-            f.z * f.z.abs()
-        }
-        19 => {
-            // -(w.y.powi(2) + w.z.powi(2))
-            -(w.y.powi(2) + w.z.powi(2))
-        }
-        20 => {
-            // -(w.x.powi(2) + w.z.powi(2))
-            -(w.x.powi(2) + w.z.powi(2))
-        }
-        21 => {
-            // -(w.x.powi(2) + w.y.powi(2))
-            -(w.x.powi(2) + w.y.powi(2))
-        }
+        0 => 1.0,
+        1 => w.x,
+        2 => w.y,
+        3 => w.z,
+        4 => f.x,
+        5 => f.y,
+        6 => f.z,
+        7 => f.x.powi(2),
+        8 => f.y.powi(2),
+        9 => f.z.powi(2),
+        10 => f.x * f.y,
+        11 => f.x * f.z,
+        12 => f.y * f.z,
+        13 => f.x.abs(),
+        14 => f.y.abs(),
+        15 => f.z.abs(),
+        16 => f.x * f.x.abs(),
+        17 => f.y * f.y.abs(),
+        18 => f.z * f.z.abs(),
+        19 => -(w.y.powi(2) + w.z.powi(2)),
+        20 => -(w.x.powi(2) + w.z.powi(2)),
+        21 => -(w.x.powi(2) + w.y.powi(2)),
         _ => panic!("regressor index {id} out of range"),
     }
 }
@@ -1143,103 +1088,59 @@ pub fn fill_nav_block(nav: &NavPoint, a: &mut [[f64; NAV_COUNT]; NAV_COUNT]) {
     let f_d = nav.f_ned[2];
     let dg_dlat = nav.dg_dlat;
     let dg_dh = nav.dg_dh;
-    // A[phi_n][phi_e] = -omega * lat.sin() - ve * lat.tan() / rn
     a[PHI_N][PHI_E] = -omega * lat.sin() - ve * lat.tan() / rn;
-    // A[phi_n][phi_d] = vn / rm
     a[PHI_N][PHI_D] = vn / rm;
-    // A[phi_n][dv_e] = 1.0 / rn
     a[PHI_N][DV_E] = 1.0 / rn;
-    // A[phi_n][dlat] = -omega * lat.sin()
     a[PHI_N][DLAT] = -omega * lat.sin();
-    // A[phi_n][dh] = -ve / rn.powi(2)
     a[PHI_N][DH] = -ve / rn.powi(2);
-    // A[phi_e][phi_n] = omega * lat.sin() + ve * lat.tan() / rn
     a[PHI_E][PHI_N] = omega * lat.sin() + ve * lat.tan() / rn;
-    // A[phi_e][phi_d] = omega * lat.cos() + ve / rn
     a[PHI_E][PHI_D] = omega * lat.cos() + ve / rn;
-    // A[phi_e][dv_n] = -1.0 / rm
     a[PHI_E][DV_N] = -1.0 / rm;
-    // A[phi_e][dh] = vn / rm.powi(2)
     a[PHI_E][DH] = vn / rm.powi(2);
-    // A[phi_d][phi_n] = -vn / rm
     a[PHI_D][PHI_N] = -vn / rm;
-    // A[phi_d][phi_e] = -omega * lat.cos() - ve / rn
     a[PHI_D][PHI_E] = -omega * lat.cos() - ve / rn;
-    // A[phi_d][dv_e] = -lat.tan() / rn
     a[PHI_D][DV_E] = -lat.tan() / rn;
-    // A[phi_d][dlat] = -omega * lat.cos() - ve / (rn * lat.cos().powi(2))
     a[PHI_D][DLAT] = -omega * lat.cos() - ve / (rn * lat.cos().powi(2));
-    // A[phi_d][dh] = ve * lat.tan() / rn.powi(2)
     a[PHI_D][DH] = ve * lat.tan() / rn.powi(2);
-    // A[dv_n][phi_e] = -f_d
     a[DV_N][PHI_E] = -f_d;
-    // A[dv_n][phi_d] = f_e
     a[DV_N][PHI_D] = f_e;
-    // A[dv_n][dv_n] = vd / rm
     a[DV_N][DV_N] = vd / rm;
-    // A[dv_n][dv_e] = -2.0 * (omega * lat.sin() + ve * lat.tan() / rn)
     a[DV_N][DV_E] = -2.0 * (omega * lat.sin() + ve * lat.tan() / rn);
-    // A[dv_n][dv_d] = vn / rm
     a[DV_N][DV_D] = vn / rm;
-    // A[dv_n][dlat] = -ve * (2.0 * omega * lat.cos() + ve / (rn * lat.cos().powi(2)))
     a[DV_N][DLAT] = -ve * (2.0 * omega * lat.cos() + ve / (rn * lat.cos().powi(2)));
-    // A[dv_n][dh] = ve * ve * lat.tan() / rn.powi(2) - vn * vd / rm.powi(2)
     a[DV_N][DH] = ve * ve * lat.tan() / rn.powi(2) - vn * vd / rm.powi(2);
-    // A[dv_e][phi_n] = f_d
     a[DV_E][PHI_N] = f_d;
-    // A[dv_e][phi_d] = -f_n
     a[DV_E][PHI_D] = -f_n;
-    // A[dv_e][dv_n] = 2.0 * omega * lat.sin() + ve * lat.tan() / rn
     a[DV_E][DV_N] = 2.0 * omega * lat.sin() + ve * lat.tan() / rn;
-    // A[dv_e][dv_e] = (vn * lat.tan() + vd) / rn
     a[DV_E][DV_E] = (vn * lat.tan() + vd) / rn;
-    // A[dv_e][dv_d] = 2.0 * omega * lat.cos() + ve / rn
     a[DV_E][DV_D] = 2.0 * omega * lat.cos() + ve / rn;
-    // A[dv_e][dlat] = 2.0 * omega * (vn * lat.cos() - vd * lat.sin()) + vn * ve / (rn * lat.cos().powi(2))
     a[DV_E][DLAT] = 2.0 * omega * (vn * lat.cos() - vd * lat.sin())
         + vn * ve / (rn * lat.cos().powi(2));
-    // A[dv_e][dh] = -ve * (vd + vn * lat.tan()) / rn.powi(2)
     a[DV_E][DH] = -ve * (vd + vn * lat.tan()) / rn.powi(2);
-    // A[dv_d][phi_n] = -f_e
     a[DV_D][PHI_N] = -f_e;
-    // A[dv_d][phi_e] = f_n
     a[DV_D][PHI_E] = f_n;
-    // A[dv_d][dv_n] = -2.0 * vn / rm
     a[DV_D][DV_N] = -2.0 * vn / rm;
-    // A[dv_d][dv_e] = -2.0 * (omega * lat.cos() + ve / rn)
     a[DV_D][DV_E] = -2.0 * (omega * lat.cos() + ve / rn);
-    // A[dv_d][dlat] = 2.0 * omega * ve * lat.sin() + dg_dlat
     a[DV_D][DLAT] = 2.0 * omega * ve * lat.sin() + dg_dlat;
-    // A[dv_d][dh] = vn * vn / rm.powi(2) + ve * ve / rn.powi(2) + dg_dh
     a[DV_D][DH] = vn * vn / rm.powi(2) + ve * ve / rn.powi(2) + dg_dh;
-    // A[dlat][dv_n] = 1.0 / rm
     a[DLAT][DV_N] = 1.0 / rm;
-    // A[dlat][dh] = -vn / rm.powi(2)
     a[DLAT][DH] = -vn / rm.powi(2);
-    // A[dlon][dv_e] = 1.0 / (rn * lat.cos())
     a[DLON][DV_E] = 1.0 / (rn * lat.cos());
-    // A[dlon][dlat] = ve * lat.tan() / (rn * lat.cos())
     a[DLON][DLAT] = ve * lat.tan() / (rn * lat.cos());
-    // A[dlon][dh] = -ve / (rn.powi(2) * lat.cos())
     a[DLON][DH] = -ve / (rn.powi(2) * lat.cos());
-    // A[dh][dv_d] = -1.0
     a[DH][DV_D] = -1.0;
 }
 
 /// Writes term `term`'s column over the navigation rows; `r` is the step mean of its regressor.
 pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUNT]) {
-    let _ = r;
     match term {
         0 => {
             // eps_x: Gyro x axis, regressor 1
             let c11 = nav.c[0][0];
             let c21 = nav.c[1][0];
             let c31 = nav.c[2][0];
-            // A[phi_n][eps_x] = -C11
             col[PHI_N] = -c11;
-            // A[phi_e][eps_x] = -C21
             col[PHI_E] = -c21;
-            // A[phi_d][eps_x] = -C31
             col[PHI_D] = -c31;
         }
         1 => {
@@ -1247,11 +1148,8 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             let c12 = nav.c[0][1];
             let c22 = nav.c[1][1];
             let c32 = nav.c[2][1];
-            // A[phi_n][eps_y] = -C12
             col[PHI_N] = -c12;
-            // A[phi_e][eps_y] = -C22
             col[PHI_E] = -c22;
-            // A[phi_d][eps_y] = -C32
             col[PHI_D] = -c32;
         }
         2 => {
@@ -1259,11 +1157,8 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             let c13 = nav.c[0][2];
             let c23 = nav.c[1][2];
             let c33 = nav.c[2][2];
-            // A[phi_n][eps_z] = -C13
             col[PHI_N] = -c13;
-            // A[phi_e][eps_z] = -C23
             col[PHI_E] = -c23;
-            // A[phi_d][eps_z] = -C33
             col[PHI_D] = -c33;
         }
         3 => {
@@ -1271,11 +1166,8 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             let c11 = nav.c[0][0];
             let c21 = nav.c[1][0];
             let c31 = nav.c[2][0];
-            // A[dv_n][nabla_x] = C11
             col[DV_N] = c11;
-            // A[dv_e][nabla_x] = C21
             col[DV_E] = c21;
-            // A[dv_d][nabla_x] = C31
             col[DV_D] = c31;
         }
         4 => {
@@ -1283,11 +1175,8 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             let c12 = nav.c[0][1];
             let c22 = nav.c[1][1];
             let c32 = nav.c[2][1];
-            // A[dv_n][nabla_y] = C12
             col[DV_N] = c12;
-            // A[dv_e][nabla_y] = C22
             col[DV_E] = c22;
-            // A[dv_d][nabla_y] = C32
             col[DV_D] = c32;
         }
         5 => {
@@ -1295,11 +1184,8 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             let c13 = nav.c[0][2];
             let c23 = nav.c[1][2];
             let c33 = nav.c[2][2];
-            // A[dv_n][nabla_z] = C13
             col[DV_N] = c13;
-            // A[dv_e][nabla_z] = C23
             col[DV_E] = c23;
-            // A[dv_d][nabla_z] = C33
             col[DV_D] = c33;
         }
         6 => {
@@ -1854,25 +1740,17 @@ pub fn measurement_entries(
 ) {
     match m {
         0 => {
-            let _ = nav;
-            // H[dv_n][dv_n] = 1.0
             emit(0, "dv_n", 1.0);
-            // H[dv_e][dv_e] = 1.0
             emit(1, "dv_e", 1.0);
         }
         1 => {
-            let _ = nav;
             let lat = nav.lat;
             let rm = nav.rm;
             let rn = nav.rn;
-            // H[dp_n][dlat] = rm
             emit(0, "dlat", rm);
-            // H[dp_e][dlon] = rn * lat.cos()
             emit(1, "dlon", rn * lat.cos());
         }
         2 => {
-            let _ = nav;
-            // H[dp_u][dh] = 1.0
             emit(0, "dh", 1.0);
         }
         _ => panic!("measurement index {m} out of range"),

@@ -3,8 +3,8 @@
 // codegen/snapshots/ with `UPDATE_SNAPSHOTS=1 cargo test -p sinsmodel-codegen --test snapshots`.
 
 use super::common::NAV_COUNT;
-use crate::catalog::StateRef;
-use crate::nav_point::NavPoint;
+use crate::model::catalog::StateRef;
+use crate::nav::nav_point::NavPoint;
 use nalgebra::Vector3;
 
 /// Model name.
@@ -330,24 +330,14 @@ impl Regressors {
     /// Adds one IMU sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
     #[inline]
     pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
-        let _ = (f, w);
-        // <w.x>
         self.sum[0] += w.x;
-        // <w.y>
         self.sum[1] += w.y;
-        // <w.z>
         self.sum[2] += w.z;
-        // <f.x>
         self.sum[3] += f.x;
-        // <f.y>
         self.sum[4] += f.y;
-        // <f.z>
         self.sum[5] += f.z;
-        // <f.x.powi(2)>
         self.sum[6] += f.x.powi(2);
-        // <f.y.powi(2)>
         self.sum[7] += f.y.powi(2);
-        // <f.z.powi(2)>
         self.sum[8] += f.z.powi(2);
         self.count += 1;
     }
@@ -372,9 +362,22 @@ impl Regressors {
     }
 }
 
+/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
+pub fn accumulate_dyn(sum: &mut [f64], f: &Vector3<f64>, w: &Vector3<f64>) {
+    let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");
+    sum[0] += w.x;
+    sum[1] += w.y;
+    sum[2] += w.z;
+    sum[3] += f.x;
+    sum[4] += f.y;
+    sum[5] += f.z;
+    sum[6] += f.x.powi(2);
+    sum[7] += f.y.powi(2);
+    sum[8] += f.z.powi(2);
+}
+
 /// Writes the structural non-zeros of A(t) at `nav` with regressor step means `r`.
 pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
-    let _ = r;
     let lat = nav.lat;
     let vn = nav.v_ned[0];
     let ve = nav.v_ned[1];
@@ -396,21 +399,13 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     let c33 = nav.c[2][2];
     let dg_dlat = nav.dg_dlat;
     let dg_dh = nav.dg_dh;
-    // A[phi_n][phi_e] = -omega * lat.sin() - ve * lat.tan() / rn
     a[PHI_N][PHI_E] = -omega * lat.sin() - ve * lat.tan() / rn;
-    // A[phi_n][phi_d] = vn / rm
     a[PHI_N][PHI_D] = vn / rm;
-    // A[phi_n][dv_e] = 1.0 / rn
     a[PHI_N][DV_E] = 1.0 / rn;
-    // A[phi_n][dlat] = -omega * lat.sin()
     a[PHI_N][DLAT] = -omega * lat.sin();
-    // A[phi_n][dh] = -ve / rn.powi(2)
     a[PHI_N][DH] = -ve / rn.powi(2);
-    // A[phi_n][eps_x] = -C11
     a[PHI_N][EPS_X] = -c11;
-    // A[phi_n][eps_y] = -C12
     a[PHI_N][EPS_Y] = -c12;
-    // A[phi_n][eps_z] = -C13
     a[PHI_N][EPS_Z] = -c13;
     // A[phi_n][kg_11] = -C11 * <w.x>
     a[PHI_N][KG_11] = -c11 * r[0];
@@ -424,19 +419,12 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     a[PHI_N][KG_32] = -c13 * r[1];
     // A[phi_n][kg_33] = -C13 * <w.z>
     a[PHI_N][KG_33] = -c13 * r[2];
-    // A[phi_e][phi_n] = omega * lat.sin() + ve * lat.tan() / rn
     a[PHI_E][PHI_N] = omega * lat.sin() + ve * lat.tan() / rn;
-    // A[phi_e][phi_d] = omega * lat.cos() + ve / rn
     a[PHI_E][PHI_D] = omega * lat.cos() + ve / rn;
-    // A[phi_e][dv_n] = -1.0 / rm
     a[PHI_E][DV_N] = -1.0 / rm;
-    // A[phi_e][dh] = vn / rm.powi(2)
     a[PHI_E][DH] = vn / rm.powi(2);
-    // A[phi_e][eps_x] = -C21
     a[PHI_E][EPS_X] = -c21;
-    // A[phi_e][eps_y] = -C22
     a[PHI_E][EPS_Y] = -c22;
-    // A[phi_e][eps_z] = -C23
     a[PHI_E][EPS_Z] = -c23;
     // A[phi_e][kg_11] = -C21 * <w.x>
     a[PHI_E][KG_11] = -c21 * r[0];
@@ -450,21 +438,13 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     a[PHI_E][KG_32] = -c23 * r[1];
     // A[phi_e][kg_33] = -C23 * <w.z>
     a[PHI_E][KG_33] = -c23 * r[2];
-    // A[phi_d][phi_n] = -vn / rm
     a[PHI_D][PHI_N] = -vn / rm;
-    // A[phi_d][phi_e] = -omega * lat.cos() - ve / rn
     a[PHI_D][PHI_E] = -omega * lat.cos() - ve / rn;
-    // A[phi_d][dv_e] = -lat.tan() / rn
     a[PHI_D][DV_E] = -lat.tan() / rn;
-    // A[phi_d][dlat] = -omega * lat.cos() - ve / (rn * lat.cos().powi(2))
     a[PHI_D][DLAT] = -omega * lat.cos() - ve / (rn * lat.cos().powi(2));
-    // A[phi_d][dh] = ve * lat.tan() / rn.powi(2)
     a[PHI_D][DH] = ve * lat.tan() / rn.powi(2);
-    // A[phi_d][eps_x] = -C31
     a[PHI_D][EPS_X] = -c31;
-    // A[phi_d][eps_y] = -C32
     a[PHI_D][EPS_Y] = -c32;
-    // A[phi_d][eps_z] = -C33
     a[PHI_D][EPS_Z] = -c33;
     // A[phi_d][kg_11] = -C31 * <w.x>
     a[PHI_D][KG_11] = -c31 * r[0];
@@ -478,25 +458,15 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     a[PHI_D][KG_32] = -c33 * r[1];
     // A[phi_d][kg_33] = -C33 * <w.z>
     a[PHI_D][KG_33] = -c33 * r[2];
-    // A[dv_n][phi_e] = -f_d
     a[DV_N][PHI_E] = -f_d;
-    // A[dv_n][phi_d] = f_e
     a[DV_N][PHI_D] = f_e;
-    // A[dv_n][dv_n] = vd / rm
     a[DV_N][DV_N] = vd / rm;
-    // A[dv_n][dv_e] = -2.0 * (omega * lat.sin() + ve * lat.tan() / rn)
     a[DV_N][DV_E] = -2.0 * (omega * lat.sin() + ve * lat.tan() / rn);
-    // A[dv_n][dv_d] = vn / rm
     a[DV_N][DV_D] = vn / rm;
-    // A[dv_n][dlat] = -ve * (2.0 * omega * lat.cos() + ve / (rn * lat.cos().powi(2)))
     a[DV_N][DLAT] = -ve * (2.0 * omega * lat.cos() + ve / (rn * lat.cos().powi(2)));
-    // A[dv_n][dh] = ve * ve * lat.tan() / rn.powi(2) - vn * vd / rm.powi(2)
     a[DV_N][DH] = ve * ve * lat.tan() / rn.powi(2) - vn * vd / rm.powi(2);
-    // A[dv_n][nabla_x] = C11
     a[DV_N][NABLA_X] = c11;
-    // A[dv_n][nabla_y] = C12
     a[DV_N][NABLA_Y] = c12;
-    // A[dv_n][nabla_z] = C13
     a[DV_N][NABLA_Z] = c13;
     // A[dv_n][ka_11] = C11 * <f.x>
     a[DV_N][KA_11] = c11 * r[3];
@@ -522,26 +492,16 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     a[DV_N][D_Y] = c12 * r[7];
     // A[dv_n][d_z] = C13 * <f.z.powi(2)>
     a[DV_N][D_Z] = c13 * r[8];
-    // A[dv_e][phi_n] = f_d
     a[DV_E][PHI_N] = f_d;
-    // A[dv_e][phi_d] = -f_n
     a[DV_E][PHI_D] = -f_n;
-    // A[dv_e][dv_n] = 2.0 * omega * lat.sin() + ve * lat.tan() / rn
     a[DV_E][DV_N] = 2.0 * omega * lat.sin() + ve * lat.tan() / rn;
-    // A[dv_e][dv_e] = (vn * lat.tan() + vd) / rn
     a[DV_E][DV_E] = (vn * lat.tan() + vd) / rn;
-    // A[dv_e][dv_d] = 2.0 * omega * lat.cos() + ve / rn
     a[DV_E][DV_D] = 2.0 * omega * lat.cos() + ve / rn;
-    // A[dv_e][dlat] = 2.0 * omega * (vn * lat.cos() - vd * lat.sin()) + vn * ve / (rn * lat.cos().powi(2))
     a[DV_E][DLAT] = 2.0 * omega * (vn * lat.cos() - vd * lat.sin())
         + vn * ve / (rn * lat.cos().powi(2));
-    // A[dv_e][dh] = -ve * (vd + vn * lat.tan()) / rn.powi(2)
     a[DV_E][DH] = -ve * (vd + vn * lat.tan()) / rn.powi(2);
-    // A[dv_e][nabla_x] = C21
     a[DV_E][NABLA_X] = c21;
-    // A[dv_e][nabla_y] = C22
     a[DV_E][NABLA_Y] = c22;
-    // A[dv_e][nabla_z] = C23
     a[DV_E][NABLA_Z] = c23;
     // A[dv_e][ka_11] = C21 * <f.x>
     a[DV_E][KA_11] = c21 * r[3];
@@ -567,23 +527,14 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     a[DV_E][D_Y] = c22 * r[7];
     // A[dv_e][d_z] = C23 * <f.z.powi(2)>
     a[DV_E][D_Z] = c23 * r[8];
-    // A[dv_d][phi_n] = -f_e
     a[DV_D][PHI_N] = -f_e;
-    // A[dv_d][phi_e] = f_n
     a[DV_D][PHI_E] = f_n;
-    // A[dv_d][dv_n] = -2.0 * vn / rm
     a[DV_D][DV_N] = -2.0 * vn / rm;
-    // A[dv_d][dv_e] = -2.0 * (omega * lat.cos() + ve / rn)
     a[DV_D][DV_E] = -2.0 * (omega * lat.cos() + ve / rn);
-    // A[dv_d][dlat] = 2.0 * omega * ve * lat.sin() + dg_dlat
     a[DV_D][DLAT] = 2.0 * omega * ve * lat.sin() + dg_dlat;
-    // A[dv_d][dh] = vn * vn / rm.powi(2) + ve * ve / rn.powi(2) + dg_dh
     a[DV_D][DH] = vn * vn / rm.powi(2) + ve * ve / rn.powi(2) + dg_dh;
-    // A[dv_d][nabla_x] = C31
     a[DV_D][NABLA_X] = c31;
-    // A[dv_d][nabla_y] = C32
     a[DV_D][NABLA_Y] = c32;
-    // A[dv_d][nabla_z] = C33
     a[DV_D][NABLA_Z] = c33;
     // A[dv_d][ka_11] = C31 * <f.x>
     a[DV_D][KA_11] = c31 * r[3];
@@ -609,46 +560,68 @@ pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
     a[DV_D][D_Y] = c32 * r[7];
     // A[dv_d][d_z] = C33 * <f.z.powi(2)>
     a[DV_D][D_Z] = c33 * r[8];
-    // A[dlat][dv_n] = 1.0 / rm
     a[DLAT][DV_N] = 1.0 / rm;
-    // A[dlat][dh] = -vn / rm.powi(2)
     a[DLAT][DH] = -vn / rm.powi(2);
-    // A[dlon][dv_e] = 1.0 / (rn * lat.cos())
     a[DLON][DV_E] = 1.0 / (rn * lat.cos());
-    // A[dlon][dlat] = ve * lat.tan() / (rn * lat.cos())
     a[DLON][DLAT] = ve * lat.tan() / (rn * lat.cos());
-    // A[dlon][dh] = -ve / (rn.powi(2) * lat.cos())
     a[DLON][DH] = -ve / (rn.powi(2) * lat.cos());
-    // A[dh][dv_d] = -1.0
     a[DH][DV_D] = -1.0;
 }
 
+/// `fill_a` on slices: `r` holds NR step means, `a` is N×N row-major (zeroed by the caller).
+pub fn fill_a_dyn(nav: &NavPoint, r: &[f64], a: &mut [f64]) {
+    let r: &[f64; NR] = r.try_into().expect("regressor means of length NR");
+    let a: &mut [[f64; N]; N] = a.as_chunks_mut::<N>().0.try_into().expect("A of N×N");
+    fill_a(nav, r, a);
+}
+
 /// Writes the non-zeros of H for `vel_ne`: north and east velocity error (computed minus aiding), m/s.
-pub fn fill_h_vel_ne(nav: &NavPoint, h: &mut [[f64; N]; 2]) {
-    let _ = nav;
-    // H[dv_n][dv_n] = 1.0
+pub fn fill_h_vel_ne(_nav: &NavPoint, h: &mut [[f64; N]; 2]) {
     h[0][DV_N] = 1.0;
-    // H[dv_e][dv_e] = 1.0
     h[1][DV_E] = 1.0;
 }
 
 /// Writes the non-zeros of H for `pos_ne`: north and east position error in metres: (R_M+h) dlat, (R_N+h) cos(lat) dlon.
 pub fn fill_h_pos_ne(nav: &NavPoint, h: &mut [[f64; N]; 2]) {
-    let _ = nav;
     let lat = nav.lat;
     let rm = nav.rm;
     let rn = nav.rn;
-    // H[dp_n][dlat] = rm
     h[0][DLAT] = rm;
-    // H[dp_e][dlon] = rn * lat.cos()
     h[1][DLON] = rn * lat.cos();
 }
 
 /// Writes the non-zeros of H for `pos_h`: height error (up), m.
-pub fn fill_h_pos_h(nav: &NavPoint, h: &mut [[f64; N]; 1]) {
-    let _ = nav;
-    // H[dp_u][dh] = 1.0
+pub fn fill_h_pos_h(_nav: &NavPoint, h: &mut [[f64; N]; 1]) {
     h[0][DH] = 1.0;
+}
+
+/// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
+pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
+    if name == "vel_ne" {
+        let mut m = [[0.0; N]; 2];
+        fill_h_vel_ne(nav, &mut m);
+        for (i, row) in m.iter().enumerate() {
+            h[i * N..(i + 1) * N].copy_from_slice(row);
+        }
+        return true;
+    }
+    if name == "pos_ne" {
+        let mut m = [[0.0; N]; 2];
+        fill_h_pos_ne(nav, &mut m);
+        for (i, row) in m.iter().enumerate() {
+            h[i * N..(i + 1) * N].copy_from_slice(row);
+        }
+        return true;
+    }
+    if name == "pos_h" {
+        let mut m = [[0.0; N]; 1];
+        fill_h_pos_h(nav, &mut m);
+        for (i, row) in m.iter().enumerate() {
+            h[i * N..(i + 1) * N].copy_from_slice(row);
+        }
+        return true;
+    }
+    false
 }
 
 /// Number of rows of Φ that differ from the identity (the navigation rows).
@@ -728,7 +701,6 @@ pub const B_COLS: [&[usize]; ND] = [
 /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows (second-order series; dt in s).
 pub fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
     let half_dt2 = 0.5 * dt * dt;
-    let _ = half_dt2;
     // row phi_n
     b[0][PHI_N] = half_dt2
         * (a[PHI_N][PHI_E] * a[PHI_E][PHI_N] + a[PHI_N][PHI_D] * a[PHI_D][PHI_N]
@@ -1411,59 +1383,6 @@ pub fn propagate_state(b: &[[f64; N]; ND], x: &mut [f64; N]) {
     for r in 0..ND {
         x[DYN_ROWS[r]] += dx[r];
     }
-}
-
-/// `fill_a` on slices: `r` holds NR step means, `a` is N×N row-major (zeroed by the caller).
-pub fn fill_a_dyn(nav: &NavPoint, r: &[f64], a: &mut [f64]) {
-    let r: &[f64; NR] = r.try_into().expect("regressor means of length NR");
-    let a: &mut [[f64; N]; N] = a.as_chunks_mut::<N>().0.try_into().expect("A of N×N");
-    fill_a(nav, r, a);
-}
-
-/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
-pub fn accumulate_dyn(sum: &mut [f64], f: &Vector3<f64>, w: &Vector3<f64>) {
-    let _ = (f, w);
-    let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");
-    let _ = &sum;
-    sum[0] += w.x;
-    sum[1] += w.y;
-    sum[2] += w.z;
-    sum[3] += f.x;
-    sum[4] += f.y;
-    sum[5] += f.z;
-    sum[6] += f.x.powi(2);
-    sum[7] += f.y.powi(2);
-    sum[8] += f.z.powi(2);
-}
-
-/// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
-pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
-    let _ = (nav, &h);
-    if name == "vel_ne" {
-        let mut m = [[0.0; N]; 2];
-        fill_h_vel_ne(nav, &mut m);
-        for (i, row) in m.iter().enumerate() {
-            h[i * N..(i + 1) * N].copy_from_slice(row);
-        }
-        return true;
-    }
-    if name == "pos_ne" {
-        let mut m = [[0.0; N]; 2];
-        fill_h_pos_ne(nav, &mut m);
-        for (i, row) in m.iter().enumerate() {
-            h[i * N..(i + 1) * N].copy_from_slice(row);
-        }
-        return true;
-    }
-    if name == "pos_h" {
-        let mut m = [[0.0; N]; 1];
-        fill_h_pos_h(nav, &mut m);
-        for (i, row) in m.iter().enumerate() {
-            h[i * N..(i + 1) * N].copy_from_slice(row);
-        }
-        return true;
-    }
-    false
 }
 
 /// `propagate_cov` on slices: `a` and `p` are N×N row-major, `q` has N entries.

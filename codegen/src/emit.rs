@@ -3,7 +3,7 @@
 //! `fill_h_*`, the regressor accumulator, and the sparse covariance kernel).
 
 use crate::layout::{term_column, Layout, StateRef, SymEntry};
-use crate::spec::{Sensor, Spec};
+use crate::spec::{Sensor, Spec, WhiteNoise};
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 use std::collections::BTreeSet;
@@ -167,7 +167,12 @@ pub fn common_module(spec: &Spec) -> String {
         let (name, unit, display, doc, vertical) = (&s.name, &s.unit, &s.display, &s.doc, s.vertical);
         let to_si = f64_lit(s.display_to_si);
         let sigma = f64_lit(s.sigma);
-        quote!(NavStateInfo { name: #name, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, vertical: #vertical, doc: #doc })
+        let white_noise = match s.white_noise {
+            WhiteNoise::None => quote!(WhiteNoise::None),
+            WhiteNoise::GyroArw => quote!(WhiteNoise::GyroArw),
+            WhiteNoise::AccelVrw => quote!(WhiteNoise::AccelVrw),
+        };
+        quote!(NavStateInfo { name: #name, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, vertical: #vertical, white_noise: #white_noise, doc: #doc })
     });
     let n_terms = spec.terms.len();
     let term_infos = spec.terms.iter().map(|t| {
@@ -188,9 +193,12 @@ pub fn common_module(spec: &Spec) -> String {
     let reg_const = spec.regressors.iter().map(|r| r.constant);
     let reg_arms = spec.regressors.iter().enumerate().map(|(i, r)| {
         let ast = &r.expr.ast;
-        let c = comment(&r.expr.source);
-        quote!(#i => { #c #ast })
+        quote!(#i => #ast,)
     });
+    let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
+    let (uses_f, uses_w) = signals_used(spec, &all_regs);
+    let (f_param, w_param) = (param("f", uses_f), param("w", uses_w));
+    let r_param = param("r", spec.terms.iter().any(|t| !spec.regressors[t.regressor].constant));
 
     // full navigation block
     let full = Layout {
@@ -204,12 +212,12 @@ pub fn common_module(spec: &Spec) -> String {
     let nav_lines = nav_entries.iter().map(|e| {
         let r = const_name(&spec.nav_states[e.row].name);
         let c = const_name(&spec.nav_states[e.col].name);
-        let text = format!(
-            "A[{}][{}] = {}",
-            spec.nav_states[e.row].name, spec.nav_states[e.col].name, e.comment
+        let label = format!(
+            "A[{}][{}]",
+            spec.nav_states[e.row].name, spec.nav_states[e.col].name
         );
-        let cm = comment(&text);
         let v = &e.value;
+        let cm = entry_comment(&label, &e.comment, v);
         quote!(#cm a[#r][#c] = #v;)
     });
 
@@ -244,11 +252,9 @@ pub fn common_module(spec: &Spec) -> String {
         ));
         let lines = col.iter().map(|(row, e)| {
             let rc = const_name(&spec.nav_states[*row].name);
-            let cm = comment(&format!(
-                "A[{}][{}] = {}",
-                spec.nav_states[*row].name, term.name, e.comment
-            ));
             let v = &e.value;
+            let label = format!("A[{}][{}]", spec.nav_states[*row].name, term.name);
+            let cm = entry_comment(&label, &e.comment, v);
             quote!(#cm col[#rc] = #v;)
         });
         quote!(#t => { #head #binds #(#lines)* })
@@ -294,19 +300,17 @@ pub fn common_module(spec: &Spec) -> String {
         let lines = entries.iter().zip(states).map(|(e, s)| {
             let row = e.row;
             let v = &e.value;
-            let cm = comment(&format!(
-                "H[{}][{}] = {}",
-                meas.rows[row].name, s, e.comment
-            ));
+            let label = format!("H[{}][{}]", meas.rows[row].name, s);
+            let cm = entry_comment(&label, &e.comment, v);
             quote!(#cm emit(#row, #s, #v);)
         });
-        quote!(#m => { let _ = nav; #binds #(#lines)* })
+        quote!(#m => { #binds #(#lines)* })
     });
 
     let arw = f64_lit(spec.sensor_noise.gyro_arw);
     let vrw = f64_lit(spec.sensor_noise.accel_vrw);
     let tokens = quote! {
-        use crate::model::catalog::{MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo};
+        use crate::model::catalog::{MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo, WhiteNoise};
         use crate::nav::nav_point::NavPoint;
         use nalgebra::Vector3;
 
@@ -339,8 +343,7 @@ pub fn common_module(spec: &Spec) -> String {
         pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
 
         /// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], FRD body frame).
-        pub fn regressor_value(id: usize, f: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
-            let _ = (f, w);
+        pub fn regressor_value(id: usize, #f_param: &Vector3<f64>, #w_param: &Vector3<f64>) -> f64 {
             match id {
                 #(#reg_arms)*
                 _ => panic!("regressor index {id} out of range"),
@@ -354,8 +357,7 @@ pub fn common_module(spec: &Spec) -> String {
         }
 
         /// Writes term `term`'s column over the navigation rows; `r` is the step mean of its regressor.
-        pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUNT]) {
-            let _ = r;
+        pub fn term_column(term: usize, nav: &NavPoint, #r_param: f64, col: &mut [f64; NAV_COUNT]) {
             match term {
                 #(#term_arms)*
                 _ => panic!("term index {term} out of range"),
@@ -396,20 +398,81 @@ fn phi_pattern(n: usize, a: &BTreeSet<(usize, usize)>) -> PhiPattern {
     PhiPattern { rows, entries }
 }
 
-fn meas_count(spec: &Spec, layout: &Layout) -> usize {
-    (0..spec.measurements.len())
-        .filter(|&m| layout.h_entries(spec, m).is_some())
-        .count()
+
+/// The comment above a generated line, or nothing when it would repeat the code: `label =
+/// expression` where the expression is the spec's text.
+fn entry_comment(label: &str, symbolic: &str, code: &TokenStream) -> TokenStream {
+    let norm = |s: &str| -> String {
+        s.chars()
+            .filter(|c| !c.is_whitespace())
+            .collect::<String>()
+            .to_lowercase()
+    };
+    if norm(symbolic) == norm(&code.to_string()) {
+        quote!()
+    } else {
+        comment(&format!("{label} = {symbolic}"))
+    }
 }
 
-/// One preset module: index constants, accumulator, `fill_a`, `fill_h_*`, covariance kernel.
+/// `name` when the generated body uses a parameter, `_name` when it does not.
+fn param(name: &str, used: bool) -> syn::Ident {
+    if used {
+        format_ident!("{}", name)
+    } else {
+        format_ident!("_{}", name)
+    }
+}
+
+/// Which IMU signals (`f`, `w`) the given regressors read.
+fn signals_used(spec: &Spec, regs: &[usize]) -> (bool, bool) {
+    let mut used = (false, false);
+    for &r in regs {
+        for s in spec.regressors[r].expr.symbols() {
+            used.0 |= s.starts_with("f.");
+            used.1 |= s.starts_with("w.");
+        }
+    }
+    used
+}
+
+/// One preset module: index constants, the regressor accumulator, `fill_a`, `fill_h_*`, the
+/// sparse covariance kernel and slice wrappers, each emitted by its own step below.
 pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
-    let n = layout.states.len();
-    let name = &layout.name;
-    let vertical = layout.vertical;
-    let names: Vec<String> = (0..n)
+    let names: Vec<String> = (0..layout.states.len())
         .map(|i| layout.state_name(spec, i).to_string())
         .collect();
+    let entries = layout.a_entries(spec);
+    let pattern: BTreeSet<(usize, usize)> = entries.iter().map(|e| (e.row, e.col)).collect();
+    let constants = preset_constants(spec, layout, &names, &pattern);
+    let accumulator = preset_accumulator(spec, layout);
+    let fill_a = preset_fill_a(&names, &entries, layout.regressors(spec).len());
+    let fill_h = preset_fill_h(spec, layout, &names);
+    let kernel = preset_kernel(&names, &pattern);
+    let tokens = quote! {
+        use super::common::NAV_COUNT;
+        use crate::model::catalog::StateRef;
+        use crate::nav::nav_point::NavPoint;
+        use nalgebra::Vector3;
+        #constants
+        #accumulator
+        #fill_a
+        #fill_h
+        #kernel
+        const _: () = assert!(ND <= NAV_COUNT);
+    };
+    format_file(tokens)
+}
+
+/// Name, index constants, state list, A's pattern, measurements and regressor ids.
+fn preset_constants(
+    spec: &Spec,
+    layout: &Layout,
+    names: &[String],
+    pattern: &BTreeSet<(usize, usize)>,
+) -> TokenStream {
+    let n = names.len();
+    let (name, vertical) = (&layout.name, layout.vertical);
     let consts = names.iter().enumerate().map(|(i, s)| {
         let c = const_name(s);
         let doc = format!(" Index of `{s}`.");
@@ -419,95 +482,195 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
         StateRef::Nav(k) => quote!(StateRef::Nav(#k)),
         StateRef::Term(k) => quote!(StateRef::Term(#k)),
     });
-
-    // regressor accumulator
-    let regs = layout.regressors(spec);
-    let nr = regs.len();
-    let n_meas = meas_count(spec, layout);
-    let reg_ids = regs.iter();
-    let reg_add = regs.iter().enumerate().map(|(k, &r)| {
-        let ast = &spec.regressors[r].expr.ast;
-        let cm = comment(&format!("<{}>", spec.regressors[r].expr.source));
-        quote!(#cm self.sum[#k] += #ast;)
-    });
-    let reg_add_dyn: Vec<TokenStream> = regs
-        .iter()
-        .enumerate()
-        .map(|(k, &r)| {
-            let ast = &spec.regressors[r].expr.ast;
-            quote!(sum[#k] += #ast;)
-        })
-        .collect();
-
-    // A
-    let entries = layout.a_entries(spec);
-    let nnz = entries.len();
-    let pattern: BTreeSet<(usize, usize)> = entries.iter().map(|e| (e.row, e.col)).collect();
+    let nnz = pattern.len();
     let pat_tokens = pattern.iter().map(|(r, c)| {
         let (r, c) = (const_name(&names[*r]), const_name(&names[*c]));
         quote!((#r, #c))
     });
+    let meas_names: Vec<&str> = (0..spec.measurements.len())
+        .filter(|&m| layout.h_entries(spec, m).is_some())
+        .map(|m| spec.measurements[m].name.as_str())
+        .collect();
+    let n_meas = meas_names.len();
+    let regs = layout.regressors(spec);
+    let nr = regs.len();
+    quote! {
+        /// Model name.
+        pub const NAME: &str = #name;
+        /// True when the vertical channel (dv_d, dh) is present.
+        pub const VERTICAL: bool = #vertical;
+        /// Number of states.
+        pub const N: usize = #n;
+        #(#consts)*
+        /// State names in order.
+        pub const STATES: [&str; N] = [#(#names),*];
+        /// What each state is, as indices into the common catalogue.
+        pub const STATE_REFS: [StateRef; N] = [#(#state_refs),*];
+        /// Number of structural non-zeros of A.
+        pub const A_NNZ: usize = #nnz;
+        /// Structural non-zeros of A, row-major.
+        pub const A_PATTERN: [(usize, usize); A_NNZ] = [#(#pat_tokens),*];
+        /// Measurements this model supports.
+        pub const MEASUREMENTS: [&str; #n_meas] = [#(#meas_names),*];
+        /// Number of accumulated regressors.
+        pub const NR: usize = #nr;
+        /// The accumulated regressors, as indices into `common::REGRESSORS`.
+        pub const REGRESSOR_IDS: [usize; NR] = [#(#regs),*];
+    }
+}
+
+/// The step-mean accumulator of the model's regressors (struct and slice form).
+fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
+    let regs = layout.regressors(spec);
+    let (uses_f, uses_w) = signals_used(spec, &regs);
+    let (f, w) = (param("f", uses_f), param("w", uses_w));
+    let sum = param("sum", !regs.is_empty());
+    let reg_add = regs.iter().enumerate().map(|(k, &r)| {
+        let ast = &spec.regressors[r].expr.ast;
+        quote!(self.sum[#k] += #ast;)
+    });
+    let reg_add_dyn = regs.iter().enumerate().map(|(k, &r)| {
+        let ast = &spec.regressors[r].expr.ast;
+        quote!(sum[#k] += #ast;)
+    });
+    let sum_array = if regs.is_empty() {
+        quote!()
+    } else {
+        quote!(let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");)
+    };
+    quote! {
+        /// Step means of this model's regressors over the IMU samples of one filter step.
+        #[derive(Debug, Clone, Default)]
+        pub struct Regressors {
+            sum: [f64; NR],
+            count: u32,
+        }
+
+        impl Regressors {
+            /// Adds one IMU sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
+            #[inline]
+            pub fn add(&mut self, #f: &Vector3<f64>, #w: &Vector3<f64>) {
+                #(#reg_add)*
+                self.count += 1;
+            }
+            /// Mean of each regressor (mean of squares, never square of means); zeros when empty.
+            pub fn mean(&self) -> [f64; NR] {
+                let mut m = self.sum;
+                if self.count > 0 {
+                    let k = 1.0 / self.count as f64;
+                    for v in m.iter_mut() {
+                        *v *= k;
+                    }
+                }
+                m
+            }
+            /// Number of samples added.
+            pub fn count(&self) -> u32 {
+                self.count
+            }
+            /// Starts a new filter step.
+            pub fn reset(&mut self) {
+                *self = Self::default();
+            }
+        }
+
+        /// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
+        pub fn accumulate_dyn(#sum: &mut [f64], #f: &Vector3<f64>, #w: &Vector3<f64>) {
+            #sum_array
+            #(#reg_add_dyn)*
+        }
+    }
+}
+
+/// `fill_a`: one line per structural non-zero, the spec's expression above it where it differs.
+fn preset_fill_a(names: &[String], entries: &[SymEntry], nr: usize) -> TokenStream {
     let refs: Vec<&SymEntry> = entries.iter().collect();
     let binds = bindings(&refs);
     let a_lines = entries.iter().map(|e| {
         let (r, c) = (const_name(&names[e.row]), const_name(&names[e.col]));
-        let cm = comment(&format!(
-            "A[{}][{}] = {}",
-            names[e.row], names[e.col], e.comment
-        ));
         let v = &e.value;
+        let label = format!("A[{}][{}]", names[e.row], names[e.col]);
+        let cm = entry_comment(&label, &e.comment, v);
         quote!(#cm a[#r][#c] = #v;)
     });
+    let r = param("r", nr > 0);
+    quote! {
+        /// Writes the structural non-zeros of A(t) at `nav` with regressor step means `r`.
+        pub fn fill_a(nav: &NavPoint, #r: &[f64; NR], a: &mut [[f64; N]; N]) {
+            #binds
+            #(#a_lines)*
+        }
 
-    // H per measurement available in this model
-    let mut h_fns = Vec::new();
-    let mut meas_names = Vec::new();
-    let mut h_dyn_arms = Vec::new();
-    for (m, meas) in spec.measurements.iter().enumerate() {
-        if let Some(h) = layout.h_entries(spec, m) {
-            let rows = meas.rows.len();
-            let f = format_ident!("fill_h_{}", meas.name);
-            let hrefs: Vec<&SymEntry> = h.iter().collect();
-            let hb = bindings(&hrefs);
-            let lines = h.iter().map(|e| {
-                let row = e.row;
-                let c = const_name(&names[e.col]);
-                let cm = comment(&format!(
-                    "H[{}][{}] = {}",
-                    meas.rows[row].name, names[e.col], e.comment
-                ));
-                let v = &e.value;
-                quote!(#cm h[#row][#c] = #v;)
-            });
-            let doc = format!(
-                " Writes the non-zeros of H for `{}`: {}.",
-                meas.name, meas.doc
-            );
-            h_fns.push(quote! {
-                #[doc = #doc]
-                pub fn #f(nav: &NavPoint, h: &mut [[f64; N]; #rows]) {
-                    let _ = nav;
-                    #hb
-                    #(#lines)*
-                }
-            });
-            let mname = &meas.name;
-            h_dyn_arms.push(quote! {
-                if name == #mname {
-                    let mut m = [[0.0; N]; #rows];
-                    #f(nav, &mut m);
-                    for (i, row) in m.iter().enumerate() {
-                        h[i * N..(i + 1) * N].copy_from_slice(row);
-                    }
-                    return true;
-                }
-            });
-            meas_names.push(meas.name.clone());
+        /// `fill_a` on slices: `r` holds NR step means, `a` is N×N row-major (zeroed by the caller).
+        pub fn fill_a_dyn(nav: &NavPoint, r: &[f64], a: &mut [f64]) {
+            let r: &[f64; NR] = r.try_into().expect("regressor means of length NR");
+            let a: &mut [[f64; N]; N] = a.as_chunks_mut::<N>().0.try_into().expect("A of N×N");
+            fill_a(nav, r, a);
         }
     }
+}
 
-    // covariance kernel
-    let phi = phi_pattern(n, &pattern);
+/// `fill_h_<measurement>` for every measurement whose states the model has, and `fill_h_dyn`.
+fn preset_fill_h(spec: &Spec, layout: &Layout, names: &[String]) -> TokenStream {
+    let mut h_fns = Vec::new();
+    let mut h_dyn_arms = Vec::new();
+    for (m, meas) in spec.measurements.iter().enumerate() {
+        let Some(h) = layout.h_entries(spec, m) else {
+            continue;
+        };
+        let rows = meas.rows.len();
+        let f = format_ident!("fill_h_{}", meas.name);
+        let hrefs: Vec<&SymEntry> = h.iter().collect();
+        let hb = bindings(&hrefs);
+        let nav = param("nav", !hb.is_empty());
+        let lines = h.iter().map(|e| {
+            let row = e.row;
+            let c = const_name(&names[e.col]);
+            let v = &e.value;
+            let label = format!("H[{}][{}]", meas.rows[row].name, names[e.col]);
+            let cm = entry_comment(&label, &e.comment, v);
+            quote!(#cm h[#row][#c] = #v;)
+        });
+        let doc = format!(
+            " Writes the non-zeros of H for `{}`: {}.",
+            meas.name, meas.doc
+        );
+        h_fns.push(quote! {
+            #[doc = #doc]
+            pub fn #f(#nav: &NavPoint, h: &mut [[f64; N]; #rows]) {
+                #hb
+                #(#lines)*
+            }
+        });
+        let mname = &meas.name;
+        h_dyn_arms.push(quote! {
+            if name == #mname {
+                let mut m = [[0.0; N]; #rows];
+                #f(nav, &mut m);
+                for (i, row) in m.iter().enumerate() {
+                    h[i * N..(i + 1) * N].copy_from_slice(row);
+                }
+                return true;
+            }
+        });
+    }
+    let any = !h_dyn_arms.is_empty();
+    let (name, nav, h) = (param("name", any), param("nav", any), param("h", any));
+    quote! {
+        #(#h_fns)*
+
+        /// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
+        pub fn fill_h_dyn(#name: &str, #nav: &NavPoint, #h: &mut [f64]) -> bool {
+            #(#h_dyn_arms)*
+            false
+        }
+    }
+}
+
+/// The covariance kernel: B = Φ − I on its pattern, P ← Φ P Φᵀ + diag(q)·dt, x ← Φ x.
+fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenStream {
+    let n = names.len();
+    let phi = phi_pattern(n, pattern);
     let nd = phi.rows.len();
     let dyn_rows = phi.rows.iter().map(|r| const_name(&names[*r]));
     let b_cols = phi.rows.iter().map(|&i| {
@@ -515,6 +678,12 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
         quote!(&[#(#cols),*])
     });
     let b_nnz = phi.entries.len();
+    let second_order = phi.entries.iter().any(|e| !e.3.is_empty());
+    let half = if second_order {
+        quote!(let half_dt2 = 0.5 * dt * dt;)
+    } else {
+        quote!()
+    };
     let b_lines = phi.rows.iter().enumerate().map(|(rd, &i)| {
         let cm = comment(&format!("row {}", names[i]));
         let ri = const_name(&names[i]);
@@ -541,80 +710,7 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
             });
         quote!(#cm #(#lines)*)
     });
-
-    let tokens = quote! {
-        use super::common::NAV_COUNT;
-        use crate::model::catalog::StateRef;
-        use crate::nav::nav_point::NavPoint;
-        use nalgebra::Vector3;
-
-        /// Model name.
-        pub const NAME: &str = #name;
-        /// True when the vertical channel (dv_d, dh) is present.
-        pub const VERTICAL: bool = #vertical;
-        /// Number of states.
-        pub const N: usize = #n;
-        #(#consts)*
-        /// State names in order.
-        pub const STATES: [&str; N] = [#(#names),*];
-        /// What each state is, as indices into the common catalogue.
-        pub const STATE_REFS: [StateRef; N] = [#(#state_refs),*];
-        /// Number of structural non-zeros of A.
-        pub const A_NNZ: usize = #nnz;
-        /// Structural non-zeros of A, row-major.
-        pub const A_PATTERN: [(usize, usize); A_NNZ] = [#(#pat_tokens),*];
-        /// Measurements this model supports.
-        pub const MEASUREMENTS: [&str; #n_meas] = [#(#meas_names),*];
-        /// Number of accumulated regressors.
-        pub const NR: usize = #nr;
-        /// The accumulated regressors, as indices into `common::REGRESSORS`.
-        pub const REGRESSOR_IDS: [usize; NR] = [#(#reg_ids),*];
-
-        /// Step means of this model's regressors over the IMU samples of one filter step.
-        #[derive(Debug, Clone, Default)]
-        pub struct Regressors {
-            sum: [f64; NR],
-            count: u32,
-        }
-
-        impl Regressors {
-            /// Adds one IMU sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
-            #[inline]
-            pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
-                let _ = (f, w);
-                #(#reg_add)*
-                self.count += 1;
-            }
-            /// Mean of each regressor (mean of squares, never square of means); zeros when empty.
-            pub fn mean(&self) -> [f64; NR] {
-                let mut m = self.sum;
-                if self.count > 0 {
-                    let k = 1.0 / self.count as f64;
-                    for v in m.iter_mut() {
-                        *v *= k;
-                    }
-                }
-                m
-            }
-            /// Number of samples added.
-            pub fn count(&self) -> u32 {
-                self.count
-            }
-            /// Starts a new filter step.
-            pub fn reset(&mut self) {
-                *self = Self::default();
-            }
-        }
-
-        /// Writes the structural non-zeros of A(t) at `nav` with regressor step means `r`.
-        pub fn fill_a(nav: &NavPoint, r: &[f64; NR], a: &mut [[f64; N]; N]) {
-            let _ = r;
-            #binds
-            #(#a_lines)*
-        }
-
-        #(#h_fns)*
-
+    quote! {
         /// Number of rows of Φ that differ from the identity (the navigation rows).
         pub const ND: usize = #nd;
         /// Those rows.
@@ -626,8 +722,7 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
 
         /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows (second-order series; dt in s).
         pub fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
-            let half_dt2 = 0.5 * dt * dt;
-            let _ = half_dt2;
+            #half
             #(#b_lines)*
         }
 
@@ -726,27 +821,6 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
             }
         }
 
-        /// `fill_a` on slices: `r` holds NR step means, `a` is N×N row-major (zeroed by the caller).
-        pub fn fill_a_dyn(nav: &NavPoint, r: &[f64], a: &mut [f64]) {
-            let r: &[f64; NR] = r.try_into().expect("regressor means of length NR");
-            let a: &mut [[f64; N]; N] = a.as_chunks_mut::<N>().0.try_into().expect("A of N×N");
-            fill_a(nav, r, a);
-        }
-
-        /// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
-        pub fn accumulate_dyn(sum: &mut [f64], f: &Vector3<f64>, w: &Vector3<f64>) {
-            let _ = (f, w);
-            let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");
-            let _ = &sum;
-            #(#reg_add_dyn)*
-        }
-
-        /// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
-        pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
-            let _ = (nav, &h);
-            #(#h_dyn_arms)*
-            false
-        }
 
         /// `propagate_cov` on slices: `a` and `p` are N×N row-major, `q` has N entries.
         pub fn propagate_cov_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
@@ -764,10 +838,7 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
             let x: &mut [f64; N] = x.try_into().expect("x of length N");
             propagate_cov_and_state(a, dt, q, p, x);
         }
-
-        const _: () = assert!(ND <= NAV_COUNT);
-    };
-    format_file(tokens)
+    }
 }
 
 /// The root file included by the main crate: one module per generated file plus a preset table.

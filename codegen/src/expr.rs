@@ -77,6 +77,12 @@ impl Expr {
         out
     }
 
+    /// Physical dimension of a regressor expression (f in m/s², w in rad/s); errors name a sum
+    /// of unlike dimensions, a fractional power or a trigonometric function of a dimensioned value.
+    pub fn dimension(&self) -> Result<crate::units::Dim, String> {
+        dimension(&self.ast)
+    }
+
     /// True when the expression is the literal `1` or `1.0`.
     pub fn is_one(&self) -> bool {
         matches!(self.source.as_str(), "1" | "1.0")
@@ -106,6 +112,58 @@ fn collect(e: &syn::Expr, out: &mut BTreeSet<String>) {
             }
         }
         _ => {}
+    }
+}
+
+fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
+    use crate::units::{DIM_ACCEL, DIM_ONE, DIM_RATE};
+    match e {
+        syn::Expr::Lit(_) => Ok(DIM_ONE),
+        syn::Expr::Field(f) => match &*f.base {
+            syn::Expr::Path(p) if p.path.is_ident("f") => Ok(DIM_ACCEL),
+            syn::Expr::Path(p) if p.path.is_ident("w") => Ok(DIM_RATE),
+            _ => Err(format!("no dimension for `{}`", f.to_token_stream())),
+        },
+        syn::Expr::Path(p) => Err(format!("no dimension for `{}`", p.to_token_stream())),
+        syn::Expr::Binary(b) => {
+            let (l, r) = (dimension(&b.left)?, dimension(&b.right)?);
+            match b.op {
+                syn::BinOp::Mul(_) => Ok(l.mul(r)),
+                syn::BinOp::Div(_) => Ok(l.div(r)),
+                _ if l == r => Ok(l),
+                _ => Err(format!(
+                    "`{}` adds or subtracts unlike dimensions [{l}] and [{r}]",
+                    b.to_token_stream()
+                )),
+            }
+        }
+        syn::Expr::Unary(u) => dimension(&u.expr),
+        syn::Expr::Paren(p) => dimension(&p.expr),
+        syn::Expr::MethodCall(m) => {
+            let d = dimension(&m.receiver)?;
+            match m.method.to_string().as_str() {
+                "abs" => Ok(d),
+                "sqrt" => d
+                    .sqrt()
+                    .ok_or_else(|| format!("`sqrt` of [{d}] has a fractional dimension")),
+                "powi" => {
+                    let k = match m.args.first() {
+                        Some(syn::Expr::Lit(syn::ExprLit {
+                            lit: syn::Lit::Int(i),
+                            ..
+                        })) => i.base10_parse::<i32>().map_err(|e| e.to_string())?,
+                        _ => return Err("`powi` takes one integer literal".into()),
+                    };
+                    Ok(d.powi(k))
+                }
+                name if d.is_dimensionless_or_angle() => {
+                    let _ = name;
+                    Ok(DIM_ONE)
+                }
+                name => Err(format!("`{name}` of a dimensioned value [{d}]")),
+            }
+        }
+        other => Err(format!("no dimension for `{}`", other.to_token_stream())),
     }
 }
 
@@ -239,6 +297,19 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                     );
                 if !ok {
                     return Err("`powi` takes one integer literal".into());
+                }
+                let k = match m.args.first() {
+                    Some(syn::Expr::Lit(syn::ExprLit {
+                        lit: syn::Lit::Int(i),
+                        ..
+                    })) => i.base10_parse::<i32>().ok(),
+                    _ => None,
+                };
+                if !k.is_some_and(|k| k.abs() <= crate::units::MAX_POWER) {
+                    return Err(format!(
+                        "`powi` exponent out of range (|n| <= {})",
+                        crate::units::MAX_POWER
+                    ));
                 }
             } else if !m.args.is_empty() {
                 return Err(format!("`{name}` takes no arguments"));

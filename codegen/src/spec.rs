@@ -72,8 +72,21 @@ pub struct NavState {
     pub sigma: f64,
     /// Present only with `+vertical`.
     pub vertical: bool,
+    /// Which white sensor noise drives the state (its process noise).
+    pub white_noise: WhiteNoise,
     /// One-line description.
     pub doc: String,
+}
+
+/// The white sensor noise that drives a navigation state (`white_noise` in navigation.toml).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WhiteNoise {
+    /// No white noise enters the state directly.
+    None,
+    /// Gyro angle random walk (attitude rows).
+    GyroArw,
+    /// Accelerometer velocity random walk (velocity rows).
+    AccelVrw,
 }
 
 /// A non-zero entry of the navigation block of A(t).
@@ -234,6 +247,8 @@ struct RawState {
     sigma: String,
     #[serde(default)]
     vertical: bool,
+    #[serde(default)]
+    white_noise: Option<Spanned<String>>,
     doc: String,
 }
 
@@ -318,14 +333,20 @@ struct RawHEntry {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawPresets {
-    preset: toml::map::Map<String, toml::Value>,
+    preset: Vec<RawPreset>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawPreset {
+    name: Spanned<String>,
     doc: String,
-    states: Vec<String>,
+    #[serde(default)]
+    states: Option<Vec<String>>,
+    #[serde(default)]
+    base: Option<Spanned<String>>,
+    #[serde(default)]
+    terms: Vec<String>,
 }
 
 // ---------------------------------------------------------------- loading
@@ -409,344 +430,26 @@ fn quantity(
 }
 
 impl Spec {
-    /// Reads and validates the spec in `dir` (the four files of [`SPEC_FILES`]).
+    /// Reads and validates the spec in `dir` (the four files of [`SPEC_FILES`]), one file and
+    /// one kind of item at a time; the first problem found is returned.
     pub fn load(dir: &Path) -> Result<Spec, SpecError> {
         let nav_src = Source::read(dir, SPEC_FILES[0])?;
         let terms_src = Source::read(dir, SPEC_FILES[1])?;
         let meas_src = Source::read(dir, SPEC_FILES[2])?;
         let preset_src = Source::read(dir, SPEC_FILES[3])?;
-
         let raw_nav: RawNavigation = nav_src.parse()?;
         let raw_terms: RawTerms = terms_src.parse()?;
         let raw_meas: RawMeasurements = meas_src.parse()?;
         let raw_presets: RawPresets = preset_src.parse()?;
 
         let mut names: HashMap<String, String> = HashMap::new();
-
-        // navigation states
-        let mut nav_states = Vec::new();
-        for s in &raw_nav.state {
-            let item = format!("state `{}`", s.name.get_ref());
-            check_name(&nav_src, &s.name, "state")?;
-            if names
-                .insert(s.name.get_ref().clone(), "navigation.toml".into())
-                .is_some()
-            {
-                return Err(nav_src.error(s.name.span(), &item, "duplicate name"));
-            }
-            let unit = units::parse_unit(&s.unit)
-                .map_err(|e| nav_src.error(s.name.span(), &item, format!("unit: {e}")))?;
-            let display = units::parse_unit(&s.display)
-                .map_err(|e| nav_src.error(s.name.span(), &item, format!("display: {e}")))?;
-            if unit.dim != display.dim {
-                return Err(nav_src.error(
-                    s.name.span(),
-                    &item,
-                    format!(
-                        "display unit `{}` does not match unit `{}`",
-                        s.display, s.unit
-                    ),
-                ));
-            }
-            let sigma = units::parse_quantity_as(&s.sigma, &s.unit)
-                .map_err(|e| nav_src.error(s.name.span(), &item, format!("sigma: {e}")))?;
-            nav_states.push(NavState {
-                name: s.name.get_ref().clone(),
-                unit: s.unit.clone(),
-                display: s.display.clone(),
-                display_to_si: display.to_si / unit.to_si,
-                sigma,
-                vertical: s.vertical,
-                doc: s.doc.clone(),
-            });
-        }
-        let nav_index = |n: &str| nav_states.iter().position(|s| s.name == n);
-
-        // navigation block
-        let mut nav_entries: Vec<NavEntry> = Vec::new();
-        for e in &raw_nav.a {
-            let item = format!("A entry ({}, {})", e.row.get_ref(), e.col.get_ref());
-            let row = nav_index(e.row.get_ref()).ok_or_else(|| {
-                nav_src.error(
-                    e.row.span(),
-                    &item,
-                    format!("unknown state `{}`", e.row.get_ref()),
-                )
-            })?;
-            let col = nav_index(e.col.get_ref()).ok_or_else(|| {
-                nav_src.error(
-                    e.col.span(),
-                    &item,
-                    format!("unknown state `{}`", e.col.get_ref()),
-                )
-            })?;
-            if nav_entries.iter().any(|x| x.row == row && x.col == col) {
-                return Err(nav_src.error(e.row.span(), &item, "duplicate entry"));
-            }
-            let expr = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
-                .map_err(|m| nav_src.error(e.expr.span(), &item, m))?;
-            nav_entries.push(NavEntry { row, col, expr });
-        }
-
-        let rows = |list: &Spanned<Vec<String>>, what: &str| -> Result<Vec<usize>, SpecError> {
-            if list.get_ref().len() != 3 {
-                return Err(nav_src.error(
-                    list.span(),
-                    "compose",
-                    format!("{what} needs 3 rows (N, E, D)"),
-                ));
-            }
-            list.get_ref()
-                .iter()
-                .map(|n| {
-                    nav_index(n).ok_or_else(|| {
-                        nav_src.error(
-                            list.span(),
-                            "compose",
-                            format!("{what}: unknown state `{n}`"),
-                        )
-                    })
-                })
-                .collect()
-        };
-        let compose = Compose {
-            gyro_rows: rows(&raw_nav.compose.gyro_rows, "gyro_rows")?,
-            gyro_sign: raw_nav.compose.gyro_sign,
-            accel_rows: rows(&raw_nav.compose.accel_rows, "accel_rows")?,
-            accel_sign: raw_nav.compose.accel_sign,
-        };
-        for (sign, what) in [
-            (compose.gyro_sign, "gyro_sign"),
-            (compose.accel_sign, "accel_sign"),
-        ] {
-            if sign != 1 && sign != -1 {
-                return Err(nav_src.error(0..0, "compose", format!("{what} must be 1 or -1")));
-            }
-        }
-        let sensor_noise = SensorNoise {
-            gyro_arw: quantity(
-                &nav_src,
-                &raw_nav.sensor_noise.gyro_arw,
-                "rad/sqrt(s)",
-                "sensor_noise",
-                "gyro_arw",
-            )?,
-            accel_vrw: quantity(
-                &nav_src,
-                &raw_nav.sensor_noise.accel_vrw,
-                "m/s/sqrt(s)",
-                "sensor_noise",
-                "accel_vrw",
-            )?,
-        };
-
-        // terms
-        let mut terms = Vec::new();
-        let mut regressors: Vec<Regressor> = Vec::new();
-        for t in &raw_terms.term {
-            let item = format!("term `{}`", t.name.get_ref());
-            check_name(&terms_src, &t.name, "term")?;
-            if let Some(prev) = names.insert(t.name.get_ref().clone(), "terms.toml".into()) {
-                return Err(terms_src.error(
-                    t.name.span(),
-                    &item,
-                    format!("duplicate name (already defined in {prev})"),
-                ));
-            }
-            let sensor = match t.sensor.get_ref().as_str() {
-                "gyro" => Sensor::Gyro,
-                "accel" => Sensor::Accel,
-                other => {
-                    return Err(terms_src.error(
-                        t.sensor.span(),
-                        &item,
-                        format!("unknown sensor `{other}` (expected `gyro` or `accel`)"),
-                    ))
-                }
-            };
-            let axis = match t.axis.get_ref().as_str() {
-                "x" => 0,
-                "y" => 1,
-                "z" => 2,
-                other => {
-                    return Err(terms_src.error(
-                        t.axis.span(),
-                        &item,
-                        format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
-                    ))
-                }
-            };
-            let rexpr = expr::parse(t.regressor.get_ref(), ExprKind::Regressor).map_err(|m| {
-                terms_src.error(t.regressor.span(), &item, format!("regressor: {m}"))
-            })?;
-            let key = rexpr.key();
-            let regressor = match regressors.iter().position(|r| r.expr.key() == key) {
-                Some(i) => i,
-                None => {
-                    let constant = rexpr.symbols().is_empty();
-                    regressors.push(Regressor {
-                        expr: rexpr,
-                        constant,
-                    });
-                    regressors.len() - 1
-                }
-            };
-            let unit = units::parse_unit(t.unit.get_ref())
-                .map_err(|e| terms_src.error(t.unit.span(), &item, format!("unit: {e}")))?;
-            let display = units::parse_unit(t.display.get_ref())
-                .map_err(|e| terms_src.error(t.display.span(), &item, format!("display: {e}")))?;
-            if unit.dim != display.dim {
-                return Err(terms_src.error(
-                    t.display.span(),
-                    &item,
-                    format!(
-                        "display unit `{}` does not match unit `{}`",
-                        t.display.get_ref(),
-                        t.unit.get_ref()
-                    ),
-                ));
-            }
-            let sigma = quantity(&terms_src, &t.sigma, t.unit.get_ref(), &item, "sigma")?;
-            let noise = match &t.noise {
-                Some(n) => quantity(
-                    &terms_src,
-                    n,
-                    &format!("({})/sqrt(s)", t.unit.get_ref()).replace("(1)/", "1/"),
-                    &item,
-                    "noise",
-                )?,
-                None => 0.0,
-            };
-            terms.push(Term {
-                name: t.name.get_ref().clone(),
-                sensor,
-                axis,
-                regressor,
-                unit: t.unit.get_ref().clone(),
-                display: t.display.get_ref().clone(),
-                display_to_si: display.to_si / unit.to_si,
-                sigma,
-                noise,
-                group: t.group.clone(),
-                doc: t.doc.clone(),
-                library: t.library,
-            });
-        }
-
-        // measurements
-        let mut measurements = Vec::new();
-        for m in &raw_meas.measurement {
-            let item = format!("measurement `{}`", m.name.get_ref());
-            check_name(&meas_src, &m.name, "measurement")?;
-            if measurements
-                .iter()
-                .any(|x: &Measurement| &x.name == m.name.get_ref())
-            {
-                return Err(meas_src.error(m.name.span(), &item, "duplicate name"));
-            }
-            let first_unit = m.rows.first().map(|r| r.unit.clone()).unwrap_or_default();
-            let sigma = quantity(&meas_src, &m.sigma, &first_unit, &item, "sigma")?;
-            let mut rows = Vec::new();
-            for r in &m.rows {
-                let mut h = Vec::new();
-                for e in &r.h {
-                    if !names.contains_key(e.state.get_ref()) {
-                        return Err(meas_src.error(
-                            e.state.span(),
-                            &item,
-                            format!("unknown state `{}`", e.state.get_ref()),
-                        ));
-                    }
-                    let expr = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
-                        .map_err(|msg| meas_src.error(e.expr.span(), &item, msg))?;
-                    h.push(HEntry {
-                        state: e.state.get_ref().clone(),
-                        expr,
-                    });
-                }
-                rows.push(MeasRow {
-                    name: r.name.clone(),
-                    unit: r.unit.clone(),
-                    h,
-                });
-            }
-            measurements.push(Measurement {
-                name: m.name.get_ref().clone(),
-                doc: m.doc.clone(),
-                sigma,
-                rows,
-            });
-        }
-
-        // presets
-        let horizontal: Vec<&str> = nav_states
-            .iter()
-            .filter(|s| !s.vertical)
-            .map(|s| s.name.as_str())
-            .collect();
-        let mut presets = Vec::new();
-        for (name, value) in raw_presets.preset.iter() {
-            let line_span = preset_src
-                .text
-                .find(&format!("[preset.{name}]"))
-                .map(|i| i..i)
-                .unwrap_or(0..0);
-            let item = format!("preset `{name}`");
-            let raw: RawPreset = value.clone().try_into().map_err(|e: toml::de::Error| {
-                preset_src.error(line_span.clone(), &item, e.message().trim())
-            })?;
-            let mut seen = BTreeSet::new();
-            for s in &raw.states {
-                if !seen.insert(s.as_str()) {
-                    return Err(preset_src.error(
-                        line_span.clone(),
-                        &item,
-                        format!("state `{s}` listed twice"),
-                    ));
-                }
-                if !names.contains_key(s) {
-                    return Err(preset_src.error(
-                        line_span.clone(),
-                        &item,
-                        format!("names missing term `{s}` (not a state of navigation.toml nor a term of terms.toml)"),
-                    ));
-                }
-                if nav_states.iter().any(|n| &n.name == s && n.vertical) {
-                    return Err(preset_src.error(
-                        line_span.clone(),
-                        &item,
-                        format!("vertical state `{s}` cannot be listed; write the model as `{name}+vertical`"),
-                    ));
-                }
-            }
-            if raw.states.len() < horizontal.len()
-                || raw.states[..horizontal.len()]
-                    .iter()
-                    .map(String::as_str)
-                    .ne(horizontal.iter().copied())
-            {
-                return Err(preset_src.error(
-                    line_span.clone(),
-                    &item,
-                    format!(
-                        "must start with the navigation states {}",
-                        horizontal.join(" ")
-                    ),
-                ));
-            }
-            presets.push(Preset {
-                name: name.clone(),
-                doc: raw.doc,
-                states: raw.states,
-            });
-        }
-        presets.sort_by_key(|p| {
-            preset_src
-                .text
-                .find(&format!("[preset.{}]", p.name))
-                .unwrap_or(usize::MAX)
-        });
-
+        let nav_states = load_nav_states(&nav_src, &raw_nav.state, &mut names)?;
+        let nav_entries = load_nav_entries(&nav_src, &raw_nav.a, &nav_states)?;
+        let compose = load_compose(&nav_src, &raw_nav.compose, &nav_states)?;
+        let sensor_noise = load_sensor_noise(&nav_src, &raw_nav.sensor_noise)?;
+        let (terms, regressors) = load_terms(&terms_src, &raw_terms.term, &mut names)?;
+        let measurements = load_measurements(&meas_src, &raw_meas.measurement, &names)?;
+        let presets = load_presets(&preset_src, &raw_presets.preset, &nav_states, &terms, &names)?;
         Ok(Spec {
             dir: dir.to_path_buf(),
             nav_states,
@@ -769,4 +472,455 @@ impl Spec {
     pub fn nav_index(&self, name: &str) -> Option<usize> {
         self.nav_states.iter().position(|s| s.name == name)
     }
+}
+
+// ---------------------------------------------------------------- loading, step by step
+
+/// Navigation states: names, units, priors and the white noise that drives each.
+fn load_nav_states(
+    src: &Source,
+    raw: &[RawState],
+    names: &mut HashMap<String, String>,
+) -> Result<Vec<NavState>, SpecError> {
+    let mut nav_states = Vec::new();
+    for s in raw {
+        let item = format!("state `{}`", s.name.get_ref());
+        check_name(src, &s.name, "state")?;
+        if names
+            .insert(s.name.get_ref().clone(), "navigation.toml".into())
+            .is_some()
+        {
+            return Err(src.error(s.name.span(), &item, "duplicate name"));
+        }
+        let unit = units::parse_unit(&s.unit)
+            .map_err(|e| src.error(s.name.span(), &item, format!("unit: {e}")))?;
+        let display = units::parse_unit(&s.display)
+            .map_err(|e| src.error(s.name.span(), &item, format!("display: {e}")))?;
+        if unit.dim != display.dim {
+            return Err(src.error(
+                s.name.span(),
+                &item,
+                format!(
+                    "display unit `{}` does not match unit `{}`",
+                    s.display, s.unit
+                ),
+            ));
+        }
+        let sigma = units::parse_quantity_as(&s.sigma, &s.unit)
+            .map_err(|e| src.error(s.name.span(), &item, format!("sigma: {e}")))?;
+        let white_noise = match s.white_noise.as_ref().map(|w| w.get_ref().as_str()) {
+            None => WhiteNoise::None,
+            Some("gyro_arw") => WhiteNoise::GyroArw,
+            Some("accel_vrw") => WhiteNoise::AccelVrw,
+            Some(other) => {
+                let span = s.white_noise.as_ref().map(|w| w.span()).unwrap_or(0..0);
+                return Err(src.error(
+                    span,
+                    &item,
+                    format!("white_noise: unknown source `{other}` (expected `gyro_arw` or `accel_vrw`, keys of [sensor_noise])"),
+                ));
+            }
+        };
+        let expected_dim = match white_noise {
+            WhiteNoise::None => None,
+            WhiteNoise::GyroArw => Some(("rad", units::parse_unit("rad").map(|u| u.dim))),
+            WhiteNoise::AccelVrw => Some(("m/s", units::parse_unit("m/s").map(|u| u.dim))),
+        };
+        if let Some((want, Ok(dim))) = expected_dim {
+            if dim != unit.dim {
+                return Err(src.error(
+                    s.name.span(),
+                    &item,
+                    format!(
+                        "white_noise: a state in `{}` cannot be driven by a density whose integral is in `{want}`",
+                        s.unit
+                    ),
+                ));
+            }
+        }
+        nav_states.push(NavState {
+            name: s.name.get_ref().clone(),
+            unit: s.unit.clone(),
+            display: s.display.clone(),
+            display_to_si: display.to_si / unit.to_si,
+            sigma,
+            vertical: s.vertical,
+            white_noise,
+            doc: s.doc.clone(),
+        });
+    }
+    Ok(nav_states)
+}
+
+fn nav_index(nav_states: &[NavState], name: &str) -> Option<usize> {
+    nav_states.iter().position(|s| s.name == name)
+}
+
+/// The navigation block of A(t): one validated expression per non-zero.
+fn load_nav_entries(
+    src: &Source,
+    raw: &[RawEntry],
+    nav_states: &[NavState],
+) -> Result<Vec<NavEntry>, SpecError> {
+    let mut nav_entries: Vec<NavEntry> = Vec::new();
+    for e in raw {
+        let item = format!("A entry ({}, {})", e.row.get_ref(), e.col.get_ref());
+        let state = |s: &Spanned<String>| {
+            nav_index(nav_states, s.get_ref()).ok_or_else(|| {
+                src.error(s.span(), &item, format!("unknown state `{}`", s.get_ref()))
+            })
+        };
+        let (row, col) = (state(&e.row)?, state(&e.col)?);
+        if nav_entries.iter().any(|x| x.row == row && x.col == col) {
+            return Err(src.error(e.row.span(), &item, "duplicate entry"));
+        }
+        let expr = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
+            .map_err(|m| src.error(e.expr.span(), &item, m))?;
+        nav_entries.push(NavEntry { row, col, expr });
+    }
+    Ok(nav_entries)
+}
+
+/// The composition rule: which rows gyro and accelerometer columns fill, with which sign.
+fn load_compose(
+    src: &Source,
+    raw: &RawCompose,
+    nav_states: &[NavState],
+) -> Result<Compose, SpecError> {
+    let rows = |list: &Spanned<Vec<String>>, what: &str| -> Result<Vec<usize>, SpecError> {
+        if list.get_ref().len() != 3 {
+            return Err(src.error(
+                list.span(),
+                "compose",
+                format!("{what} needs 3 rows (N, E, D)"),
+            ));
+        }
+        list.get_ref()
+            .iter()
+            .map(|n| {
+                nav_index(nav_states, n).ok_or_else(|| {
+                    src.error(list.span(), "compose", format!("{what}: unknown state `{n}`"))
+                })
+            })
+            .collect()
+    };
+    let compose = Compose {
+        gyro_rows: rows(&raw.gyro_rows, "gyro_rows")?,
+        gyro_sign: raw.gyro_sign,
+        accel_rows: rows(&raw.accel_rows, "accel_rows")?,
+        accel_sign: raw.accel_sign,
+    };
+    for (sign, what) in [
+        (compose.gyro_sign, "gyro_sign"),
+        (compose.accel_sign, "accel_sign"),
+    ] {
+        if sign != 1 && sign != -1 {
+            return Err(src.error(0..0, "compose", format!("{what} must be 1 or -1")));
+        }
+    }
+    Ok(compose)
+}
+
+/// The white sensor noise densities.
+fn load_sensor_noise(src: &Source, raw: &RawSensorNoise) -> Result<SensorNoise, SpecError> {
+    Ok(SensorNoise {
+        gyro_arw: quantity(src, &raw.gyro_arw, "rad/sqrt(s)", "sensor_noise", "gyro_arw")?,
+        accel_vrw: quantity(src, &raw.accel_vrw, "m/s/sqrt(s)", "sensor_noise", "accel_vrw")?,
+    })
+}
+
+/// Instrument error terms and the distinct regressors they use; each term's unit times its
+/// regressor's dimension must be the sensor's (rad/s for gyros, m/s² for accelerometers).
+fn load_terms(
+    src: &Source,
+    raw: &[RawTerm],
+    names: &mut HashMap<String, String>,
+) -> Result<(Vec<Term>, Vec<Regressor>), SpecError> {
+    let mut terms = Vec::new();
+    let mut regressors: Vec<Regressor> = Vec::new();
+    for t in raw {
+        let item = format!("term `{}`", t.name.get_ref());
+        check_name(src, &t.name, "term")?;
+        if let Some(prev) = names.insert(t.name.get_ref().clone(), "terms.toml".into()) {
+            return Err(src.error(
+                t.name.span(),
+                &item,
+                format!("duplicate name (already defined in {prev})"),
+            ));
+        }
+        let sensor = match t.sensor.get_ref().as_str() {
+            "gyro" => Sensor::Gyro,
+            "accel" => Sensor::Accel,
+            other => {
+                return Err(src.error(
+                    t.sensor.span(),
+                    &item,
+                    format!("unknown sensor `{other}` (expected `gyro` or `accel`)"),
+                ))
+            }
+        };
+        let axis = match t.axis.get_ref().as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            other => {
+                return Err(src.error(
+                    t.axis.span(),
+                    &item,
+                    format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
+                ))
+            }
+        };
+        let rexpr = expr::parse(t.regressor.get_ref(), ExprKind::Regressor)
+            .map_err(|m| src.error(t.regressor.span(), &item, format!("regressor: {m}")))?;
+        let unit = units::parse_unit(t.unit.get_ref())
+            .map_err(|e| src.error(t.unit.span(), &item, format!("unit: {e}")))?;
+        check_term_dimension(src, t, &item, sensor, &rexpr, unit.dim)?;
+        let key = rexpr.key();
+        let regressor = match regressors.iter().position(|r| r.expr.key() == key) {
+            Some(i) => i,
+            None => {
+                let constant = rexpr.symbols().is_empty();
+                regressors.push(Regressor {
+                    expr: rexpr,
+                    constant,
+                });
+                regressors.len() - 1
+            }
+        };
+        let display = units::parse_unit(t.display.get_ref())
+            .map_err(|e| src.error(t.display.span(), &item, format!("display: {e}")))?;
+        if unit.dim != display.dim {
+            return Err(src.error(
+                t.display.span(),
+                &item,
+                format!(
+                    "display unit `{}` does not match unit `{}`",
+                    t.display.get_ref(),
+                    t.unit.get_ref()
+                ),
+            ));
+        }
+        let sigma = quantity(src, &t.sigma, t.unit.get_ref(), &item, "sigma")?;
+        let noise = match &t.noise {
+            Some(n) => quantity(
+                src,
+                n,
+                &format!("({})/sqrt(s)", t.unit.get_ref()).replace("(1)/", "1/"),
+                &item,
+                "noise",
+            )?,
+            None => 0.0,
+        };
+        terms.push(Term {
+            name: t.name.get_ref().clone(),
+            sensor,
+            axis,
+            regressor,
+            unit: t.unit.get_ref().clone(),
+            display: t.display.get_ref().clone(),
+            display_to_si: display.to_si / unit.to_si,
+            sigma,
+            noise,
+            group: t.group.clone(),
+            doc: t.doc.clone(),
+            library: t.library,
+        });
+    }
+    Ok((terms, regressors))
+}
+
+/// Unit × regressor dimension = the sensor's dimension. Radians are compared loosely (an SI
+/// radian is dimensionless: ω² times a lever arm in m is an acceleration).
+fn check_term_dimension(
+    src: &Source,
+    t: &RawTerm,
+    item: &str,
+    sensor: Sensor,
+    regressor: &Expr,
+    unit: units::Dim,
+) -> Result<(), SpecError> {
+    let reg_dim = regressor
+        .dimension()
+        .map_err(|m| src.error(t.regressor.span(), item, format!("regressor: {m}")))?;
+    let (sensor_unit, sensor_name) = match sensor {
+        Sensor::Gyro => ("rad/s", "a gyro error"),
+        Sensor::Accel => ("m/s^2", "an accelerometer error"),
+    };
+    let want = units::parse_unit(sensor_unit).expect("sensor unit parses").dim;
+    let got = unit.mul(reg_dim);
+    if got.0[0] != want.0[0] || got.0[1] != want.0[1] {
+        return Err(src.error(
+            t.unit.span(),
+            item,
+            format!(
+                "unit `{}` times regressor `{}` [{}] is {}, but {sensor_name} is in {sensor_unit}: the unit should be {} ",
+                t.unit.get_ref(),
+                t.regressor.get_ref(),
+                reg_dim,
+                got,
+                want.div(reg_dim)
+            )
+            .trim_end()
+            .to_string(),
+        ));
+    }
+    Ok(())
+}
+
+/// Measurements: components with their H entries (states must exist) and default σ.
+fn load_measurements(
+    src: &Source,
+    raw: &[RawMeasurement],
+    names: &HashMap<String, String>,
+) -> Result<Vec<Measurement>, SpecError> {
+    let mut measurements: Vec<Measurement> = Vec::new();
+    for m in raw {
+        let item = format!("measurement `{}`", m.name.get_ref());
+        check_name(src, &m.name, "measurement")?;
+        if measurements.iter().any(|x| &x.name == m.name.get_ref()) {
+            return Err(src.error(m.name.span(), &item, "duplicate name"));
+        }
+        let first_unit = m.rows.first().map(|r| r.unit.clone()).unwrap_or_default();
+        let sigma = quantity(src, &m.sigma, &first_unit, &item, "sigma")?;
+        if !(sigma > 0.0 && sigma.is_finite()) {
+            return Err(src.error(m.sigma.span(), &item, "sigma must be positive and finite"));
+        }
+        let mut rows = Vec::new();
+        for r in &m.rows {
+            let mut h = Vec::new();
+            for e in &r.h {
+                if !names.contains_key(e.state.get_ref()) {
+                    return Err(src.error(
+                        e.state.span(),
+                        &item,
+                        format!("unknown state `{}`", e.state.get_ref()),
+                    ));
+                }
+                let expr = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
+                    .map_err(|msg| src.error(e.expr.span(), &item, msg))?;
+                h.push(HEntry {
+                    state: e.state.get_ref().clone(),
+                    expr,
+                });
+            }
+            rows.push(MeasRow {
+                name: r.name.clone(),
+                unit: r.unit.clone(),
+                h,
+            });
+        }
+        measurements.push(Measurement {
+            name: m.name.get_ref().clone(),
+            doc: m.doc.clone(),
+            sigma,
+            rows,
+        });
+    }
+    Ok(measurements)
+}
+
+/// Presets: `[[preset]]` entries with either the full `states` list or a `base` preset (defined
+/// earlier in the file) plus `terms`; every name is checked, none listed twice.
+fn load_presets(
+    src: &Source,
+    raw: &[RawPreset],
+    nav_states: &[NavState],
+    terms: &[Term],
+    names: &HashMap<String, String>,
+) -> Result<Vec<Preset>, SpecError> {
+    let horizontal: Vec<&str> = nav_states
+        .iter()
+        .filter(|s| !s.vertical)
+        .map(|s| s.name.as_str())
+        .collect();
+    let mut presets: Vec<Preset> = Vec::new();
+    for raw in raw {
+        let name = raw.name.get_ref();
+        let item = format!("preset `{name}`");
+        let span = raw.name.span();
+        let ok_name = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+            && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !ok_name || name.eq_ignore_ascii_case("vertical") {
+            return Err(src.error(
+                span,
+                &item,
+                "preset names are letters, digits and `_`, starting with a letter (and not `vertical`)",
+            ));
+        }
+        if presets.iter().any(|p| p.name.eq_ignore_ascii_case(name)) {
+            return Err(src.error(span, &item, "duplicate preset (names are case-insensitive)"));
+        }
+        if terms.iter().any(|t| t.name.eq_ignore_ascii_case(name)) {
+            return Err(src.error(span, &item, "a preset cannot have the name of a term"));
+        }
+        let states: Vec<String> = match (&raw.states, &raw.base) {
+            (Some(s), None) => {
+                if !raw.terms.is_empty() {
+                    return Err(src.error(span, &item, "give either `states`, or `base` and `terms`"));
+                }
+                s.clone()
+            }
+            (None, Some(base)) => {
+                let b = presets
+                    .iter()
+                    .find(|p| p.name.eq_ignore_ascii_case(base.get_ref()))
+                    .ok_or_else(|| {
+                        src.error(
+                            base.span(),
+                            &item,
+                            format!("base `{}` is not a preset defined above it", base.get_ref()),
+                        )
+                    })?;
+                let mut s = b.states.clone();
+                s.extend(raw.terms.iter().cloned());
+                s
+            }
+            _ => {
+                return Err(src.error(
+                    span,
+                    &item,
+                    "give either `states` (the full list) or `base` (a preset above) and `terms`",
+                ))
+            }
+        };
+        let mut seen = BTreeSet::new();
+        for s in &states {
+            if !seen.insert(s.as_str()) {
+                return Err(src.error(span.clone(), &item, format!("state `{s}` listed twice")));
+            }
+            if !names.contains_key(s) {
+                return Err(src.error(
+                    span.clone(),
+                    &item,
+                    format!("names missing term `{s}` (not a state of navigation.toml nor a term of terms.toml)"),
+                ));
+            }
+            if nav_states.iter().any(|n| &n.name == s && n.vertical) {
+                return Err(src.error(
+                    span.clone(),
+                    &item,
+                    format!("vertical state `{s}` cannot be listed; write the model as `{name}+vertical`"),
+                ));
+            }
+        }
+        if states.len() < horizontal.len()
+            || states[..horizontal.len()]
+                .iter()
+                .map(String::as_str)
+                .ne(horizontal.iter().copied())
+        {
+            return Err(src.error(
+                span,
+                &item,
+                format!("must start with the navigation states {}", horizontal.join(" ")),
+            ));
+        }
+        presets.push(Preset {
+            name: name.clone(),
+            doc: raw.doc.clone(),
+            states,
+        });
+    }
+    Ok(presets)
 }

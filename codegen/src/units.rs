@@ -26,7 +26,40 @@ impl Dim {
     fn scale(self, k: i32) -> Dim {
         Dim([self.0[0] * k, self.0[1] * k, self.0[2] * k])
     }
+    /// Dimension of a product.
+    pub fn mul(self, o: Dim) -> Dim {
+        self.add(o, 1)
+    }
+    /// Dimension of a quotient.
+    pub fn div(self, o: Dim) -> Dim {
+        self.add(o, -1)
+    }
+    /// Dimension raised to an integer power (|k| ≤ [`MAX_POWER`]).
+    pub fn powi(self, k: i32) -> Dim {
+        self.scale(k)
+    }
+    /// Square root; None when an exponent would become fractional beyond halves.
+    pub fn sqrt(self) -> Option<Dim> {
+        if self.0.iter().any(|e| e % 2 != 0) {
+            return None;
+        }
+        Some(Dim([self.0[0] / 2, self.0[1] / 2, self.0[2] / 2]))
+    }
+    /// True for a dimensionless quantity (radians allowed: an angle is dimensionless in SI).
+    pub fn is_dimensionless_or_angle(self) -> bool {
+        self.0[0] == 0 && self.0[1] == 0
+    }
 }
+
+/// Largest power a unit factor or a regressor's `powi` may use.
+pub const MAX_POWER: i32 = 12;
+
+/// Dimension of a specific force, m/s².
+pub const DIM_ACCEL: Dim = Dim([2, -4, 0]);
+/// Dimension of an angular rate, rad/s.
+pub const DIM_RATE: Dim = Dim([0, -2, 2]);
+/// Dimensionless.
+pub const DIM_ONE: Dim = ONE;
 
 impl fmt::Display for Dim {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -167,6 +200,9 @@ fn parse_factor(f: &str) -> Result<Unit, String> {
                 .trim()
                 .parse()
                 .map_err(|_| format!("power `{p}` is not an integer"))?;
+            if p.abs() > MAX_POWER {
+                return Err(format!("power `{p}` is out of range (|power| <= {MAX_POWER})"));
+            }
             (n.trim(), p)
         }
         None => (f, 1),

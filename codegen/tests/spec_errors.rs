@@ -59,8 +59,17 @@ fn expect_error(file: &str, from: &str, to: &str, needle_line: &str, item: &str,
 fn the_real_spec_loads() {
     let spec = Spec::load(&spec_dir()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(spec.nav_states.len(), 9);
-    assert_eq!(spec.terms.iter().filter(|t| !t.library).count(), 24);
-    assert_eq!(spec.terms.iter().filter(|t| t.library).count(), 27);
+    // counts are derived, not hard-coded: the library is exactly the terms no preset contains
+    for t in &spec.terms {
+        let in_preset = spec.presets.iter().any(|p| p.states.contains(&t.name));
+        assert_eq!(
+            t.library, !in_preset,
+            "term `{}`: `library = true` exactly when no preset has it",
+            t.name
+        );
+    }
+    let p31 = spec.presets.iter().find(|p| p.name == "P31").unwrap();
+    assert_eq!(p31.states.len(), 31, "P31 (written as base P28 + d) has 31 states");
     let names: Vec<_> = spec.presets.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["P13", "P24", "P28", "P31"]);
 }
@@ -117,9 +126,9 @@ fn duplicate_term_name() {
 fn preset_naming_a_missing_term() {
     expect_error(
         "presets.toml",
-        "\"d_x\", \"d_y\", \"d_z\",",
-        "\"d_x\", \"d_y\", \"d_q\",",
-        "[preset.P31]",
+        "\nterms = [\"d_x\", \"d_y\", \"d_z\"]",
+        "\nterms = [\"d_x\", \"d_y\", \"d_q\"]",
+        "name = \"P31\"",
         "preset `P31`",
         "missing term `d_q`",
     );
@@ -184,7 +193,7 @@ fn missing_spec_file() {
 /// any model that adds it, with nothing else edited.
 #[test]
 fn a_new_term_is_one_spec_entry() {
-    let entry = "\n[[term]]\nname = \"kgt_x\"\nsensor = \"gyro\"\naxis = \"x\"\nregressor = \"w.x * f.z\"\nunit = \"rad*s/m\"\ndisplay = \"deg/h/g\"\nsigma = \"0.01 deg/h/g\"\ngroup = \"test\"\nlibrary = true\ndoc = \"test term\"\n";
+    let entry = "\n[[term]]\nname = \"kgt_x\"\nsensor = \"gyro\"\naxis = \"x\"\nregressor = \"w.x * f.z\"\nunit = \"s^2/m\"\ndisplay = \"s^2/m\"\nsigma = \"1e-6 s^2/m\"\ngroup = \"test\"\nlibrary = true\ndoc = \"test term\"\n";
     let (_d, r) = load_edited(|f, t| if f == "terms.toml" { t + entry } else { t });
     let spec = r.unwrap_or_else(|e| panic!("{e}"));
     let t = spec.term_index("kgt_x").expect("new term loaded");
@@ -215,4 +224,96 @@ fn a_new_term_is_one_spec_entry() {
         .collect();
     assert_eq!(rows, ["phi_n", "phi_e", "phi_d"]);
     assert_eq!(entries[2].comment, "-C31 * <w.x * f.z>");
+}
+
+/// A term's unit times its regressor's dimension must be the sensor's (issue: `m` for an
+/// accelerometer regressor `f.y * f.z` used to load).
+#[test]
+fn unit_inconsistent_with_the_regressor_and_sensor() {
+    expect_error(
+        "terms.toml",
+        "unit = \"s^2/m\"\ndisplay = \"ug/g^2\"",
+        "unit = \"m*1\"\ndisplay = \"m\"",
+        "unit = \"m*1\"",
+        "term `d_x`",
+        "an accelerometer error is in m/s^2: the unit should be m^-1*s^2",
+    );
+    // a gyro term with an accelerometer's unit
+    expect_error(
+        "terms.toml",
+        "unit = \"rad/s\"",
+        "unit = \"m/s^2\"",
+        "unit = \"m/s^2\"",
+        "term `eps_x`",
+        "a gyro error is in rad/s",
+    );
+}
+
+#[test]
+fn powi_exponent_is_bounded() {
+    expect_error(
+        "terms.toml",
+        "regressor = \"f.x.powi(2)\"",
+        "regressor = \"f.x.powi(2147483647)\"",
+        "2147483647",
+        "term `d_x`",
+        "out of range",
+    );
+}
+
+#[test]
+fn preset_with_an_unknown_base_or_both_forms() {
+    expect_error(
+        "presets.toml",
+        "\nbase = \"P28\"",
+        "\nbase = \"P99\"",
+        "base = \"P99\"",
+        "preset `P31`",
+        "base `P99` is not a preset defined above it",
+    );
+    expect_error(
+        "presets.toml",
+        "name = \"P13\"",
+        "name = \"P28\"",
+        "name = \"P28\"",
+        "preset `P28`",
+        "duplicate preset",
+    );
+}
+
+#[test]
+fn white_noise_source_must_exist_and_fit_the_state() {
+    expect_error(
+        "navigation.toml",
+        "white_noise = \"gyro_arw\"",
+        "white_noise = \"gyro_arv\"",
+        "gyro_arv",
+        "state `phi_n`",
+        "unknown source `gyro_arv`",
+    );
+    expect_error(
+        "navigation.toml",
+        "white_noise = \"gyro_arw\"",
+        "white_noise = \"accel_vrw\"",
+        "name = \"phi_n\"",
+        "state `phi_n`",
+        "cannot be driven",
+    );
+}
+
+/// A user preset written as base + terms compiles to its own generated module.
+#[test]
+fn a_user_preset_compiles_to_its_own_kernels() {
+    let entry = "\n[[preset]]\nname = \"P28kaq\"\ndoc = \"test\"\nbase = \"P28\"\nterms = [\"kaq_x_xy\", \"kgf_xz\"]\n";
+    let (_d, r) = load_edited(|f, t| if f == "presets.toml" { t + entry } else { t });
+    let spec = r.unwrap_or_else(|e| panic!("{e}"));
+    let files = generate(&spec);
+    let m = files
+        .iter()
+        .find(|f| f.module == "p28kaq")
+        .expect("module for the user preset");
+    assert!(m.text.contains("pub const N: usize = 30;"), "30 states");
+    assert!(files.iter().any(|f| f.module == "p28kaq_vertical"));
+    // and the library flag check of `the_real_spec_loads` would now flag the two terms
+    assert!(spec.terms.iter().any(|t| t.name == "kaq_x_xy" && t.library));
 }

@@ -27,8 +27,21 @@ pub struct NavStateInfo {
     pub sigma: f64,
     /// Present only with `+vertical`.
     pub vertical: bool,
+    /// The white sensor noise that drives the state (its process noise).
+    pub white_noise: WhiteNoise,
     /// One-line description.
     pub doc: &'static str,
+}
+
+/// Which white sensor noise drives a navigation state (`white_noise` in navigation.toml).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WhiteNoise {
+    /// None enters the state directly.
+    None,
+    /// Gyro angle random walk [rad/√s] (attitude rows).
+    GyroArw,
+    /// Accelerometer velocity random walk [m/s/√s] (velocity rows).
+    AccelVrw,
 }
 
 /// An instrument error term as declared in `model-spec/terms.toml`.
