@@ -242,8 +242,8 @@ fn unit_inconsistent_with_the_regressor_and_sensor() {
     expect_error(
         "terms.toml",
         "unit = \"rad/s\"",
-        "unit = \"m/s^2\"",
-        "unit = \"m/s^2\"",
+        "unit = \"m/s^2*1\"",
+        "unit = \"m/s^2*1\"",
         "term `eps_x`",
         "a gyro error is in rad/s",
     );
