@@ -4,9 +4,9 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use nalgebra::{SMatrix, Vector3};
-use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::model::covariance::SparsePropagator;
 use sinsmodel::model::generated::p31;
+use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::nav_point::NavPoint;
 
 type M31 = SMatrix<f64, 31, 31>;
@@ -67,7 +67,7 @@ fn bench(c: &mut Criterion) {
     });
     let flat_a: Vec<f64> = a.iter().flatten().copied().collect();
     let flat_p: Vec<f64> = p.iter().flatten().copied().collect();
-    let prop = SparsePropagator::new(31, &p31::A_PATTERN);
+    let mut prop = SparsePropagator::new(31, &p31::A_PATTERN);
     g.bench_function("runtime_sparse", |b| {
         b.iter(|| {
             let mut pp = flat_p.clone();

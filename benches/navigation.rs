@@ -2,9 +2,9 @@
 //! bytes per second (criterion reports them as throughput). Run: `cargo bench --bench navigation`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
+use sinsmodel::nav::strapdown::{Navigator, Vertical};
 use sinsmodel::sim::scenario::Scenario;
 use sinsmodel::sim::simulator::simulate;
-use sinsmodel::nav::strapdown::{Navigator, Vertical};
 
 fn scenario(rate: f64, secs: f64, vib: bool) -> Scenario {
     let v = if vib {

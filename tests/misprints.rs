@@ -3,9 +3,9 @@
 //! where the two differ.
 
 use nalgebra::Vector3;
+use sinsmodel::model::Model;
 use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::earth::OMEGA;
-use sinsmodel::model::Model;
 use sinsmodel::nav::nav_point::NavPoint;
 
 struct Filled {

@@ -2,10 +2,10 @@
 //! against a dense reference, and the regressor accumulator.
 
 use nalgebra::{DMatrix, Vector3};
-use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::model::covariance::{propagate_dense, SparsePropagator};
 use sinsmodel::model::generated::PRESETS;
 use sinsmodel::model::Model;
+use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::nav_point::NavPoint;
 
 /// Small deterministic generator (xorshift) so the tests need no extra crate.

@@ -1,12 +1,12 @@
 //! Strapdown navigator and simulator against analytic results (issue 3's test list).
 
 use nalgebra::Vector3;
+use sinsmodel::io::truth::TruthRow;
 use sinsmodel::nav::attitude::{attitude_error, dcm_from_euler};
 use sinsmodel::nav::earth;
+use sinsmodel::nav::strapdown::{Navigator, Vertical};
 use sinsmodel::sim::scenario::Scenario;
 use sinsmodel::sim::simulator::{simulate, SimOutput};
-use sinsmodel::nav::strapdown::{Navigator, Vertical};
-use sinsmodel::io::truth::TruthRow;
 
 const ARCSEC: f64 = std::f64::consts::PI / 180.0 / 3600.0;
 
@@ -194,8 +194,9 @@ fn quadratic_accelerometer_error_rectifies_to_d_a2_over_2() {
         ),
         |_| {},
     );
-    let sum =
-        |s: &sinsmodel::sim::simulator::SimOutput| s.imu.samples.iter().map(|x| x.dv.x).sum::<f64>();
+    let sum = |s: &sinsmodel::sim::simulator::SimOutput| {
+        s.imu.samples.iter().map(|x| x.dv.x).sum::<f64>()
+    };
     let rate = (sum(&dirty) - sum(&clean)) / dirty.imu.duration().max(10.0);
     let a = 6.0 * 9.80665;
     let expect = 5e-5 * a * a / 2.0;

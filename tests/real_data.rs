@@ -4,10 +4,10 @@
 
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use sinsmodel::estimate::allan::{fit, oadev};
-use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
-use sinsmodel::model::Model;
 use sinsmodel::io::readers::{gnss_imu, rtklib};
+use sinsmodel::model::Model;
+use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::strapdown::{NavState, Vertical};
 use std::path::PathBuf;
 

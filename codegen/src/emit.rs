@@ -198,7 +198,12 @@ pub fn common_module(spec: &Spec) -> String {
     let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
     let (uses_f, uses_w) = signals_used(spec, &all_regs);
     let (f_param, w_param) = (param("f", uses_f), param("w", uses_w));
-    let r_param = param("r", spec.terms.iter().any(|t| !spec.regressors[t.regressor].constant));
+    let r_param = param(
+        "r",
+        spec.terms
+            .iter()
+            .any(|t| !spec.regressors[t.regressor].constant),
+    );
 
     // full navigation block
     let full = Layout {
@@ -397,7 +402,6 @@ fn phi_pattern(n: usize, a: &BTreeSet<(usize, usize)>) -> PhiPattern {
     }
     PhiPattern { rows, entries }
 }
-
 
 /// The comment above a generated line, or nothing when it would repeat the code: `label =
 /// expression` where the expression is the spec's text.

@@ -449,7 +449,13 @@ impl Spec {
         let sensor_noise = load_sensor_noise(&nav_src, &raw_nav.sensor_noise)?;
         let (terms, regressors) = load_terms(&terms_src, &raw_terms.term, &mut names)?;
         let measurements = load_measurements(&meas_src, &raw_meas.measurement, &names)?;
-        let presets = load_presets(&preset_src, &raw_presets.preset, &nav_states, &terms, &names)?;
+        let presets = load_presets(
+            &preset_src,
+            &raw_presets.preset,
+            &nav_states,
+            &terms,
+            &names,
+        )?;
         Ok(Spec {
             dir: dir.to_path_buf(),
             nav_states,
@@ -599,7 +605,11 @@ fn load_compose(
             .iter()
             .map(|n| {
                 nav_index(nav_states, n).ok_or_else(|| {
-                    src.error(list.span(), "compose", format!("{what}: unknown state `{n}`"))
+                    src.error(
+                        list.span(),
+                        "compose",
+                        format!("{what}: unknown state `{n}`"),
+                    )
                 })
             })
             .collect()
@@ -624,8 +634,20 @@ fn load_compose(
 /// The white sensor noise densities.
 fn load_sensor_noise(src: &Source, raw: &RawSensorNoise) -> Result<SensorNoise, SpecError> {
     Ok(SensorNoise {
-        gyro_arw: quantity(src, &raw.gyro_arw, "rad/sqrt(s)", "sensor_noise", "gyro_arw")?,
-        accel_vrw: quantity(src, &raw.accel_vrw, "m/s/sqrt(s)", "sensor_noise", "accel_vrw")?,
+        gyro_arw: quantity(
+            src,
+            &raw.gyro_arw,
+            "rad/sqrt(s)",
+            "sensor_noise",
+            "gyro_arw",
+        )?,
+        accel_vrw: quantity(
+            src,
+            &raw.accel_vrw,
+            "m/s/sqrt(s)",
+            "sensor_noise",
+            "accel_vrw",
+        )?,
     })
 }
 
@@ -747,7 +769,9 @@ fn check_term_dimension(
         Sensor::Gyro => ("rad/s", "a gyro error"),
         Sensor::Accel => ("m/s^2", "an accelerometer error"),
     };
-    let want = units::parse_unit(sensor_unit).expect("sensor unit parses").dim;
+    let want = units::parse_unit(sensor_unit)
+        .expect("sensor unit parses")
+        .dim;
     let got = unit.mul(reg_dim);
     if got.0[0] != want.0[0] || got.0[1] != want.0[1] {
         return Err(src.error(
@@ -857,7 +881,11 @@ fn load_presets(
         let states: Vec<String> = match (&raw.states, &raw.base) {
             (Some(s), None) => {
                 if !raw.terms.is_empty() {
-                    return Err(src.error(span, &item, "give either `states`, or `base` and `terms`"));
+                    return Err(src.error(
+                        span,
+                        &item,
+                        "give either `states`, or `base` and `terms`",
+                    ));
                 }
                 s.clone()
             }
@@ -913,7 +941,10 @@ fn load_presets(
             return Err(src.error(
                 span,
                 &item,
-                format!("must start with the navigation states {}", horizontal.join(" ")),
+                format!(
+                    "must start with the navigation states {}",
+                    horizontal.join(" ")
+                ),
             ));
         }
         presets.push(Preset {

@@ -201,7 +201,9 @@ fn parse_factor(f: &str) -> Result<Unit, String> {
                 .parse()
                 .map_err(|_| format!("power `{p}` is not an integer"))?;
             if p.abs() > MAX_POWER {
-                return Err(format!("power `{p}` is out of range (|power| <= {MAX_POWER})"));
+                return Err(format!(
+                    "power `{p}` is out of range (|power| <= {MAX_POWER})"
+                ));
             }
             (n.trim(), p)
         }

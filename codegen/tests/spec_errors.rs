@@ -69,7 +69,11 @@ fn the_real_spec_loads() {
         );
     }
     let p31 = spec.presets.iter().find(|p| p.name == "P31").unwrap();
-    assert_eq!(p31.states.len(), 31, "P31 (written as base P28 + d) has 31 states");
+    assert_eq!(
+        p31.states.len(),
+        31,
+        "P31 (written as base P28 + d) has 31 states"
+    );
     let names: Vec<_> = spec.presets.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["P13", "P24", "P28", "P31"]);
 }

@@ -6,8 +6,8 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::allan::{fit, oadev, AllanCurve, NoiseFit};
-use sinsmodel::report::plot::{line_plot, Scale, Series};
 use sinsmodel::io::{atomic_file, readers};
+use sinsmodel::report::plot::{line_plot, Scale, Series};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 

@@ -3,12 +3,12 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::io::atomic_file::AtomicFile;
-use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
-use sinsmodel::model::Model;
-use sinsmodel::nav::strapdown::{NavState, Vertical};
+use sinsmodel::io::atomic_file::AtomicFile;
 use sinsmodel::io::{aiding, readers, truth};
+use sinsmodel::model::Model;
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::nav::strapdown::{NavState, Vertical};
 use sinsmodel::report::progress;
 use std::io::Write;
 use std::path::PathBuf;

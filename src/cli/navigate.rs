@@ -3,10 +3,10 @@
 use anyhow::{bail, Result};
 use clap::Args;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::nav::attitude::dcm_from_euler;
-use sinsmodel::nav::strapdown::{NavState, Navigator, Vertical};
 use sinsmodel::io::truth::TruthRow;
 use sinsmodel::io::{readers, truth};
+use sinsmodel::nav::attitude::dcm_from_euler;
+use sinsmodel::nav::strapdown::{NavState, Navigator, Vertical};
 use sinsmodel::report::progress;
 use std::path::PathBuf;
 

@@ -5,10 +5,10 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::filter::FilterRun;
-use sinsmodel::report::plot::{line_plot, Scale, Series};
-use sinsmodel::report::reproduce::{self, CaseResult, GridPoint, Priors};
 use sinsmodel::io::atomic_file;
+use sinsmodel::report::plot::{line_plot, Scale, Series};
 use sinsmodel::report::progress;
+use sinsmodel::report::reproduce::{self, CaseResult, GridPoint, Priors};
 use std::path::PathBuf;
 
 /// Arguments of `reproduce`.

@@ -2,10 +2,10 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use sinsmodel::sim::scenario::Scenario;
-use sinsmodel::sim::simulator::simulate;
 use sinsmodel::io::{aiding, atomic_file, imu, truth};
 use sinsmodel::report::progress;
+use sinsmodel::sim::scenario::Scenario;
+use sinsmodel::sim::simulator::simulate;
 use std::path::PathBuf;
 
 /// Arguments of `simulate`.

@@ -7,23 +7,25 @@
 //!   P ← Φ P Φᵀ + diag(q) dt through the preset's generated sparse kernel (or the run-time sparse
 //!   propagator for composed models); q: gyro ARW² on the attitude rows, accelerometer VRW² on
 //!   the velocity rows, each term's random-walk density² on its row.
-//! - Updates at the aiding epochs (at the first step end at or after the epoch): sequential
-//!   scalar updates in Joseph form for `vel_ne` (and `pos_ne`, `pos_h`), innovations and their
-//!   variance recorded.
+//! - Updates at the aiding epochs (at the first step end at or after the epoch): for every
+//!   measurement of `model-spec/measurements.toml` that the model supports and the epoch carries,
+//!   the residual z (computed minus aiding, in the measurement's components) and the generated H
+//!   at the navigation point ([`Model::fill_h`]); sequential scalar updates in Joseph form,
+//!   innovations and their variance recorded.
 //! - Open loop: errors estimated, never fed back (the paper's comparison). Closed loop: after each
 //!   update attitude, velocity and position are corrected and every instrument term's estimate is
 //!   moved into a correction applied to all later increments (per sample, with its regressor).
 
-use crate::nav::attitude::{attitude_error, dcm_from_euler};
-use crate::model::catalog::{Sensor, StateRef};
-use crate::model::covariance::SparsePropagator;
-use crate::nav::earth;
-use crate::model::generated::common;
 use crate::io::imu::ImuData;
+use crate::io::truth::TruthRow;
+use crate::model::catalog::{Sensor, StateRef, WhiteNoise};
+use crate::model::covariance::SparsePropagator;
+use crate::model::generated::common;
 use crate::model::Model;
+use crate::nav::attitude::{attitude_error, dcm_from_euler};
+use crate::nav::earth;
 use crate::nav::nav_point::NavPoint;
 use crate::nav::strapdown::{NavState, Navigator, Vertical};
-use crate::io::truth::TruthRow;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Feedback mode.
@@ -62,13 +64,11 @@ impl FilterConfig {
         let mut q = vec![0.0; n];
         for (i, s) in model.states.iter().enumerate() {
             q[i] = match *s {
-                StateRef::Nav(k) if common::NAV_STATES[k].name.starts_with("phi_") => {
-                    common::GYRO_ARW.powi(2)
-                }
-                StateRef::Nav(k) if common::NAV_STATES[k].name.starts_with("dv_") => {
-                    common::ACCEL_VRW.powi(2)
-                }
-                StateRef::Nav(_) => 0.0,
+                StateRef::Nav(k) => match common::NAV_STATES[k].white_noise {
+                    WhiteNoise::GyroArw => common::GYRO_ARW.powi(2),
+                    WhiteNoise::AccelVrw => common::ACCEL_VRW.powi(2),
+                    WhiteNoise::None => 0.0,
+                },
                 StateRef::Term(k) => common::TERMS[k].noise.powi(2),
             };
         }
@@ -88,12 +88,15 @@ impl FilterConfig {
     }
 
     /// Sets the white sensor noise used in q: ARW [rad/√s] and VRW [m/s/√s].
+    /// (which states each drives is the spec's `white_noise`).
     pub fn with_sensor_noise(mut self, model: &Model, arw: f64, vrw: f64) -> FilterConfig {
-        for (i, name) in model.names.iter().enumerate() {
-            if name.starts_with("phi_") {
-                self.q[i] = arw * arw;
-            } else if name.starts_with("dv_") {
-                self.q[i] = vrw * vrw;
+        for (i, s) in model.states.iter().enumerate() {
+            if let StateRef::Nav(k) = *s {
+                match common::NAV_STATES[k].white_noise {
+                    WhiteNoise::GyroArw => self.q[i] = arw * arw,
+                    WhiteNoise::AccelVrw => self.q[i] = vrw * vrw,
+                    WhiteNoise::None => {}
+                }
             }
         }
         self
@@ -192,6 +195,295 @@ pub fn run(
     run_with(model, cfg, imu, start, aiding, truth, progress, &mut |_| {})
 }
 
+/// The residual z = computed − aiding of spec measurement `meas` at an epoch, in the
+/// measurement's components and units, with each component's 1-σ; None when the epoch does not
+/// carry that measurement. H for the same measurement comes from the spec ([`Model::fill_h`]);
+/// `residual_matches_generated_h` (tests/filter.rs) checks that z and H agree to first order.
+pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>, Vec<f64>)> {
+    match meas {
+        "vel_ne" => ep
+            .vel
+            .map(|(v, sig)| (vec![s.v.x - v.x, s.v.y - v.y], vec![sig, sig])),
+        "pos_ne" => ep.pos.map(|(lat, lon, _, sig)| {
+            let rm = earth::radius_meridian(s.lat) + s.h;
+            let rn = earth::radius_transverse(s.lat) + s.h;
+            (
+                vec![(s.lat - lat) * rm, (s.lon - lon) * rn * s.lat.cos()],
+                vec![sig[0], sig[1]],
+            )
+        }),
+        "pos_h" => ep.pos.map(|(_, _, h, sig)| (vec![s.h - h], vec![sig[2]])),
+        _ => None,
+    }
+}
+
+/// Spec measurements the filter can form a residual for (see [`residual`]).
+pub const FORMED_MEASUREMENTS: [&str; 3] = ["vel_ne", "pos_ne", "pos_h"];
+
+/// The running filter: navigator, error state, covariance and the per-step buffers.
+struct Engine<'a> {
+    model: &'a Model,
+    cfg: &'a FilterConfig,
+    n: usize,
+    nav: Navigator,
+    x: Vec<f64>,
+    p: Vec<f64>,
+    kernel: Kernel,
+    a: Vec<f64>,
+    acc: crate::model::RegressorAccumulator,
+    r_mean: Vec<f64>,
+    f_sum: Vector3<f64>,
+    in_step: usize,
+    step_t0: f64,
+    /// (model index, term index) of every instrument term.
+    terms: Vec<(usize, usize)>,
+    /// Closed-loop corrections per state (SI), applied to later increments.
+    correction: Vec<f64>,
+    np: NavPoint,
+    /// Spec measurements this model supports: (name, number of components).
+    meas: Vec<(&'static str, usize)>,
+    h: Vec<f64>,
+    u: Vec<f64>,
+    i_phi: [Option<usize>; 3],
+    i_dv: [Option<usize>; 3],
+    i_pos: [Option<usize>; 3],
+    innovations: Vec<Innovation>,
+    records: Vec<Record>,
+    truth_i: usize,
+}
+
+impl<'a> Engine<'a> {
+    fn new(model: &'a Model, cfg: &'a FilterConfig, start: NavState) -> Engine<'a> {
+        let n = model.n();
+        let mut p = vec![0.0; n * n];
+        for i in 0..n {
+            p[i * n + i] = cfg.prior_sigma[i].powi(2);
+        }
+        let kernel = match model.preset {
+            _ if cfg.dense_reference => Kernel::Dense,
+            Some(k) => Kernel::Preset(k.propagate),
+            None => Kernel::Runtime(SparsePropagator::new(n, model.a_pattern())),
+        };
+        let terms = model
+            .states
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| match *s {
+                StateRef::Term(k) => Some((i, k)),
+                StateRef::Nav(_) => None,
+            })
+            .collect();
+        let meas: Vec<(&'static str, usize)> = model
+            .measurements()
+            .iter()
+            .filter(|m| FORMED_MEASUREMENTS.contains(&m.name))
+            .map(|m| (m.name, m.rows.len()))
+            .collect();
+        let max_rows = meas.iter().map(|m| m.1).max().unwrap_or(0);
+        let idx = |name: &str| model.index_of(name);
+        Engine {
+            model,
+            cfg,
+            n,
+            nav: Navigator::new(start, cfg.vertical),
+            x: vec![0.0; n],
+            p,
+            kernel,
+            a: vec![0.0; n * n],
+            acc: model.accumulator(),
+            r_mean: vec![0.0; model.regressor_ids.len()],
+            f_sum: Vector3::zeros(),
+            in_step: 0,
+            step_t0: start.t,
+            terms,
+            correction: vec![0.0; n],
+            np: NavPoint::new(start.lat, start.h, start.v, &start.dcm(), &Vector3::zeros()),
+            meas,
+            h: vec![0.0; max_rows * n],
+            u: vec![0.0; n],
+            i_phi: [idx("phi_n"), idx("phi_e"), idx("phi_d")],
+            i_dv: [idx("dv_n"), idx("dv_e"), idx("dv_d")],
+            i_pos: [idx("dlat"), idx("dlon"), idx("dh")],
+            innovations: Vec::new(),
+            records: Vec::new(),
+            truth_i: 0,
+        }
+    }
+
+    /// One IMU sample: closed-loop sensor corrections, strapdown step, regressor sums.
+    fn navigate(&mut self, smp: &crate::io::imu::ImuSample, dt: f64) {
+        let (mut dth, mut dvel) = (smp.dtheta, smp.dv);
+        if self.cfg.mode == Mode::ClosedLoop {
+            let f_meas = dvel / dt;
+            let w_meas = dth / dt;
+            for &(i, t) in &self.terms {
+                if self.correction[i] != 0.0 {
+                    let info = &common::TERMS[t];
+                    let r = common::regressor_value(info.regressor, &f_meas, &w_meas);
+                    match info.sensor {
+                        Sensor::Gyro => dth[info.axis] -= self.correction[i] * r * dt,
+                        Sensor::Accel => dvel[info.axis] -= self.correction[i] * r * dt,
+                    }
+                }
+            }
+        }
+        self.nav.step(&dth, &dvel, dt);
+        self.nav.state.t = smp.t;
+        let inv_dt = 1.0 / dt;
+        let (f_c, w_c) = (dvel * inv_dt, dth * inv_dt);
+        self.acc.add(&f_c, &w_c);
+        self.f_sum += f_c;
+        self.in_step += 1;
+    }
+
+    /// Propagates x and P over the step that ends now: A(t) at the navigation point with the
+    /// step's regressor means, through the preset kernel, the run-time propagator or dense.
+    fn propagate(&mut self, t: f64) {
+        let (n, s) = (self.n, self.nav.state);
+        let step_dt = t - self.step_t0;
+        let f_mean = self.f_sum / self.in_step as f64;
+        self.np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
+        for &(i, j) in self.model.a_pattern() {
+            self.a[i * n + j] = 0.0;
+        }
+        self.acc.mean_into(&mut self.r_mean);
+        self.model.fill_a(&self.np, &self.r_mean, &mut self.a);
+        let q = &self.cfg.q;
+        match &mut self.kernel {
+            Kernel::Preset(f) => f(&self.a, step_dt, q, &mut self.p, &mut self.x),
+            Kernel::Runtime(sp) => {
+                sp.propagate_with_state(&self.a, step_dt, q, &mut self.p, Some(&mut self.x))
+            }
+            Kernel::Dense => {
+                // the whole step with dense matrices: Φ, Φ P Φᵀ + Q and Φ x
+                let am = nalgebra::DMatrix::from_row_slice(n, n, &self.a);
+                let pm = nalgebra::DMatrix::from_row_slice(n, n, &self.p);
+                let out = crate::model::covariance::propagate_dense_with_state(
+                    &am,
+                    step_dt,
+                    q,
+                    &pm,
+                    Some(&mut self.x),
+                );
+                self.p.copy_from_slice(out.transpose().as_slice());
+            }
+        }
+        self.acc.reset();
+        self.f_sum = Vector3::zeros();
+        self.in_step = 0;
+        self.step_t0 = t;
+    }
+
+    /// Sequential scalar updates for every spec measurement the epoch carries, with the
+    /// generated H at the current navigation point.
+    fn update(&mut self, ep: &AidingEpoch) {
+        let (n, s) = (self.n, self.nav.state);
+        let f_ned = Vector3::from(self.np.f_ned);
+        let c = s.dcm();
+        let np = NavPoint::new(s.lat, s.h, s.v, &c, &(c.transpose() * f_ned));
+        for &(name, rows) in &self.meas {
+            let Some((z, sigma)) = residual(name, &s, ep) else {
+                continue;
+            };
+            let h = &mut self.h[..rows * n];
+            h.iter_mut().for_each(|v| *v = 0.0);
+            self.model
+                .fill_h(name, &np, h)
+                .expect("the model supports the measurements it lists");
+            for (comp, (&zc, &sc)) in z.iter().zip(&sigma).enumerate() {
+                let h_row = &self.h[comp * n..(comp + 1) * n];
+                if let Some((nu, sv)) =
+                    joseph_update(&mut self.x, &mut self.p, h_row, zc, sc * sc, &mut self.u)
+                {
+                    self.innovations.push(Innovation {
+                        t: ep.t,
+                        meas: name,
+                        component: comp,
+                        nu,
+                        s: sv,
+                    });
+                }
+            }
+        }
+    }
+
+    /// The record of an update epoch: estimates, σ, and with truth the true φ and position error.
+    fn record(&mut self, ep: &AidingEpoch, truth: Option<&[TruthRow]>) {
+        let n = self.n;
+        let truth_i = &mut self.truth_i;
+        let truth_row = truth.and_then(|tr| {
+            while *truth_i + 1 < tr.len() && tr[*truth_i].t < ep.t - 1e-6 {
+                *truth_i += 1;
+            }
+            let row = tr.get(*truth_i)?;
+            ((row.t - ep.t).abs() < 0.5 * self.cfg.step_s).then_some(*row)
+        });
+        let s = self.nav.state;
+        let phi_true = truth_row.map(|row| {
+            let c_true = dcm_from_euler(row.euler.x, row.euler.y, row.euler.z);
+            attitude_error(&s.dcm(), &c_true)
+        });
+        let pos_err_ne = truth_row.map(|row| {
+            [
+                (s.lat - row.lat) * (earth::radius_meridian(row.lat) + row.h),
+                (s.lon - row.lon) * (earth::radius_transverse(row.lat) + row.h) * row.lat.cos(),
+            ]
+        });
+        let x = &self.x;
+        let phi_est = Vector3::new(
+            self.i_phi[0].map(|j| x[j]).unwrap_or(0.0),
+            self.i_phi[1].map(|j| x[j]).unwrap_or(0.0),
+            self.i_phi[2].map(|j| x[j]).unwrap_or(0.0),
+        );
+        let mut xr = x.clone();
+        for &(i, _) in &self.terms {
+            xr[i] += self.correction[i];
+        }
+        self.records.push(Record {
+            t: ep.t,
+            x: xr,
+            sigma: (0..n).map(|i| self.p[i * n + i].max(0.0).sqrt()).collect(),
+            phi_true,
+            phi_est,
+            pos_err_ne,
+            nav: s,
+            cov: self.cfg.keep_covariance.then(|| self.p.clone()),
+        });
+    }
+
+    /// Closed loop: moves the navigation error estimates into the navigator and the instrument
+    /// estimates into the sensor corrections; the error state restarts at zero.
+    fn feedback(&mut self) {
+        let x = &mut self.x;
+        let mut take =
+            |i: Option<usize>| i.map(|j| std::mem::replace(&mut x[j], 0.0)).unwrap_or(0.0);
+        let phi = Vector3::new(
+            take(self.i_phi[0]),
+            take(self.i_phi[1]),
+            take(self.i_phi[2]),
+        );
+        let dv = [take(self.i_dv[0]), take(self.i_dv[1]), take(self.i_dv[2])];
+        let dpos = [
+            take(self.i_pos[0]),
+            take(self.i_pos[1]),
+            take(self.i_pos[2]),
+        ];
+        let s = &mut self.nav.state;
+        // C~ = (I − [φ×]) C  ⇒  C = exp([φ×]) C~
+        s.q = UnitQuaternion::from_scaled_axis(phi) * s.q;
+        for c in 0..3 {
+            s.v[c] -= dv[c];
+        }
+        s.lat -= dpos[0];
+        s.lon -= dpos[1];
+        s.h -= dpos[2];
+        for &(i, _) in &self.terms {
+            self.correction[i] += self.x[i];
+            self.x[i] = 0.0;
+        }
+    }
+}
+
 /// [`run`] with a callback after every IMU sample (e.g. to write a navigation row per epoch).
 #[allow(clippy::too_many_arguments)]
 pub fn run_with(
@@ -204,208 +496,28 @@ pub fn run_with(
     mut progress: impl FnMut(f64),
     on_sample: &mut dyn FnMut(&NavState),
 ) -> FilterRun {
-    let n = model.n();
-    let mut nav = Navigator::new(start, cfg.vertical);
-    let mut x = vec![0.0; n];
-    let mut p = vec![0.0; n * n];
-    for i in 0..n {
-        p[i * n + i] = cfg.prior_sigma[i].powi(2);
-    }
-    let kernel = match model.preset {
-        _ if cfg.dense_reference => Kernel::Dense,
-        Some(k) => Kernel::Preset(k.propagate),
-        None => Kernel::Runtime(SparsePropagator::new(n, model.a_pattern())),
-    };
-    let pattern = model.a_pattern().to_vec();
-    let mut a = vec![0.0; n * n];
-    let mut acc = model.accumulator();
-    let mut r_mean = vec![0.0; model.regressor_ids.len()];
-    let mut f_sum = Vector3::zeros();
-    let mut in_step = 0usize;
-    let mut step_t0 = start.t;
-    // closed-loop corrections per term (SI), and per-term regressor/sensor info
-    let terms: Vec<(usize, usize)> = model
-        .states
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| match *s {
-            StateRef::Term(k) => Some((i, k)),
-            StateRef::Nav(_) => None,
-        })
-        .collect();
-    let mut correction = vec![0.0; n];
+    let mut e = Engine::new(model, cfg, start);
     let mut next_aid = 0usize;
-    let mut records = Vec::new();
-    let mut innovations = Vec::new();
-    let mut truth_i = 0usize;
     let report = (imu.samples.len() / 200).max(1);
     let mut prev_t = start.t;
-    let idx = |name: &str| model.index_of(name);
-    let (i_phi, i_dv) = (
-        [idx("phi_n"), idx("phi_e"), idx("phi_d")],
-        [idx("dv_n"), idx("dv_e"), idx("dv_d")],
-    );
-    let (i_lat, i_lon, i_h) = (idx("dlat"), idx("dlon"), idx("dh"));
-    let mut h_row = vec![0.0; n];
-    let mut np = NavPoint::new(start.lat, start.h, start.v, &start.dcm(), &Vector3::zeros());
-    let mut u = vec![0.0; n];
     for (k, smp) in imu.samples.iter().enumerate() {
         let dt = smp.t - prev_t;
         prev_t = smp.t;
-        let (mut dth, mut dvel) = (smp.dtheta, smp.dv);
-        if cfg.mode == Mode::ClosedLoop {
-            let f_meas = dvel / dt;
-            let w_meas = dth / dt;
-            for &(i, t) in &terms {
-                if correction[i] != 0.0 {
-                    let info = &common::TERMS[t];
-                    let r = common::regressor_value(info.regressor, &f_meas, &w_meas);
-                    match info.sensor {
-                        Sensor::Gyro => dth[info.axis] -= correction[i] * r * dt,
-                        Sensor::Accel => dvel[info.axis] -= correction[i] * r * dt,
-                    }
-                }
-            }
-        }
-        nav.step(&dth, &dvel, dt);
-        nav.state.t = smp.t;
-        on_sample(&nav.state);
-        let inv_dt = 1.0 / dt;
-        let (f_c, w_c) = (dvel * inv_dt, dth * inv_dt);
-        acc.add(&f_c, &w_c);
-        f_sum += f_c;
-        in_step += 1;
-        let step_dt = smp.t - step_t0;
+        e.navigate(smp, dt);
+        on_sample(&e.nav.state);
         let aid_due = next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9;
-        if step_dt + 1e-9 < cfg.step_s && !aid_due && k + 1 < imu.samples.len() {
+        let step_done = smp.t - e.step_t0 + 1e-9 >= cfg.step_s;
+        if !step_done && !aid_due && k + 1 < imu.samples.len() {
             continue;
         }
-        // ---- propagation over the step
-        let s = nav.state;
-        let f_mean = f_sum / in_step as f64;
-        np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
-        for &(i, j) in &pattern {
-            a[i * n + j] = 0.0;
-        }
-        acc.mean_into(&mut r_mean);
-        model.fill_a(&np, &r_mean, &mut a);
-        match &kernel {
-            Kernel::Preset(f) => f(&a, step_dt, &cfg.q, &mut p, &mut x),
-            Kernel::Runtime(sp) => {
-                sp.propagate_with_state(&a, step_dt, &cfg.q, &mut p, Some(&mut x))
-            }
-            Kernel::Dense => {
-                // the whole step with dense matrices: Φ, Φ P Φᵀ + Q and Φ x
-                let am = nalgebra::DMatrix::from_row_slice(n, n, &a);
-                let pm = nalgebra::DMatrix::from_row_slice(n, n, &p);
-                let out = crate::model::covariance::propagate_dense_with_state(
-                    &am,
-                    step_dt,
-                    &cfg.q,
-                    &pm,
-                    Some(&mut x),
-                );
-                p.copy_from_slice(out.transpose().as_slice());
-            }
-        }
-        acc.reset();
-        f_sum = Vector3::zeros();
-        in_step = 0;
-        step_t0 = smp.t;
-        // ---- updates
+        e.propagate(smp.t);
         while next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9 {
-            let ep = aiding[next_aid];
+            let ep = &aiding[next_aid];
             next_aid += 1;
-            let s = nav.state;
-            let mut scalar =
-                |meas: &'static str, comp: usize, z: f64, r: f64, hrow: &[(usize, f64)]| {
-                    h_row.iter_mut().for_each(|v| *v = 0.0);
-                    for &(j, v) in hrow {
-                        h_row[j] = v;
-                    }
-                    if let Some((nu, sv)) = joseph_update(&mut x, &mut p, &h_row, z, r, &mut u) {
-                        innovations.push(Innovation {
-                            t: ep.t,
-                            meas,
-                            component: comp,
-                            nu,
-                            s: sv,
-                        });
-                    }
-                };
-            if let Some((v, sig)) = ep.vel {
-                for c in 0..2 {
-                    if let Some(j) = i_dv[c] {
-                        scalar("vel_ne", c, s.v[c] - v[c], sig * sig, &[(j, 1.0)]);
-                    }
-                }
-            }
-            if let Some((lat, lon, h, sig)) = ep.pos {
-                let rm = earth::radius_meridian(s.lat) + s.h;
-                let rn = earth::radius_transverse(s.lat) + s.h;
-                if let (Some(jl), Some(jo)) = (i_lat, i_lon) {
-                    scalar("pos_ne", 0, (s.lat - lat) * rm, sig[0].powi(2), &[(jl, rm)]);
-                    scalar(
-                        "pos_ne",
-                        1,
-                        (s.lon - lon) * rn * s.lat.cos(),
-                        sig[1].powi(2),
-                        &[(jo, rn * s.lat.cos())],
-                    );
-                }
-                if let Some(jh) = i_h {
-                    scalar("pos_h", 0, s.h - h, sig[2].powi(2), &[(jh, 1.0)]);
-                }
-            }
-            let truth_row = truth.and_then(|tr| {
-                while truth_i + 1 < tr.len() && tr[truth_i].t < ep.t - 1e-6 {
-                    truth_i += 1;
-                }
-                let row = tr[truth_i];
-                ((row.t - ep.t).abs() < 0.5 * cfg.step_s).then_some(row)
-            });
-            let phi_true = truth_row.map(|row| {
-                let c_true = dcm_from_euler(row.euler.x, row.euler.y, row.euler.z);
-                attitude_error(&nav.state.dcm(), &c_true)
-            });
-            let pos_err_ne = truth_row.map(|row| {
-                let s = nav.state;
-                [
-                    (s.lat - row.lat) * (earth::radius_meridian(row.lat) + row.h),
-                    (s.lon - row.lon) * (earth::radius_transverse(row.lat) + row.h) * row.lat.cos(),
-                ]
-            });
-            let phi_est = Vector3::new(
-                i_phi[0].map(|j| x[j]).unwrap_or(0.0),
-                i_phi[1].map(|j| x[j]).unwrap_or(0.0),
-                i_phi[2].map(|j| x[j]).unwrap_or(0.0),
-            );
-            let mut xr = x.clone();
-            for &(i, _) in &terms {
-                xr[i] += correction[i];
-            }
-            records.push(Record {
-                t: ep.t,
-                x: xr,
-                sigma: (0..n).map(|i| p[i * n + i].max(0.0).sqrt()).collect(),
-                phi_true,
-                phi_est,
-                pos_err_ne,
-                nav: nav.state,
-                cov: cfg.keep_covariance.then(|| p.clone()),
-            });
+            e.update(ep);
+            e.record(ep, truth);
             if cfg.mode == Mode::ClosedLoop {
-                feedback(
-                    &mut nav,
-                    &mut x,
-                    &mut correction,
-                    &terms,
-                    i_phi,
-                    i_dv,
-                    i_lat,
-                    i_lon,
-                    i_h,
-                );
+                e.feedback();
             }
         }
         if k % report == 0 {
@@ -415,9 +527,9 @@ pub fn run_with(
     progress(1.0);
     FilterRun {
         names: model.names.clone(),
-        records,
-        innovations,
-        final_state: nav.state,
+        records: e.records,
+        innovations: e.innovations,
+        final_state: e.nav.state,
     }
 }
 
@@ -460,37 +572,6 @@ fn joseph_update(
         }
     }
     Some((nu, s))
-}
-
-#[allow(clippy::too_many_arguments)]
-fn feedback(
-    nav: &mut Navigator,
-    x: &mut [f64],
-    correction: &mut [f64],
-    terms: &[(usize, usize)],
-    i_phi: [Option<usize>; 3],
-    i_dv: [Option<usize>; 3],
-    i_lat: Option<usize>,
-    i_lon: Option<usize>,
-    i_h: Option<usize>,
-) {
-    let take = |x: &mut [f64], i: Option<usize>| {
-        i.map(|j| std::mem::replace(&mut x[j], 0.0)).unwrap_or(0.0)
-    };
-    let phi = Vector3::new(take(x, i_phi[0]), take(x, i_phi[1]), take(x, i_phi[2]));
-    let s = &mut nav.state;
-    // C~ = (I − [φ×]) C  ⇒  C = exp([φ×]) C~
-    s.q = UnitQuaternion::from_scaled_axis(phi) * s.q;
-    for (c, &i) in i_dv.iter().enumerate() {
-        s.v[c] -= take(x, i);
-    }
-    s.lat -= take(x, i_lat);
-    s.lon -= take(x, i_lon);
-    s.h -= take(x, i_h);
-    for &(i, _) in terms {
-        correction[i] += x[i];
-        x[i] = 0.0;
-    }
 }
 
 /// Root-mean-square of the model error e = φ̂ − φ (north, east) over records with t in [t0, t1],

@@ -2,9 +2,9 @@
 //! gravity in the static start, heading from the direction of the first acceleration when the
 //! vehicle drives off, matched to the course of the reference (RTK) velocity.
 
-use crate::nav::attitude::dcm_from_euler;
 use crate::io::imu::ImuData;
 use crate::io::readers::rtklib::PosEpoch;
+use crate::nav::attitude::dcm_from_euler;
 use anyhow::{bail, Result};
 use nalgebra::Vector3;
 

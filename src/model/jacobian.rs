@@ -1,8 +1,8 @@
 //! The `jacobian` command: A and H of a model at one linearisation point given as JSON, for the
 //! independent CasADi check (`tools/verify-jacobians`).
 
-use crate::nav::attitude::dcm_from_euler;
 use crate::model::Model;
+use crate::nav::attitude::dcm_from_euler;
 use crate::nav::nav_point::NavPoint;
 use anyhow::{bail, Context, Result};
 use nalgebra::Vector3;

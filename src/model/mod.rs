@@ -42,6 +42,46 @@ pub struct Model {
     pub preset: Option<&'static PresetKernels>,
     nav_pos: [Option<usize>; common::NAV_COUNT],
     a_pattern: Vec<(usize, usize)>,
+    /// Run-time composition plan: (nav row, nav col, model row, model col) of the navigation block.
+    nav_map: Vec<(usize, usize, usize, usize)>,
+    /// Run-time composition plan: (model column, term, position of its regressor's mean).
+    term_cols: Vec<(usize, usize, Option<usize>)>,
+}
+
+/// Levenshtein distance between two names (byte-wise; names are ASCII).
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.iter().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != cb);
+            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Spec term names nearest to `name` (at most 3, within edit distance 3).
+pub fn nearest_terms(name: &str) -> Vec<&'static str> {
+    let mut v: Vec<(usize, &'static str)> = common::TERMS
+        .iter()
+        .map(|t| (edit_distance(name, t.name), t.name))
+        .filter(|(d, _)| *d <= 3)
+        .collect();
+    v.sort();
+    v.into_iter().take(3).map(|(_, n)| n).collect()
+}
+
+/// `; did you mean a, b?` for an unknown term name, or nothing when no name is near.
+pub fn did_you_mean(name: &str) -> String {
+    let near = nearest_terms(name);
+    if near.is_empty() {
+        String::new()
+    } else {
+        format!("; did you mean {}?", near.join(", "))
+    }
 }
 
 fn preset_names() -> String {
@@ -75,7 +115,8 @@ impl Model {
                 .position(|t| t.name == p)
                 .ok_or_else(|| {
                     ModelError(format!(
-                        "model `{text}`: unknown term `{p}` (see `sinsmodel model list`)"
+                        "model `{text}`: unknown term `{p}`{} (see `sinsmodel model list`)",
+                        did_you_mean(p)
                     ))
                 })?;
             if extra.contains(&t) {
@@ -116,12 +157,12 @@ impl Model {
             name.push('+');
             name.push_str(common::TERMS[t].name);
         }
-        Ok(Model::from_states(
-            name,
-            vertical,
-            states,
-            extra.is_empty().then_some(kernels),
-        ))
+        // a composed model whose states are exactly a compiled preset's (same order, e.g.
+        // P28+d_x+d_y+d_z = P31, or a user's [[preset]]) runs on that preset's generated kernels
+        let compiled = PRESETS
+            .iter()
+            .find(|k| k.vertical == vertical && k.state_refs == states.as_slice());
+        Ok(Model::from_states(name, vertical, states, compiled))
     }
 
     fn from_states(
@@ -168,6 +209,21 @@ impl Model {
             }
         }
         a_pattern.sort_unstable();
+        let nav_map = common::NAV_PATTERN
+            .iter()
+            .filter_map(|&(r, c)| Some((r, c, nav_pos[r]?, nav_pos[c]?)))
+            .collect();
+        let term_cols = states
+            .iter()
+            .enumerate()
+            .filter_map(|(j, s)| match *s {
+                StateRef::Term(t) => {
+                    let reg = common::TERMS[t].regressor;
+                    Some((j, t, regressor_ids.iter().position(|&x| x == reg)))
+                }
+                StateRef::Nav(_) => None,
+            })
+            .collect();
         Model {
             name,
             vertical,
@@ -177,6 +233,8 @@ impl Model {
             preset,
             nav_pos,
             a_pattern,
+            nav_map,
+            term_cols,
         }
     }
 
@@ -229,6 +287,19 @@ impl Model {
         }
     }
 
+    /// The same model without its generated kernels (run-time composition only): the
+    /// benchmark's and the tests' reference for the composed path.
+    pub fn runtime_only(&self) -> Model {
+        let mut m = self.clone();
+        m.preset = None;
+        m
+    }
+
+    /// Name of the compiled preset whose kernels this model runs on, if any.
+    pub fn compiled_as(&self) -> Option<&'static str> {
+        self.preset.map(|k| k.name)
+    }
+
     /// Fills A (n×n row-major, zeroed by the caller) through the preset kernel when there is
     /// one, else by run-time composition.
     pub fn fill_a(&self, nav: &NavPoint, r: &[f64], a: &mut [f64]) {
@@ -243,26 +314,16 @@ impl Model {
         let n = self.n();
         let mut block = [[0.0; common::NAV_COUNT]; common::NAV_COUNT];
         common::fill_nav_block(nav, &mut block);
-        for &(r_nav, c_nav) in common::NAV_PATTERN.iter() {
-            if let (Some(i), Some(j)) = (self.nav_pos[r_nav], self.nav_pos[c_nav]) {
-                a[i * n + j] = block[r_nav][c_nav];
-            }
+        for &(r_nav, c_nav, i, j) in &self.nav_map {
+            a[i * n + j] = block[r_nav][c_nav];
         }
-        for (j, s) in self.states.iter().enumerate() {
-            if let StateRef::Term(t) = *s {
-                let reg = common::TERMS[t].regressor;
-                let rv = self
-                    .regressor_ids
-                    .iter()
-                    .position(|&x| x == reg)
-                    .map(|k| r[k])
-                    .unwrap_or(0.0);
-                let mut col = [0.0; common::NAV_COUNT];
-                common::term_column(t, nav, rv, &mut col);
-                for &row in common::TERM_ROWS[t] {
-                    if let Some(i) = self.nav_pos[row] {
-                        a[i * n + j] = col[row];
-                    }
+        for &(j, t, k) in &self.term_cols {
+            let rv = k.map(|k| r[k]).unwrap_or(0.0);
+            let mut col = [0.0; common::NAV_COUNT];
+            common::term_column(t, nav, rv, &mut col);
+            for &row in common::TERM_ROWS[t] {
+                if let Some(i) = self.nav_pos[row] {
+                    a[i * n + j] = col[row];
                 }
             }
         }

@@ -4,11 +4,11 @@
 
 use crate::estimate::filter::{self, AidingEpoch, FilterConfig, FilterRun, Mode};
 use crate::estimate::stats::chi2_quantile;
+use crate::io::units;
 use crate::model::Model;
 use crate::sim::rng::Rng;
 use crate::sim::scenario::Scenario;
 use crate::sim::simulator::{simulate, SimOutput};
-use crate::io::units;
 use nalgebra::Vector3;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -296,7 +296,11 @@ pub fn run_models(
             |f| progress(m, f),
         );
         let e = filter::model_error_rms_arcsec(&run, window.0, window.1).ok_or_else(|| {
-            anyhow::anyhow!("no truth in the RMS window {:.0}..{:.0} s", window.0, window.1)
+            anyhow::anyhow!(
+                "no truth in the RMS window {:.0}..{:.0} s",
+                window.0,
+                window.1
+            )
         })?;
         rms.insert(m.to_string(), e);
         runs.push(run);
@@ -387,7 +391,6 @@ pub struct Consistency {
     /// Fraction of epochs with the averaged NIS in its band.
     pub nis_fraction_in_band: f64,
 
-
     /// Seed-averaged NEES per update epoch (not divided by n).
     #[serde(skip)]
     pub nees_avg: Vec<f64>,
@@ -395,7 +398,10 @@ pub struct Consistency {
 
 /// 20-seed Monte Carlo with the true model: every seed draws the initial navigation errors and
 /// all 24 instrument parameters of P31 from the filter's prior N(0, P0), injects them, and runs P31.
-pub fn consistency(quick: bool, mut progress: impl FnMut(usize, usize)) -> anyhow::Result<Consistency> {
+pub fn consistency(
+    quick: bool,
+    mut progress: impl FnMut(usize, usize),
+) -> anyhow::Result<Consistency> {
     let seeds = 20usize;
     let secs = if quick { 600.0 } else { 3600.0 };
     let priors = Priors::default();
@@ -405,7 +411,9 @@ pub fn consistency(quick: bool, mut progress: impl FnMut(usize, usize)) -> anyho
     let base = cases(true, 0)[0]
         .scenario
         .replace("duration_s = 600", &format!("duration_s = {secs}"));
-    let base = &base[..base.find("[errors]").ok_or_else(|| anyhow::anyhow!("errors table"))?];
+    let base = &base[..base
+        .find("[errors]")
+        .ok_or_else(|| anyhow::anyhow!("errors table"))?];
     let mut nees_sum: Vec<f64> = Vec::new();
     let mut nis_sum: Vec<f64> = Vec::new();
     for s in 0..seeds {

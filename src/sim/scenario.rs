@@ -1,8 +1,8 @@
 //! Simulation scenarios (TOML): start state, motion segments, vibration, injected sensor errors,
 //! noise and GNSS aiding. See `scenarios/*.toml` for documented examples.
 
-use crate::model::generated::common;
 use crate::io::units;
+use crate::model::generated::common;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;

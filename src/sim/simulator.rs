@@ -4,15 +4,15 @@
 //! bias random walk and quantisation. Seeded and bit-reproducible.
 
 use crate::io::aiding::PositionFix;
-use crate::model::catalog::Sensor;
-use crate::nav::earth;
-use crate::model::generated::common;
 use crate::io::imu::{ImuData, ImuSample};
+use crate::io::truth::TruthRow;
+use crate::model::catalog::Sensor;
+use crate::model::generated::common;
+use crate::nav::earth;
+use crate::nav::strapdown::NavState;
 use crate::sim::rng::Rng;
 use crate::sim::scenario::Scenario;
-use crate::nav::strapdown::NavState;
 use crate::sim::trajectory::Trajectory;
-use crate::io::truth::TruthRow;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Everything a simulation produces.

@@ -4,10 +4,10 @@
 //! acceleration, attitude and body rate are exact derivatives of each other; position is
 //! integrated from the velocity (see `simulator`).
 
+use crate::io::units;
 use crate::nav::attitude::dcm_from_euler;
 use crate::sim::rng::Rng;
 use crate::sim::scenario::Scenario;
-use crate::io::units;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
 
