@@ -107,3 +107,130 @@ fn closed_loop_feedback_keeps_the_navigator_on_the_truth() {
     let s = open.records.last().unwrap().sigma[i];
     assert!((eo - ec).abs() < s, "eps_x open {eo} closed {ec} sigma {s}");
 }
+
+/// The residual the filter forms for each spec measurement agrees to first order with the
+/// generated H: perturbing the computed state by δx changes z by H δx. A radius mix-up in H
+/// (R_N for R_M, 0.7 % at 60°) or a residual in other units fails this.
+#[test]
+fn residual_matches_generated_h() {
+    use sinsmodel::estimate::filter::{residual, AidingEpoch, FORMED_MEASUREMENTS};
+    use sinsmodel::model::generated::common;
+    use sinsmodel::nav::nav_point::NavPoint;
+    use sinsmodel::nav::strapdown::NavState;
+    // every spec measurement has a residual in the filter
+    for m in common::MEASUREMENTS.iter() {
+        assert!(
+            FORMED_MEASUREMENTS.contains(&m.name),
+            "spec measurement `{}` has no residual in the filter",
+            m.name
+        );
+    }
+    let model = Model::parse("P13+vertical").unwrap();
+    let n = model.n();
+    for &lat_deg in &[0.0, 35.0, 60.0, -72.0] {
+        let truth = NavState {
+            t: 1.0,
+            lat: f64::to_radians(lat_deg),
+            lon: 0.3,
+            h: 1200.0,
+            v: nalgebra::Vector3::new(12.0, -7.0, 0.5),
+            q: nalgebra::UnitQuaternion::identity(),
+        };
+        let ep = AidingEpoch {
+            t: 1.0,
+            vel: Some((truth.v, 0.01)),
+            pos: Some((truth.lat, truth.lon, truth.h, [0.5, 0.5, 1.0])),
+        };
+        // computed = truth + δ (δ in the model's error states)
+        let mut dx = vec![0.0; n];
+        let set = |dx: &mut Vec<f64>, name: &str, v: f64| dx[model.index_of(name).unwrap()] = v;
+        set(&mut dx, "dlat", 3e-6);
+        set(&mut dx, "dlon", -5e-6);
+        set(&mut dx, "dh", 4.0);
+        set(&mut dx, "dv_n", 0.2);
+        set(&mut dx, "dv_e", -0.3);
+        set(&mut dx, "dv_d", 0.1);
+        let mut comp = truth;
+        comp.lat += dx[model.index_of("dlat").unwrap()];
+        comp.lon += dx[model.index_of("dlon").unwrap()];
+        comp.h += dx[model.index_of("dh").unwrap()];
+        comp.v += nalgebra::Vector3::new(0.2, -0.3, 0.1);
+        let np = NavPoint::new(
+            comp.lat,
+            comp.h,
+            comp.v,
+            &comp.dcm(),
+            &nalgebra::Vector3::new(0.0, 0.0, -9.8),
+        );
+        for m in model.measurements() {
+            let (z, _) = residual(m.name, &comp, &ep).expect("epoch carries it");
+            let mut h = vec![0.0; m.rows.len() * n];
+            model.fill_h(m.name, &np, &mut h).unwrap();
+            for (c, zc) in z.iter().enumerate() {
+                let hx: f64 = (0..n).map(|j| h[c * n + j] * dx[j]).sum();
+                let rel = (zc - hx).abs() / zc.abs();
+                assert!(
+                    rel < 1e-5,
+                    "{} component {c} at lat {lat_deg}: z {zc} vs H dx {hx} (rel {rel:.2e})",
+                    m.name
+                );
+            }
+        }
+    }
+}
+
+/// One precise position update recovers a large initial position error through the filter's
+/// H: with R_N in place of R_M the estimate is off by 0.67 % near the equator, with cos(lat)
+/// missing by a factor 3 at 70°; either fails this (tolerance 0.1 %).
+#[test]
+fn filter_position_update_recovers_the_position_error() {
+    for lat in ["2.0", "70.0"] {
+        position_update_at(lat);
+    }
+}
+
+fn position_update_at(lat_deg: &str) {
+    let case = &reproduce::cases(true, 3)[0];
+    let text = case
+        .scenario
+        .replace("lat_deg = 28.22", &format!("lat_deg = {lat_deg}"))
+        .replace("duration_s = 600", "duration_s = 5");
+    let sim = simulate(&Scenario::parse(&text, "highlat").unwrap(), |_| {});
+    let model = Model::parse("P13").unwrap();
+    let mut cfg = FilterConfig::new(&model);
+    cfg.set_prior(&model, "dlat", 1e-3);
+    cfg.set_prior(&model, "dlon", 1e-3);
+    let (dlat, dlon) = (4e-5, -6e-5); // ≈ 255 m north, 130 m east at 70°
+    let mut start = sim.start;
+    start.lat += dlat;
+    start.lon += dlon;
+    let row = sim.truth.iter().find(|r| (r.t - 1.0).abs() < 1e-9).unwrap();
+    let aid = [filter::AidingEpoch {
+        t: row.t,
+        vel: None,
+        pos: Some((row.lat, row.lon, row.h, [0.001, 0.001, 0.001])),
+    }];
+    let run = filter::run(
+        &model,
+        &cfg,
+        &sim.imu,
+        start,
+        &aid,
+        Some(&sim.truth),
+        |_| {},
+    );
+    let r = &run.records[0];
+    let (il, io) = (
+        model.index_of("dlat").unwrap(),
+        model.index_of("dlon").unwrap(),
+    );
+    let true_lat = r.nav.lat - row.lat;
+    let true_lon = r.nav.lon - row.lon;
+    let e_lat = (r.x[il] - true_lat).abs() / true_lat.abs();
+    let e_lon = (r.x[io] - true_lon).abs() / true_lon.abs();
+    eprintln!("lat {lat_deg}: relative error of the estimate: dlat {e_lat:.2e}, dlon {e_lon:.2e}");
+    assert!(
+        e_lat < 1e-3 && e_lon < 1e-3,
+        "lat {lat_deg}: dlat {e_lat:.2e}, dlon {e_lon:.2e}"
+    );
+}
