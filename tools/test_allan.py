@@ -16,7 +16,9 @@ import allantools
 import numpy as np
 
 HERE = os.path.dirname(__file__)
-BIN = os.environ.get("SINSMODEL_BIN", os.path.join(HERE, "..", "target", "debug", "sinsmodel"))
+BIN = os.environ.get("SINSMODEL_BIN") or subprocess.run(
+    [os.path.join(os.path.dirname(os.path.abspath(__file__)), "sinsmodel-bin")],
+    check=True, capture_output=True, text=True).stdout.strip()
 PSINS = os.path.join(HERE, "..", "..", "shared", "data", "psins-lasergyro", "lasergyro.imu")
 NAMES = ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]
 

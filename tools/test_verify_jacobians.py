@@ -7,13 +7,16 @@ Run: target/tools-venv/bin/python -m unittest tools/test_verify_jacobians.py (ne
 import contextlib
 import io
 import os
+import subprocess
 import sys
 import unittest
 
 sys.path.insert(0, os.path.dirname(__file__))
 import verify_jacobians as vj  # noqa: E402
 
-BIN = os.environ.get("SINSMODEL_BIN", os.path.join(os.path.dirname(__file__), "..", "target", "debug", "sinsmodel"))
+BIN = os.environ.get("SINSMODEL_BIN") or subprocess.run(
+    [os.path.join(os.path.dirname(os.path.abspath(__file__)), "sinsmodel-bin")],
+    check=True, capture_output=True, text=True).stdout.strip()
 
 
 def run(*args):
@@ -33,18 +36,22 @@ class MisprintsAreCaught(unittest.TestCase):
         code, out = run("--models", "P31", "P31+vertical")
         self.assertEqual(code, 0, out)
 
-    def check_fails(self, k, model):
+    def check_fails(self, k, model, names=None):
+        """The check fails and, where `names` is given, the message names that entry."""
         code, out = run("--corrupt", str(k), "--models", model)
         self.assertEqual(code, 1, f"misprint {k} not caught:\n{out}")
+        if names:
+            self.assertIn(f"at {names}:", out, f"misprint {k}: wrong entry named:\n{out}")
+            self.assertNotIn("np.float64", out, "plain floats in the report")
 
     def test_misprint_1_cos2L(self):
-        self.check_fails(1, "P31")
+        self.check_fails(1, "P31", "A[phi_d][dlat]")
 
     def test_misprint_2_tan_in_dv_n_dlat(self):
-        self.check_fails(2, "P31")
+        self.check_fails(2, "P31", "A[dv_n][dlat]")
 
     def test_misprint_3_c12_in_gyro_scale_block(self):
-        self.check_fails(3, "P31")
+        self.check_fails(3, "P31", "A[phi_d][kg_32]")
 
     def test_misprint_4_parameter_rows(self):
         self.check_fails(4, "P31")
@@ -53,7 +60,31 @@ class MisprintsAreCaught(unittest.TestCase):
         self.check_fails(5, "P31")
 
     def test_misprint_6_dh_rate(self):
-        self.check_fails(6, "P31+vertical")
+        self.check_fails(6, "P31+vertical", "A[dh][dv_d]")
+
+    def test_wrong_radius_in_h_is_named_in_h(self):
+        self.check_fails(7, "P31", "H[pos_ne][0][dlat]")
+
+    def test_every_spec_term_is_checked_by_default(self):
+        models = vj.default_models()
+        named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}
+        self.assertEqual(set(vj.TERMS) - named, set())
+
+
+class RegressorTranslation(unittest.TestCase):
+    def test_translates_the_spec_grammar(self):
+        import casadi as ca
+        f, w = ca.DM([1.5, -2.0, 3.0]), ca.DM([0.1, 0.2, -0.3])
+        for text, want in [("1", 1.0), ("f.x * f.y", -3.0), ("f.z.powi(2)", 9.0), ("f.y.abs()", 2.0),
+                           ("f.y * f.y.abs()", -4.0), ("-(w.y.powi(2) + w.z.powi(2))", -0.13),
+                           ("f.x / 2.0 - w.x", 0.65)]:
+            got = float(vj.translate_regressor(text, "t")(f, w))
+            self.assertAlmostEqual(got, want, places=12, msg=text)
+
+    def test_rejects_what_it_cannot_translate(self):
+        for text in ["f.x.exp()", "g.y", "f.x ** 2", "f.x.powi(h)", "import os", "f[0]", "lat"]:
+            with self.assertRaises(vj.SpecTranslationError, msg=text):
+                vj.translate_regressor(text, "t")
 
 
 if __name__ == "__main__":

@@ -3,11 +3,16 @@
 
 The nonlinear strapdown equations (NED navigation frame, FRD body frame, WGS-84, radii frozen at
 the true latitude, normal gravity by Somigliana with the WGS-84 free-air term) are written here
-from scratch for a true and an error-corrupted navigator. The error state is defined by
-C~ = (I - [phi x]) C, dv = v~ - v, dlat, dlon, dh = computed - true, and the instrument error
-terms by this file's own table (DESIGN.md §2, §7), not by the project's spec. CasADi
-differentiates the error-state derivative at zero error; the result is compared with
-`sinsmodel jacobian` at random points for several models, together with the structural sparsity.
+from scratch for a true and an error-corrupted navigator, and so are the measurements (velocity,
+north/east position in metres, height). The error state is defined by C~ = (I - [phi x]) C,
+dv = v~ - v, dlat, dlon, dh = computed - true. The instrument error terms are read from the spec
+(`model-spec/terms.toml`: each term's sensor, axis and regressor, the regressor translated into
+CasADi; anything the translator does not know is rejected loudly): a term corrupts its sensor,
+w_meas = w + theta * r(f, w) or f_meas = f + theta * r(f, w), and CasADi differentiates the
+error-state derivative of the nonlinear equations at zero error. Nothing of the spec's A(t), H or
+composition rule is read. The result is compared with `sinsmodel jacobian` at random points for
+every preset (with and without the vertical channel) and for the largest preset plus every other
+spec term, so every spec term is checked by default; the structural sparsity is compared too.
 
 Error metric: for a structural non-zero, |generated - casadi| / max(|casadi|, 1e-6 * s_row), with
 s_row = max(1, max |casadi row|, |w_b|); a structural zero must have |casadi| <= 1e-14 * s_row.
@@ -70,60 +75,108 @@ def dcm_from_euler(roll, pitch, yaw):
     return rz @ ry @ rx
 
 
-# ---------------------------------------------------------------- instrument terms (DESIGN §2, §7)
-def _fx(f, w): return f[0]
-def _fy(f, w): return f[1]
-def _fz(f, w): return f[2]
+# ---------------------------------------------------------------- instrument terms, read from the spec
+import ast  # noqa: E402
+import os  # noqa: E402
+import tomllib  # noqa: E402
+
+SPEC_DIR = os.environ.get("SINSMODEL_SPEC_DIR", os.path.join(os.path.dirname(__file__), "..", "model-spec"))
 
 
-TERMS = {}
+class SpecTranslationError(Exception):
+    """A spec regressor the checker cannot translate into CasADi."""
 
 
-def term(name, sensor, axis, regressor):
-    TERMS[name] = (sensor, "xyz".index(axis), regressor)
+_METHODS = {
+    "abs": lambda x: ca.fabs(x),
+    "sqrt": lambda x: ca.sqrt(x),
+    "sin": lambda x: ca.sin(x),
+    "cos": lambda x: ca.cos(x),
+    "tan": lambda x: ca.tan(x),
+}
 
 
-for ax in "xyz":
-    term(f"eps_{ax}", "gyro", ax, lambda f, w: 1.0)
-    term(f"nabla_{ax}", "accel", ax, lambda f, w: 1.0)
-# gyro lower-triangular scale/misalignment: kg_ij, gyro i, regressor w_j
-for name, i, j in [("kg_11", 0, 0), ("kg_21", 1, 0), ("kg_31", 2, 0), ("kg_22", 1, 1), ("kg_32", 2, 1), ("kg_33", 2, 2)]:
-    term(name, "gyro", "xyz"[i], (lambda jj: lambda f, w: w[jj])(j))
-# accelerometer full matrix: ka_ij, accel i, regressor f_j
-for i in range(3):
-    for j in range(3):
-        term(f"ka_{i + 1}{j + 1}", "accel", "xyz"[i], (lambda jj: lambda f, w: f[jj])(j))
-for i, ax in enumerate("xyz"):
-    term(f"d_{ax}", "accel", ax, (lambda ii: lambda f, w: f[ii] ** 2)(i))
-LIBRARY = []
+def translate_regressor(text, term):
+    """Turns a spec regressor (Rust syntax: `f.x * f.y`, `f.z.powi(2)`, `-(w.y.powi(2) + w.z.powi(2))`)
+    into a function (f, w) -> CasADi expression. Only literals, f.x..w.z, + - * /, unary minus and
+    the methods abs sqrt sin cos tan powi(integer) are accepted; anything else raises."""
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as e:
+        raise SpecTranslationError(f"term `{term}`: regressor `{text}`: not an expression the checker reads ({e.msg})")
+
+    def fail(node, why):
+        raise SpecTranslationError(f"term `{term}`: regressor `{text}`: cannot translate `{ast.unparse(node)}` ({why})")
+
+    def tr(node):
+        if isinstance(node, ast.Constant) and type(node.value) in (int, float):
+            v = float(node.value)
+            return lambda f, w: v
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            if node.value.id in ("f", "w") and node.attr in ("x", "y", "z"):
+                sig, k = node.value.id, "xyz".index(node.attr)
+                return (lambda f, w: f[k]) if sig == "f" else (lambda f, w: w[k])
+            fail(node, "signals are f.x f.y f.z and w.x w.y w.z")
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+            inner = tr(node.operand)
+            return (lambda f, w: -inner(f, w)) if isinstance(node.op, ast.USub) else inner
+        if isinstance(node, ast.BinOp):
+            a, b = tr(node.left), tr(node.right)
+            ops = {ast.Add: lambda x, y: x + y, ast.Sub: lambda x, y: x - y,
+                   ast.Mult: lambda x, y: x * y, ast.Div: lambda x, y: x / y}
+            op = ops.get(type(node.op))
+            if op is None:
+                fail(node, "operators are + - * /")
+            return lambda f, w: op(a(f, w), b(f, w))
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and not node.keywords:
+            recv, name = tr(node.func.value), node.func.attr
+            if name == "powi":
+                if len(node.args) != 1 or not (isinstance(node.args[0], ast.Constant) and type(node.args[0].value) is int):
+                    fail(node, "powi takes one integer literal")
+                k = node.args[0].value
+                return lambda f, w: recv(f, w) ** k
+            if name in _METHODS and not node.args:
+                m = _METHODS[name]
+                return lambda f, w: m(recv(f, w))
+            fail(node, f"methods are {' '.join(sorted(_METHODS))} powi")
+        fail(node, "not arithmetic over f and w")
+
+    return tr(tree.body)
 
 
-def lib(name, sensor, axis, regressor):
-    term(name, sensor, axis, regressor)
-    LIBRARY.append(name)
+def load_spec_terms(spec_dir=SPEC_DIR):
+    """Every term of the spec as name -> (sensor, axis index, regressor function), the library
+    names, and the presets (name -> state list, `base` + `terms` resolved)."""
+    with open(os.path.join(spec_dir, "terms.toml"), "rb") as fh:
+        raw = tomllib.load(fh)
+    terms, library = {}, []
+    for t in raw.get("term", []):
+        name = t["name"]
+        if t["sensor"] not in ("gyro", "accel") or t["axis"] not in ("x", "y", "z"):
+            raise SpecTranslationError(f"term `{name}`: sensor `{t['sensor']}` / axis `{t['axis']}` unknown to the checker")
+        terms[name] = (t["sensor"], "xyz".index(t["axis"]), translate_regressor(t["regressor"], name))
+        if t.get("library", False):
+            library.append(name)
+    with open(os.path.join(spec_dir, "presets.toml"), "rb") as fh:
+        raw_p = tomllib.load(fh)
+    presets = {}
+    for p in raw_p.get("preset", []):
+        states = p["states"] if "states" in p else presets[p["base"]] + list(p.get("terms", []))
+        presets[p["name"]] = states
+    return terms, library, presets
 
 
-for name, i, j, k in [("kaq_x_xy", 0, 0, 1), ("kaq_x_xz", 0, 0, 2), ("kaq_y_xy", 1, 0, 1),
-                      ("kaq_y_yz", 1, 1, 2), ("kaq_z_xz", 2, 0, 2), ("kaq_z_yz", 2, 1, 2)]:
-    lib(name, "accel", "xyz"[i], (lambda a, b: lambda f, w: f[a] * f[b])(j, k))
-for i, ax in enumerate("xyz"):
-    lib(f"kas_{ax}", "accel", ax, (lambda ii: lambda f, w: ca.fabs(f[ii]))(i))
-for i, ax in enumerate("xyz"):
-    lib(f"kao_{ax}", "accel", ax, (lambda ii: lambda f, w: f[ii] * ca.fabs(f[ii]))(i))
-for i, gx in enumerate("xyz"):
-    for j, fx in enumerate("xyz"):
-        lib(f"kgf_{gx}{fx}", "gyro", gx, (lambda jj: lambda f, w: f[jj])(j))
-for i, ax in enumerate("xyz"):
-    j, k = [a for a in range(3) if a != i]
-    lib(f"kgq_{ax}", "gyro", ax, (lambda a, b: lambda f, w: f[a] * f[b])(j, k))
-for i, ax in enumerate("xyz"):
-    j, k = [a for a in range(3) if a != i]
-    lib(f"size_{ax}", "accel", ax, (lambda a, b: lambda f, w: -(w[a] ** 2 + w[b] ** 2))(j, k))
+try:
+    TERMS, LIBRARY, PRESETS = load_spec_terms()
+except (SpecTranslationError, OSError, KeyError, tomllib.TOMLDecodeError) as _e:
+    sys.exit(f"verify_jacobians: spec {os.path.abspath(SPEC_DIR)}: {_e}")
 
 NAV = ["phi_n", "phi_e", "phi_d", "dv_n", "dv_e", "dv_d", "dlat", "dlon", "dh"]
 TERM_NAMES = list(TERMS)
 ALL_STATES = NAV + TERM_NAMES
-
+# the measurements, written independently: z = [dv_n, dv_e, dp_n, dp_e, dp_u]
+MEAS_ROWS = {"vel_ne": [0, 1], "pos_ne": [2, 3], "pos_h": [4]}
+MEAS_STATES = {"vel_ne": ["dv_n", "dv_e"], "pos_ne": ["dlat", "dlon"], "pos_h": ["dh"]}
 
 # ---------------------------------------------------------------- the nonlinear error dynamics
 def build_jacobian_function():
@@ -216,6 +269,9 @@ def corrupt(kind, out, pt):
                         a[idx[row]][idx[f"d_{ax}"]] = cm[k, i] * f[i]
     elif kind == 6 and "dh" in idx:
         a[idx["dh"]][idx["dv_d"]] = 0.0
+    elif kind == 7 and "pos_ne" in out["h"]:
+        # not a paper misprint: the radius mix-up of an H (R_N + h for R_M + h on dp_n)
+        out["h"]["pos_ne"][0][idx["dlat"]] = rn
 
 
 def random_points(n, rng):
@@ -253,6 +309,10 @@ def run_sinsmodel(binary, model, points, runtime):
 
 
 def check_model(binary, model, points, fun, x0, sparsity, tol, corrupt_kind, runtime):
+    """Compares one model's generated A and H with CasADi's at every point. Returns (problems,
+    worst absolute error, worst relative error, where the worst relative error is (a label like
+    `A[phi_d][dlat]` or `H[pos_ne][dp_n][dlat]`, generated value, CasADi value), number of
+    CasADi structural entries that cancel numerically)."""
     outs = run_sinsmodel(binary, model, points, runtime)
     worst_abs, worst_rel, worst_at = 0.0, 0.0, None
     problems = []
@@ -261,7 +321,6 @@ def check_model(binary, model, points, fun, x0, sparsity, tol, corrupt_kind, run
     if unknown:
         return [f"states unknown to the independent model: {unknown}"], 0, 0, None, 0
     cols = [ALL_STATES.index(s) for s in states]
-    nav_rows = [NAV.index(s) for s in states if s in NAV]
     n = len(states)
     # structural: CasADi's pattern restricted to the model, vs the generated pattern
     cas_struct = set()
@@ -273,6 +332,9 @@ def check_model(binary, model, points, fun, x0, sparsity, tol, corrupt_kind, run
     if missing:
         problems.append(f"generated non-zeros that CasADi says are structurally zero: "
                         f"{sorted((states[i], states[j]) for i, j in missing)[:8]}")
+    unknown_meas = sorted(set(outs[0]["h"]) - set(MEAS_ROWS))
+    if unknown_meas:
+        problems.append(f"measurements unknown to the independent model (not checked): {unknown_meas}")
     extra_nonzero = set()
     for pt, out in zip(points, outs):
         if corrupt_kind:
@@ -301,29 +363,59 @@ def check_model(binary, model, points, fun, x0, sparsity, tol, corrupt_kind, run
                     # of ~1e-16*|w| from the body-rate terms that cancel analytically)
                     rel = d / max(abs(ref[i, j]), 1e-6 * row_scale)
                     if rel > worst_rel:
-                        worst_rel, worst_at = rel, (states[i], states[j], gen[i, j], ref[i, j])
+                        worst_rel = rel
+                        worst_at = (f"A[{states[i]}][{states[j]}]", float(gen[i, j]), float(ref[i, j]))
                 elif abs(ref[i, j]) > zero_tol or gen[i, j] != 0.0:
                     extra_nonzero.add((states[i], states[j]))
-        # H: rows of z = [dv_n, dv_e, dp_n, dp_e, dp_u]
-        h_rows = {"vel_ne": [0, 1], "pos_ne": [2, 3], "pos_h": [4]}
-        for name, rows in h_rows.items():
-            needs = {"vel_ne": ["dv_n", "dv_e"], "pos_ne": ["dlat", "dlon"], "pos_h": ["dh"]}[name]
-            if all(s in states for s in needs):
-                if name not in out["h"]:
-                    problems.append(f"H {name} missing")
-                    continue
-                hg = np.array(out["h"][name])
-                hr = jh[rows][:, cols]
-                d = np.abs(hg - hr)
-                rel = float(np.max(d / np.maximum(np.abs(hr), 1e-12)))
-                worst_rel = max(worst_rel, rel if np.max(d) > 0 else 0.0)
-                worst_abs = max(worst_abs, float(np.max(d)))
+        for name, rows in MEAS_ROWS.items():
+            if not all(s in states for s in MEAS_STATES[name]):
+                continue
+            if name not in out["h"]:
+                problems.append(f"H {name} missing")
+                continue
+            hg = np.array(out["h"][name], dtype=float)
+            hr = jh[rows][:, cols]
+            if hg.shape != hr.shape:
+                problems.append(f"H {name} has shape {hg.shape}, expected {hr.shape}")
+                continue
+            for c in range(hr.shape[0]):
+                for j in range(n):
+                    d = abs(hg[c, j] - hr[c, j])
+                    worst_abs = max(worst_abs, d)
+                    if d == 0.0:
+                        continue
+                    rel = d / max(abs(hr[c, j]), 1e-12)
+                    if rel > worst_rel:
+                        worst_rel = rel
+                        worst_at = (f"H[{name}][{c}][{states[j]}]", float(hg[c, j]), float(hr[c, j]))
     if extra_nonzero:
         problems.append(f"CasADi non-zeros outside the generated pattern: {sorted(extra_nonzero)[:8]}")
     if worst_rel > tol:
-        problems.append(f"worst relative error {worst_rel:.3e} > {tol:.1e} at {worst_at}")
+        label, g, r = worst_at
+        problems.append(f"worst relative error {worst_rel:.3e} > {tol:.1e} at {label}: generated {g:.12g}, CasADi {r:.12g}")
     cancelled = len(cas_struct - gen_struct)
     return problems, worst_abs, worst_rel, worst_at, cancelled
+
+
+def default_models():
+    """Every spec preset with and without the vertical channel, and the largest preset with every
+    spec term it lacks (with and without vertical): every term of the spec is checked."""
+    models = []
+    for name in PRESETS:
+        models += [name, f"{name}+vertical"]
+    largest = max(PRESETS, key=lambda k: len(PRESETS[k]))
+    rest = [t for t in TERM_NAMES if t not in PRESETS[largest]]
+    if rest:
+        models += [f"{largest}+{'+'.join(rest)}", f"{largest}+vertical+{'+'.join(rest)}"]
+    return models
+
+
+def label_of(model):
+    parts = model.split("+")
+    if len(parts) <= 4:
+        return model
+    head = [p for p in parts[:2] if p == parts[0] or p == "vertical"]
+    return "+".join(head) + f"+<{len(parts) - len(head)} terms>"
 
 
 def main():
@@ -333,18 +425,17 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A: the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne]; the check must fail")
     args = ap.parse_args()
 
-    lib_terms = "+".join(LIBRARY)
-    models = args.models or ["P13", "P24", "P28", "P31", "P31+vertical", f"P31+{lib_terms}", f"P31+vertical+{lib_terms}"]
+    models = args.models or default_models()
     fun, x0, sparsity = build_jacobian_function()
     rng = np.random.default_rng(args.seed)
     points = random_points(args.points, rng)
     failed = False
     overall_abs, overall_rel = 0.0, 0.0
     for model in models:
-        label = model if len(model) < 40 else model[:model.index("+", 4)] + "+<27 library terms>"
+        label = label_of(model)
         for runtime in (False, True):
             problems, wa, wr, at, cancelled = check_model(args.bin, model, points, fun, x0, sparsity, args.tol,
                                                           args.corrupt, runtime)
@@ -356,6 +447,10 @@ def main():
                 print(f"     - {p}")
             failed |= bool(problems)
             overall_abs, overall_rel = max(overall_abs, wa), max(overall_rel, wr)
+    checked = {s for m in models for s in m.split("+")[1:] if s in TERMS}
+    checked |= {s for m in models for s in PRESETS.get(m.split("+")[0], []) if s in TERMS}
+    print(f"spec terms checked: {len(checked)} of {len(TERMS)}"
+          + ("" if len(checked) == len(TERMS) else f" (not checked: {sorted(set(TERMS) - checked)})"))
     print(f"points {len(points)}, models {len(models)}: worst absolute error {overall_abs:.3e}, "
           f"worst relative error {overall_rel:.3e} (tolerance {args.tol:.1e} relative)")
     print("FAILED" if failed else "PASSED")

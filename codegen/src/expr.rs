@@ -128,8 +128,8 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
         syn::Expr::Binary(b) => {
             let (l, r) = (dimension(&b.left)?, dimension(&b.right)?);
             match b.op {
-                syn::BinOp::Mul(_) => Ok(l.mul(r)),
-                syn::BinOp::Div(_) => Ok(l.div(r)),
+                syn::BinOp::Mul(_) => Ok(l.times(r)),
+                syn::BinOp::Div(_) => Ok(l.per(r)),
                 _ if l == r => Ok(l),
                 _ => Err(format!(
                     "`{}` adds or subtracts unlike dimensions [{l}] and [{r}]",
@@ -305,7 +305,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                     })) => i.base10_parse::<i32>().ok(),
                     _ => None,
                 };
-                if !k.is_some_and(|k| k.abs() <= crate::units::MAX_POWER) {
+                if k.is_none_or(|k| k.abs() > crate::units::MAX_POWER) {
                     return Err(format!(
                         "`powi` exponent out of range (|n| <= {})",
                         crate::units::MAX_POWER

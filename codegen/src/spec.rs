@@ -772,7 +772,7 @@ fn check_term_dimension(
     let want = units::parse_unit(sensor_unit)
         .expect("sensor unit parses")
         .dim;
-    let got = unit.mul(reg_dim);
+    let got = unit.times(reg_dim);
     if got.0[0] != want.0[0] || got.0[1] != want.0[1] {
         return Err(src.error(
             t.unit.span(),
@@ -783,7 +783,7 @@ fn check_term_dimension(
                 t.regressor.get_ref(),
                 reg_dim,
                 got,
-                want.div(reg_dim)
+                want.per(reg_dim)
             )
             .trim_end()
             .to_string(),

@@ -27,11 +27,11 @@ impl Dim {
         Dim([self.0[0] * k, self.0[1] * k, self.0[2] * k])
     }
     /// Dimension of a product.
-    pub fn mul(self, o: Dim) -> Dim {
+    pub fn times(self, o: Dim) -> Dim {
         self.add(o, 1)
     }
     /// Dimension of a quotient.
-    pub fn div(self, o: Dim) -> Dim {
+    pub fn per(self, o: Dim) -> Dim {
         self.add(o, -1)
     }
     /// Dimension raised to an integer power (|k| ≤ [`MAX_POWER`]).

@@ -227,7 +227,7 @@ fn consistency(args: &ReproduceArgs) -> Result<()> {
         "update epoch [s]",
         "NEES / n",
         &[
-            series(&nees_avg, n as f64, "NEES/n"),
+            series(nees_avg, n as f64, "NEES/n"),
             Series {
                 label: "95% band".into(),
                 points: vec![

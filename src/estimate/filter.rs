@@ -471,9 +471,7 @@ impl<'a> Engine<'a> {
         let s = &mut self.nav.state;
         // C~ = (I − [φ×]) C  ⇒  C = exp([φ×]) C~
         s.q = UnitQuaternion::from_scaled_axis(phi) * s.q;
-        for c in 0..3 {
-            s.v[c] -= dv[c];
-        }
+        s.v -= Vector3::from(dv);
         s.lat -= dpos[0];
         s.lon -= dpos[1];
         s.h -= dpos[2];

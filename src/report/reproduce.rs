@@ -270,6 +270,9 @@ pub fn run_case(
     ))
 }
 
+/// Model error RMS [arcsec] north, east, by model name.
+pub type ModelErrors = BTreeMap<String, [f64; 2]>;
+
 /// Runs each model (open loop, the case priors) on the same simulation and aiding; returns the
 /// model error RMS [arcsec] north, east over `window` [s] per model, and the runs. The one
 /// P28/P31 run loop of the reproduction, the priors study and the tests.
@@ -280,7 +283,7 @@ pub fn run_models(
     priors: &Priors,
     window: (f64, f64),
     mut progress: impl FnMut(&str, f64),
-) -> anyhow::Result<(BTreeMap<String, [f64; 2]>, Vec<FilterRun>)> {
+) -> anyhow::Result<(ModelErrors, Vec<FilterRun>)> {
     let mut rms = BTreeMap::new();
     let mut runs = Vec::new();
     for &m in models {
