@@ -1,14 +1,11 @@
 //! `sinsmodel filter --model MODEL --imu FILE --aid FILE [--truth FILE] [--init …] --out DIR`.
 
-use anyhow::{bail, Context, Result};
+use super::data::DataArgs;
+use anyhow::{Context, Result};
 use clap::Args;
-use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
+use sinsmodel::estimate::filter;
 use sinsmodel::io::atomic_file::AtomicFile;
-use sinsmodel::io::{aiding, readers, truth};
 use sinsmodel::model::Model;
-use sinsmodel::nav::attitude::dcm_from_euler;
-use sinsmodel::nav::strapdown::{NavState, Vertical};
 use sinsmodel::report::progress;
 use std::io::Write;
 use std::path::PathBuf;
@@ -19,39 +16,8 @@ pub struct FilterArgs {
     /// Model, e.g. P31, P28+kaq_x_xy, P31+vertical.
     #[arg(long)]
     model: String,
-    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
-    #[arg(long)]
-    imu: PathBuf,
-    /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
-    #[arg(long)]
-    aid: Option<PathBuf>,
-    /// A static vehicle at a known position: lat,lon [deg],h [m]; position updates (σ 0.1 m) and
-    /// zero-velocity updates (σ from --zupt, default 0.01 m/s) at 1 Hz instead of --aid.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    static_aid: Option<Vec<f64>>,
-    /// Prior 1-σ of a state, NAME=QUANTITY with units (repeatable); a trailing `*` matches a
-    /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`.
-    #[arg(long)]
-    prior: Vec<String>,
-    /// Sensor white noise from `sinsmodel allan --json` (mean ARW of the gyros, VRW of the
-    /// accelerometers) instead of the spec defaults.
-    #[arg(long)]
-    noise: Option<PathBuf>,
-    /// Truth file (t lat lon h vn ve vd roll pitch yaw): adds the true φ and the model error.
-    #[arg(long)]
-    truth: Option<PathBuf>,
-    /// Initial lat,lon [deg],h [m],roll,pitch,yaw [deg][,vn,ve,vd m/s]; default: the first truth row.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    init: Option<Vec<f64>>,
-    /// open (errors estimated only) or closed (fed back).
-    #[arg(long, default_value = "open")]
-    mode: String,
-    /// Filter step [s].
-    #[arg(long, default_value_t = 0.01)]
-    step: f64,
-    /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
-    #[arg(long)]
-    zupt: Option<f64>,
+    #[command(flatten)]
+    data: DataArgs,
     /// Output directory: states.txt, innovations.txt, model_error.txt (with truth).
     #[arg(long)]
     out: PathBuf,
@@ -60,153 +26,13 @@ pub struct FilterArgs {
 /// Runs the command.
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
-    let mut cfg = FilterConfig::new(&model);
-    cfg.mode = match args.mode.as_str() {
-        "open" => Mode::OpenLoop,
-        "closed" => Mode::ClosedLoop,
-        m => bail!("--mode `{m}`: expected open or closed"),
-    };
-    if args.step.is_nan() || args.step <= 0.0 {
-        bail!("--step must be positive");
-    }
-    cfg.step_s = args.step;
-    if !model.vertical {
-        cfg.vertical = Vertical::Fixed;
-    }
-    let imu = readers::read_any_imu(&args.imu)?;
-    imu.check_time(&args.imu.display().to_string(), 5.0)?;
-    for spec in &args.prior {
-        let (name, value) = spec
-            .split_once('=')
-            .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
-        let (name, value) = (name.trim(), value.trim());
-        let matches: Vec<usize> = (0..model.n())
-            .filter(|&i| match name.strip_suffix('*') {
-                Some(prefix) => model.names[i].starts_with(prefix),
-                None => model.names[i] == name,
-            })
-            .collect();
-        if matches.is_empty() {
-            bail!(
-                "--prior `{spec}`: no state `{name}` in model {}",
-                model.name
-            );
-        }
-        for i in matches {
-            let si = sinsmodel::io::units::parse_quantity_as(value, model.unit(i))
-                .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
-            cfg.prior_sigma[i] = si;
-        }
-    }
-    if let Some(path) = &args.noise {
-        let (arw, vrw) = noise_from_allan(path)?;
-        cfg = cfg.with_sensor_noise(&model, arw, vrw);
-        eprintln!(
-            "noise from {}: ARW {:.3e} rad/sqrt(s), VRW {:.3e} m/s/sqrt(s)",
-            path.display(),
-            arw,
-            vrw
-        );
-    }
-    let fixes = match (&args.aid, &args.static_aid) {
-        (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {
-            sinsmodel::io::readers::rtklib::read(p)?
-                .iter()
-                .map(|e| aiding::PositionFix {
-                    t: e.t,
-                    lat: e.lat_deg.to_radians(),
-                    lon: e.lon_deg.to_radians(),
-                    h: e.h,
-                    sigma: [
-                        e.sigma_neu[0].max(0.02),
-                        e.sigma_neu[1].max(0.02),
-                        e.sigma_neu[2].max(0.05),
-                    ],
-                })
-                .collect()
-        }
-        (Some(p), None) => aiding::read(p)?,
-        (None, Some(v)) if v.len() == 3 => {
-            let (t_first, t_last) = (imu.samples[0].t, imu.samples[imu.samples.len() - 1].t);
-            (1..)
-                .map(|k| t_first.floor() + k as f64)
-                .take_while(|t| *t <= t_last)
-                .map(|t| aiding::PositionFix {
-                    t,
-                    lat: v[0].to_radians(),
-                    lon: v[1].to_radians(),
-                    h: v[2],
-                    sigma: [0.1, 0.1, 0.1],
-                })
-                .collect()
-        }
-        _ => bail!("give either --aid FILE or --static-aid LAT,LON,H"),
-    };
-    let zupt = args.zupt.or(args.static_aid.as_ref().map(|_| 0.01));
-    let truth_rows = match &args.truth {
-        Some(p) => Some(truth::read(p)?),
-        None => None,
-    };
-    let t0 = imu.samples[0].t - imu.interval();
-    let d = std::f64::consts::PI / 180.0;
-    let start = match (&args.init, &truth_rows) {
-        (Some(v), _) => {
-            if v.len() != 6 && v.len() != 9 {
-                bail!(
-                    "--init takes lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (6 or 9 numbers), got {}",
-                    v.len()
-                );
-            }
-            let c = dcm_from_euler(v[3] * d, v[4] * d, v[5] * d);
-            NavState {
-                t: t0,
-                lat: v[0] * d,
-                lon: v[1] * d,
-                h: v[2],
-                v: if v.len() == 9 {
-                    Vector3::new(v[6], v[7], v[8])
-                } else {
-                    Vector3::zeros()
-                },
-                q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
-            }
-        }
-        (None, Some(tr)) => {
-            let r = tr
-                .iter()
-                .find(|r| (r.t - t0).abs() < 1e-6)
-                .context("no truth row at the IMU start time; give --init")?;
-            let c = dcm_from_euler(r.euler.x, r.euler.y, r.euler.z);
-            NavState {
-                t: t0,
-                lat: r.lat,
-                lon: r.lon,
-                h: r.h,
-                v: r.v,
-                q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
-            }
-        }
-        (None, None) => bail!("give --init or --truth for the initial state"),
-    };
-    let aid: Vec<AidingEpoch> = fixes
-        .iter()
-        .filter(|f| f.t > t0)
-        .map(|f| AidingEpoch {
-            t: f.t,
-            vel: zupt.map(|s| (Vector3::zeros(), s)),
-            pos: Some((f.lat, f.lon, f.h, f.sigma)),
-        })
-        .collect();
+    let cfg = args.data.config(&model, false)?;
+    let inputs = args.data.load()?;
+    let (imu, aid, truth_rows, start) = (&inputs.imu, &inputs.aid, &inputs.truth, inputs.start);
     let pb = progress::bar(1000, "filter");
-    let run = filter::run(
-        &model,
-        &cfg,
-        &imu,
-        start,
-        &aid,
-        truth_rows.as_deref(),
-        |f| pb.set_position((f * 1000.0) as u64),
-    );
+    let run = filter::run(&model, &cfg, imu, start, aid, truth_rows.as_deref(), |f| {
+        pb.set_position((f * 1000.0) as u64)
+    });
     pb.finish_and_clear();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
@@ -290,32 +116,4 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
-}
-
-/// Mean gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from an `allan --json` file.
-fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not valid JSON", path.display()))?;
-    let white = |names: [&str; 3]| -> Result<f64> {
-        let mut s = 0.0;
-        for n in names {
-            let w = v["fit"][n]["white"]
-                .as_f64()
-                .with_context(|| format!("{}: fit.{n}.white missing", path.display()))?;
-            if !w.is_finite() || w <= 0.0 {
-                bail!(
-                    "{}: fit.{n}.white = {w} is not a positive density",
-                    path.display()
-                );
-            }
-            s += w * w;
-        }
-        Ok((s / 3.0).sqrt())
-    };
-    Ok((
-        white(["gyro_x", "gyro_y", "gyro_z"])?,
-        white(["accel_x", "accel_y", "accel_z"])?,
-    ))
 }

@@ -175,6 +175,35 @@ pub struct FilterRun {
     pub final_state: NavState,
 }
 
+/// Watches a filter run from inside: every IMU sample, every propagation step and every scalar
+/// update with its gain. `explain` propagates candidate-term signatures through it.
+pub trait Observer {
+    /// One IMU sample as the filter uses it: specific force f [m/s²] and rate w [rad/s], FRD.
+    fn sample(&mut self, _f: &Vector3<f64>, _w: &Vector3<f64>) {}
+    /// After the propagation over a step of `dt` [s] ending at `t`: the navigation point and the
+    /// model's A (n×n row-major; non-zeros at `pattern`) used for it.
+    fn step(&mut self, _t: f64, _dt: f64, _np: &NavPoint, _a: &[f64], _pattern: &[(usize, usize)]) {
+    }
+    /// Before a scalar update is applied: its row `h`, gain `k` = P⁻hᵀ/S, innovation ν and
+    /// variance S, and which measurement component it is.
+    #[allow(clippy::too_many_arguments)]
+    fn scalar_update(
+        &mut self,
+        _t: f64,
+        _meas: &'static str,
+        _component: usize,
+        _h: &[f64],
+        _k: &[f64],
+        _nu: f64,
+        _s: f64,
+    ) {
+    }
+}
+
+/// An observer that watches nothing.
+struct NoObserver;
+impl Observer for NoObserver {}
+
 enum Kernel {
     Preset(crate::model::catalog::PropagateFn),
     Runtime(SparsePropagator),
@@ -244,6 +273,7 @@ struct Engine<'a> {
     meas: Vec<(&'static str, usize)>,
     h: Vec<f64>,
     u: Vec<f64>,
+    k: Vec<f64>,
     i_phi: [Option<usize>; 3],
     i_dv: [Option<usize>; 3],
     i_pos: [Option<usize>; 3],
@@ -301,6 +331,7 @@ impl<'a> Engine<'a> {
             meas,
             h: vec![0.0; max_rows * n],
             u: vec![0.0; n],
+            k: vec![0.0; n],
             i_phi: [idx("phi_n"), idx("phi_e"), idx("phi_d")],
             i_dv: [idx("dv_n"), idx("dv_e"), idx("dv_d")],
             i_pos: [idx("dlat"), idx("dlon"), idx("dh")],
@@ -311,7 +342,7 @@ impl<'a> Engine<'a> {
     }
 
     /// One IMU sample: closed-loop sensor corrections, strapdown step, regressor sums.
-    fn navigate(&mut self, smp: &crate::io::imu::ImuSample, dt: f64) {
+    fn navigate(&mut self, smp: &crate::io::imu::ImuSample, dt: f64, obs: &mut dyn Observer) {
         let (mut dth, mut dvel) = (smp.dtheta, smp.dv);
         if self.cfg.mode == Mode::ClosedLoop {
             let f_meas = dvel / dt;
@@ -332,13 +363,14 @@ impl<'a> Engine<'a> {
         let inv_dt = 1.0 / dt;
         let (f_c, w_c) = (dvel * inv_dt, dth * inv_dt);
         self.acc.add(&f_c, &w_c);
+        obs.sample(&f_c, &w_c);
         self.f_sum += f_c;
         self.in_step += 1;
     }
 
     /// Propagates x and P over the step that ends now: A(t) at the navigation point with the
     /// step's regressor means, through the preset kernel, the run-time propagator or dense.
-    fn propagate(&mut self, t: f64) {
+    fn propagate(&mut self, t: f64, obs: &mut dyn Observer) {
         let (n, s) = (self.n, self.nav.state);
         let step_dt = t - self.step_t0;
         let f_mean = self.f_sum / self.in_step as f64;
@@ -368,6 +400,7 @@ impl<'a> Engine<'a> {
                 self.p.copy_from_slice(out.transpose().as_slice());
             }
         }
+        obs.step(t, step_dt, &self.np, &self.a, self.model.a_pattern());
         self.acc.reset();
         self.f_sum = Vector3::zeros();
         self.in_step = 0;
@@ -376,7 +409,7 @@ impl<'a> Engine<'a> {
 
     /// Sequential scalar updates for every spec measurement the epoch carries, with the
     /// generated H at the current navigation point.
-    fn update(&mut self, ep: &AidingEpoch) {
+    fn update(&mut self, ep: &AidingEpoch, obs: &mut dyn Observer) {
         let (n, s) = (self.n, self.nav.state);
         let f_ned = Vector3::from(self.np.f_ned);
         let c = s.dcm();
@@ -392,9 +425,16 @@ impl<'a> Engine<'a> {
                 .expect("the model supports the measurements it lists");
             for (comp, (&zc, &sc)) in z.iter().zip(&sigma).enumerate() {
                 let h_row = &self.h[comp * n..(comp + 1) * n];
-                if let Some((nu, sv)) =
-                    joseph_update(&mut self.x, &mut self.p, h_row, zc, sc * sc, &mut self.u)
-                {
+                if let Some((nu, sv)) = joseph_update(
+                    &mut self.x,
+                    &mut self.p,
+                    h_row,
+                    zc,
+                    sc * sc,
+                    &mut self.u,
+                    &mut self.k,
+                ) {
+                    obs.scalar_update(ep.t, name, comp, h_row, &self.k, nu, sv);
                     self.innovations.push(Innovation {
                         t: ep.t,
                         meas: name,
@@ -491,8 +531,34 @@ pub fn run_with(
     start: NavState,
     aiding: &[AidingEpoch],
     truth: Option<&[TruthRow]>,
+    progress: impl FnMut(f64),
+    on_sample: &mut dyn FnMut(&NavState),
+) -> FilterRun {
+    run_observed(
+        model,
+        cfg,
+        imu,
+        start,
+        aiding,
+        truth,
+        progress,
+        on_sample,
+        &mut NoObserver,
+    )
+}
+
+/// [`run_with`] with an [`Observer`] that sees every sample, step and scalar update.
+#[allow(clippy::too_many_arguments)]
+pub fn run_observed(
+    model: &Model,
+    cfg: &FilterConfig,
+    imu: &ImuData,
+    start: NavState,
+    aiding: &[AidingEpoch],
+    truth: Option<&[TruthRow]>,
     mut progress: impl FnMut(f64),
     on_sample: &mut dyn FnMut(&NavState),
+    obs: &mut dyn Observer,
 ) -> FilterRun {
     let mut e = Engine::new(model, cfg, start);
     let mut next_aid = 0usize;
@@ -501,18 +567,18 @@ pub fn run_with(
     for (k, smp) in imu.samples.iter().enumerate() {
         let dt = smp.t - prev_t;
         prev_t = smp.t;
-        e.navigate(smp, dt);
+        e.navigate(smp, dt, obs);
         on_sample(&e.nav.state);
         let aid_due = next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9;
         let step_done = smp.t - e.step_t0 + 1e-9 >= cfg.step_s;
         if !step_done && !aid_due && k + 1 < imu.samples.len() {
             continue;
         }
-        e.propagate(smp.t);
+        e.propagate(smp.t, obs);
         while next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9 {
             let ep = &aiding[next_aid];
             next_aid += 1;
-            e.update(ep);
+            e.update(ep, obs);
             e.record(ep, truth);
             if cfg.mode == Mode::ClosedLoop {
                 e.feedback();
@@ -540,6 +606,7 @@ fn joseph_update(
     z: f64,
     r: f64,
     u: &mut [f64],
+    k: &mut [f64],
 ) -> Option<(f64, f64)> {
     let n = x.len();
     let nz: Vec<usize> = (0..n).filter(|&j| h[j] != 0.0).collect();
@@ -552,7 +619,9 @@ fn joseph_update(
         return None;
     }
     let nu = z - nz.iter().map(|&j| h[j] * x[j]).sum::<f64>();
-    let k: Vec<f64> = u.iter().map(|v| v / s).collect();
+    for (ki, ui) in k.iter_mut().zip(u.iter()) {
+        *ki = ui / s;
+    }
     for i in 0..n {
         x[i] += k[i] * nu;
     }

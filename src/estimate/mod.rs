@@ -3,6 +3,7 @@
 
 pub mod align;
 pub mod allan;
+pub mod explain;
 pub mod filter;
 pub mod mounting;
 pub mod stats;

@@ -48,6 +48,14 @@ pub struct Model {
     term_cols: Vec<(usize, usize, Option<usize>)>,
 }
 
+/// Default noise 1-σ (SI, per component) of spec measurement `name`.
+pub fn measurement_sigma(name: &str) -> Option<f64> {
+    common::MEASUREMENTS
+        .iter()
+        .find(|m| m.name == name)
+        .map(|m| m.sigma)
+}
+
 /// Levenshtein distance between two names (byte-wise; names are ASCII).
 pub fn edit_distance(a: &str, b: &str) -> usize {
     let (a, b) = (a.as_bytes(), b.as_bytes());
@@ -395,6 +403,16 @@ pub struct RegressorAccumulator {
 pub type AccumulateFn = fn(&mut [f64], &Vector3<f64>, &Vector3<f64>);
 
 impl RegressorAccumulator {
+    /// An accumulator of the given regressors (indices into `common::REGRESSORS`).
+    pub fn new(ids: Vec<usize>) -> RegressorAccumulator {
+        RegressorAccumulator {
+            sum: vec![0.0; ids.len()],
+            ids,
+            count: 0,
+            generated: None,
+        }
+    }
+
     /// Adds one sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
     pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
         match self.generated {

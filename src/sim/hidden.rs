@@ -1,0 +1,330 @@
+//! Seeded cases with an error term hidden in simulated data, for testing and evaluating
+//! `explain`: a library term (or none, or two), a scenario that excites it (DESIGN §7), a
+//! magnitude, and a baseline model that lacks it.
+
+use crate::model::generated::common;
+use crate::sim::rng::Rng;
+
+/// Library groups a case can hide a term from.
+pub const GROUPS: [&str; 7] = ["d", "kaq", "kas", "kao", "kgf", "kgq", "size"];
+
+/// Standard gravity [m/s²].
+const G0: f64 = 9.806_65;
+
+/// What kind of case to draw.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CaseKind {
+    /// Nothing hidden beyond the baseline's own errors.
+    Null,
+    /// One term of a group.
+    One(&'static str),
+    /// Two terms (d_x and d_y on different windows) that need forward selection.
+    Two,
+}
+
+/// A hidden-effect case.
+#[derive(Debug, Clone)]
+pub struct HiddenCase {
+    /// Seed of the draw (also the simulation's).
+    pub seed: u64,
+    /// Group (`null` and `two` for those kinds).
+    pub group: String,
+    /// Hidden terms and their true values, SI.
+    pub hidden: Vec<(String, f64)>,
+    /// Baseline model that lacks them.
+    pub baseline: String,
+    /// Scenario text (scenario file format).
+    pub scenario: String,
+    /// One line describing the case.
+    pub description: String,
+    /// Effect size used to size the magnitude (mg for accelerometer, deg/h for gyro terms).
+    pub effect: f64,
+}
+
+impl HiddenCase {
+    /// The model a filter that knows the truth would use: baseline + hidden terms.
+    pub fn oracle_model(&self) -> String {
+        let mut m = self.baseline.clone();
+        for (t, _) in &self.hidden {
+            m.push('+');
+            m.push_str(t);
+        }
+        m
+    }
+
+    /// The same case with every hidden value multiplied by `k` (the scenario is rewritten).
+    pub fn scaled(&self, k: f64) -> HiddenCase {
+        let mut c = self.clone();
+        for (name, v) in &mut c.hidden {
+            let old = format!("{name} = \"{:e} {}\"", *v, unit_of(name));
+            *v *= k;
+            let new = format!("{name} = \"{:e} {}\"", *v, unit_of(name));
+            c.scenario = c.scenario.replace(&old, &new);
+        }
+        c.effect *= k;
+        c
+    }
+}
+
+fn unit_of(name: &str) -> &'static str {
+    common::TERMS
+        .iter()
+        .find(|t| t.name == name)
+        .map(|t| t.unit)
+        .unwrap_or("1")
+}
+
+fn pick<'a, T>(rng: &mut Rng, v: &'a [T]) -> &'a T {
+    let k = ((rng.uniform() * v.len() as f64) as usize).min(v.len() - 1);
+    &v[k]
+}
+
+fn sine(axis: &str, amp_g: f64, freq: f64, schedule: &str) -> String {
+    format!(
+        "[[vibration]]\nkind = \"sine\"\naxis = \"{axis}\"\namplitude = \"{amp_g} g\"\nfreq_hz = {freq}\nschedule = {schedule}\n"
+    )
+}
+
+fn angular(axis: &str, amp_deg: f64, freq: f64, schedule: &str) -> String {
+    format!(
+        "[[vibration]]\nkind = \"angular\"\naxis = \"{axis}\"\namplitude = \"{amp_deg} deg\"\nfreq_hz = {freq}\nschedule = {schedule}\n"
+    )
+}
+
+/// The baseline's own instrument errors (paper-like magnitudes, seeded signs), without `skip`.
+fn baseline_errors(rng: &mut Rng, with_d: bool, skip: &[String]) -> String {
+    let mut s = String::from("[errors]\n");
+    let add = |name: &str, v: &str, s: &mut String| {
+        if !skip.iter().any(|x| x == name) {
+            s.push_str(&format!("{name} = \"{v}\"\n"));
+        }
+    };
+    for ax in ["x", "y", "z"] {
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        add(
+            &format!("eps_{ax}"),
+            &format!("{} deg/h", 0.01 * sgn),
+            &mut s,
+        );
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        add(
+            &format!("nabla_{ax}"),
+            &format!("{} ug", 50.0 * sgn),
+            &mut s,
+        );
+        if with_d {
+            add(&format!("d_{ax}"), "5e-6 s^2/m", &mut s);
+        }
+    }
+    for k in ["kg_11", "kg_22", "kg_33", "ka_11", "ka_22", "ka_33"] {
+        add(k, "20 ppm", &mut s);
+    }
+    s
+}
+
+/// Draws a case of `kind` from `seed`. Cases last `seconds` (≥ 300) of 2 kHz IMU data at rest
+/// (or a short drive for the g-sensitivity group), with windows of excitation that switch on
+/// and off or step in amplitude, so that the hidden term is separable from the baseline's bias
+/// and tilt. `effect` sizes the term: the mg (accelerometer) or deg/h (gyro) it produces at the
+/// strongest excitation.
+pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenCase {
+    let mut rng = Rng::new(seed.wrapping_mul(0x9e37_79b9).wrapping_add(17));
+    let seconds = seconds.max(300.0);
+    let lat = 20.0 + 30.0 * rng.uniform();
+    let freq = (30.0 + 30.0 * rng.uniform()).round();
+    let w = seconds / 6.0; // six windows
+    let win = |a: f64, b: f64| (a * w, b * w);
+    let (on1, on2) = (win(1.0, 2.0), win(3.0, 4.0));
+    let steps = format!(
+        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5]]",
+        on1.0, on1.1, on2.0, on2.1
+    );
+    let amp = (4.0 + 4.0 * rng.uniform()).round(); // g
+    let mut segments = format!("[[segment]]\nkind = \"rest\"\nduration_s = {seconds}\n");
+    let mut vib = String::new();
+    let mut hidden: Vec<(String, f64)> = Vec::new();
+    let mut baseline = "P31".to_string();
+    let mut with_d = true;
+    let axes = ["x", "y", "z"];
+    let effect_si_acc = effect * 1e-3 * G0;
+    let effect_si_gyro = effect * std::f64::consts::PI / 180.0 / 3600.0;
+    let a_si = amp * G0;
+    let group: String;
+    let description: String;
+    match kind {
+        CaseKind::Null => {
+            group = "null".into();
+            let ax = *pick(&mut rng, &axes[..2]);
+            vib = sine(ax, amp, freq, &steps);
+            description = format!(
+                "nothing hidden; {amp} g / {} g vibration on {ax}",
+                amp / 2.0
+            );
+        }
+        CaseKind::Two => {
+            group = "two".into();
+            baseline = "P28".into();
+            with_d = false;
+            let s1 = format!("[[{:.1}, {:.1}, 1.0]]", on1.0, on1.1);
+            let s2 = format!("[[{:.1}, {:.1}, 1.0]]", on2.0, on2.1);
+            let s3 = format!("[[{:.1}, {:.1}, 1.0]]", 5.0 * w, 5.5 * w);
+            vib = sine(
+                "x",
+                amp,
+                freq,
+                &format!(
+                    "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                    on1.0,
+                    on1.1,
+                    5.0 * w,
+                    5.5 * w
+                ),
+            ) + &sine(
+                "y",
+                amp,
+                freq + 7.0,
+                &format!(
+                    "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                    on2.0,
+                    on2.1,
+                    5.0 * w,
+                    5.5 * w
+                ),
+            );
+            let _ = (s1, s2, s3);
+            let d = effect_si_acc / (a_si * a_si / 2.0);
+            hidden.push(("d_x".into(), d));
+            hidden.push(("d_y".into(), -0.7 * d));
+            description = format!("d_x and d_y hidden; {amp} g vibration on x, then y, then both");
+        }
+        CaseKind::One(g) => {
+            group = g.into();
+            match g {
+                "d" => {
+                    baseline = "P28".into();
+                    with_d = false;
+                    let ax = *pick(&mut rng, &axes[..2]);
+                    vib = sine(ax, amp, freq, &steps);
+                    let v = effect_si_acc / (a_si * a_si / 2.0);
+                    hidden.push((format!("d_{ax}"), v));
+                }
+                "kaq" => {
+                    let (name, j, k) =
+                        *pick(&mut rng, &[("kaq_x_xy", "x", "y"), ("kaq_y_xy", "x", "y")]);
+                    // single-axis windows, then both in phase
+                    let s_j = format!(
+                        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                        on1.0, on1.1, on2.0, on2.1
+                    );
+                    let s_k = format!(
+                        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                        2.0 * w,
+                        2.5 * w,
+                        on2.0,
+                        on2.1
+                    );
+                    vib = sine(j, amp, freq, &s_j) + &sine(k, amp, freq, &s_k);
+                    let v = effect_si_acc / (a_si * a_si / 2.0);
+                    hidden.push((name.into(), v));
+                }
+                "kas" => {
+                    let ax = *pick(&mut rng, &axes[..2]);
+                    vib = sine(ax, amp, freq, &steps);
+                    let v = effect_si_acc / (a_si * 2.0 / std::f64::consts::PI);
+                    hidden.push((format!("kas_{ax}"), v));
+                }
+                "kao" => {
+                    // gravity along z plus vibration beyond 1 g along z; the vertical channel shows it
+                    baseline = "P31+vertical".into();
+                    vib = sine("z", amp, freq, &steps);
+                    let v = effect_si_acc / (a_si * a_si / 2.0);
+                    hidden.push(("kao_z".into(), v));
+                }
+                "kgf" => {
+                    // a short drive: accelerations along x, turns (centripetal f_y)
+                    let (name, fj) = *pick(
+                        &mut rng,
+                        &[("kgf_xx", 0), ("kgf_yx", 1), ("kgf_xy", 2), ("kgf_yy", 3)],
+                    );
+                    let n = ((seconds - 60.0) / 60.0).floor().max(1.0) as usize;
+                    segments = String::from("[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n");
+                    for i in 0..n {
+                        if fj < 2 {
+                            let a = if i % 2 == 0 { 2.0 } else { -2.0 };
+                            segments.push_str(&format!("[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = {a}\n[[segment]]\nkind = \"cruise\"\nduration_s = 50.0\n"));
+                        } else {
+                            let r = if i % 2 == 0 { 6.0 } else { -6.0 };
+                            if i == 0 {
+                                segments.push_str("[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = 2.0\n");
+                            }
+                            segments.push_str(&format!("[[segment]]\nkind = \"turn\"\nduration_s = 15.0\nyaw_rate_deg_s = {r}\n[[segment]]\nkind = \"cruise\"\nduration_s = 35.0\n"));
+                        }
+                    }
+                    let g_exc = if fj < 2 {
+                        2.0
+                    } else {
+                        20.0 * 6.0f64.to_radians()
+                    };
+                    let v = effect_si_gyro / g_exc;
+                    hidden.push((name.into(), v));
+                }
+                "kgq" => {
+                    let (name, j, k) = *pick(&mut rng, &[("kgq_x", "y", "z"), ("kgq_y", "x", "z")]);
+                    let s_j = format!(
+                        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                        on1.0, on1.1, on2.0, on2.1
+                    );
+                    let s_k = format!("[[{:.1}, {:.1}, 1.0]]", on2.0, on2.1);
+                    vib = sine(j, amp, freq, &s_j) + &sine(k, amp, freq, &s_k);
+                    let v = effect_si_gyro / (a_si * a_si / 2.0);
+                    hidden.push((name.into(), v));
+                }
+                "size" => {
+                    let (name, ax) = *pick(
+                        &mut rng,
+                        &[("size_x", "yaw"), ("size_y", "yaw"), ("size_x", "pitch")],
+                    );
+                    let amp_deg = 0.5;
+                    let f_ang = 10.0;
+                    vib = angular(ax, amp_deg, f_ang, &steps);
+                    let om = 2.0 * std::f64::consts::PI * f_ang * amp_deg.to_radians();
+                    let v = effect_si_acc / (om * om / 2.0);
+                    hidden.push((name.into(), v));
+                }
+                other => panic!("unknown group {other}"),
+            }
+            description =
+                format!(
+                    "{} hidden ({} {}), baseline {baseline}",
+                    hidden[0].0,
+                    effect,
+                    if common::TERMS.iter().any(|t| t.name == hidden[0].0
+                        && t.sensor == crate::model::catalog::Sensor::Gyro)
+                    {
+                        "deg/h"
+                    } else {
+                        "mg"
+                    }
+                );
+        }
+    }
+    let skip: Vec<String> = hidden.iter().map(|h| h.0.clone()).collect();
+    let mut errors = baseline_errors(&mut rng, with_d, &skip);
+    for (name, v) in &hidden {
+        errors.push_str(&format!("{name} = \"{v:e} {}\"\n", unit_of(name)));
+    }
+    let scenario = format!(
+        "name = \"hidden-{group}-{seed}\"\nimu_rate_hz = 2000.0\ntruth_rate_hz = 1.0\nseed = {seed}\n\
+         [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}\
+         [noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n"
+    );
+    HiddenCase {
+        seed,
+        group,
+        hidden,
+        baseline,
+        scenario,
+        description,
+        effect,
+    }
+}
