@@ -88,6 +88,23 @@ pub fn chi2_sf(x: f64, k: f64) -> f64 {
     gamma_q(0.5 * k, 0.5 * x.max(0.0))
 }
 
+/// The x with P(χ²_k > x) = p (bisection on [`chi2_sf`]; p in (0, 1)).
+pub fn chi2_isf(p: f64, k: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, k + 10.0);
+    while chi2_sf(hi, k) > p {
+        hi *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if chi2_sf(mid, k) > p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// Standard normal cumulative distribution Φ(z).
 pub fn normal_cdf(z: f64) -> f64 {
     if z >= 0.0 {
@@ -155,6 +172,7 @@ mod tests {
         assert!((chi2_sf(100.0, 50.0) / 3.454_931_382_984_871e-5 - 1.0).abs() < 1e-10);
         assert!(chi2_sf(2000.0, 1.0) < 1e-300 && chi2_sf(2000.0, 1.0) >= 0.0);
         assert!((normal_cdf(1.959_963_984_540_054) - 0.975).abs() < 1e-12);
+        assert!((chi2_isf(0.01, 1.0) - 6.634_896_601_021_214).abs() < 1e-9);
         assert!((ln_gamma(10.0) - 362_880f64.ln()).abs() < 1e-12);
     }
 
