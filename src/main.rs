@@ -34,6 +34,9 @@ enum Command {
     Allan(cli::allan::AllanArgs),
     /// Throughput of navigation + filter jobs (generated kernels vs dense), peak memory.
     Bench(cli::bench::BenchArgs),
+    /// What the model gets wrong on the data, the missing error term, the extended model and
+    /// its gain; without data options, the embedded demo (the paper's case with d hidden).
+    Explain(cli::explain::ExplainArgs),
     /// Reproduce the paper's experiments (P28 vs P31), with figures, priors study, consistency.
     Reproduce(cli::reproduce::ReproduceArgs),
 }
@@ -47,6 +50,7 @@ fn main() -> ExitCode {
         Command::Navigate(args) => cli::navigate::run(&args),
         Command::Reproduce(args) => cli::reproduce::run(&args),
         Command::Filter(args) => cli::filter::run(&args),
+        Command::Explain(args) => cli::explain::run(&args),
         Command::Bench(args) => cli::bench::run(&args),
         Command::Allan(args) => cli::allan::run(&args),
         Command::Align(args) => cli::align::run(&args),

@@ -18,7 +18,7 @@ use std::path::PathBuf;
 pub struct DataArgs {
     /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
     #[arg(long)]
-    imu: PathBuf,
+    imu: Option<PathBuf>,
     /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
     #[arg(long)]
     aid: Option<PathBuf>,
@@ -64,14 +64,54 @@ pub struct Inputs {
 }
 
 impl DataArgs {
+    /// True when any data option was given (explain runs its embedded demo when none is).
+    pub fn any_given(&self) -> bool {
+        self.imu.is_some()
+            || self.aid.is_some()
+            || self.static_aid.is_some()
+            || !self.prior.is_empty()
+            || self.noise.is_some()
+            || self.truth.is_some()
+            || self.init.is_some()
+            || self.zupt.is_some()
+    }
+
+    /// The input files named by the options (so outputs never land on them).
+    pub fn input_paths(&self) -> Vec<&std::path::Path> {
+        [&self.imu, &self.aid, &self.noise, &self.truth]
+            .into_iter()
+            .flatten()
+            .map(|p| p.as_path())
+            .collect()
+    }
+
+    /// A description of the data for reports.
+    pub fn describe(&self) -> String {
+        let mut s = String::new();
+        if let Some(p) = &self.imu {
+            s.push_str(&format!("IMU {}", p.display()));
+        }
+        if let Some(p) = &self.aid {
+            s.push_str(&format!(", aiding {}", p.display()));
+        }
+        if let Some(v) = &self.static_aid {
+            s.push_str(&format!(", static at {v:?}"));
+        }
+        if let Some(p) = &self.truth {
+            s.push_str(&format!(", truth {}", p.display()));
+        }
+        s
+    }
+
     /// Reads the IMU, aiding and truth files and builds the initial state.
     pub fn load(&self) -> Result<Inputs> {
         let args = self;
-        if args.step.is_nan() || args.step <= 0.0 {
-            bail!("--step must be positive");
+        if !(args.step.is_finite() && args.step > 0.0 && args.step <= 10.0) {
+            bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
-        let imu = readers::read_any_imu(&args.imu)?;
-        imu.check_time(&args.imu.display().to_string(), 5.0)?;
+        let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
+        let imu = readers::read_any_imu(imu_path)?;
+        imu.check_time(&imu_path.display().to_string(), 5.0)?;
         let fixes = match (&args.aid, &args.static_aid) {
             (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {
                 sinsmodel::io::readers::rtklib::read(p)?
@@ -91,6 +131,13 @@ impl DataArgs {
             }
             (Some(p), None) => aiding::read(p)?,
             (None, Some(v)) if v.len() == 3 => {
+                if !v.iter().all(|x| x.is_finite())
+                    || v[0].abs() > 90.0
+                    || v[1].abs() > 360.0
+                    || !(-1000.0..=20_000.0).contains(&v[2])
+                {
+                    bail!("--static-aid {v:?}: expected LAT in [-90, 90] deg, LON in [-360, 360] deg, H in [-1000, 20000] m");
+                }
                 let (t_first, t_last) = (imu.samples[0].t, imu.samples[imu.samples.len() - 1].t);
                 (1..)
                     .map(|k| t_first.floor() + k as f64)
@@ -104,8 +151,20 @@ impl DataArgs {
                     })
                     .collect()
             }
-            _ => bail!("give either --aid FILE or --static-aid LAT,LON,H"),
+            (Some(_), Some(_)) => bail!("give --aid FILE or --static-aid LAT,LON,H, not both"),
+            (None, Some(v)) => bail!(
+                "--static-aid takes LAT,LON,H (3 numbers: deg, deg, m), got {}",
+                v.len()
+            ),
+            (None, None) => bail!(
+                "no aiding: give --aid FILE or --static-aid LAT,LON,H (the filter works on innovations)"
+            ),
         };
+        if let Some(z) = args.zupt {
+            if !(z.is_finite() && z > 0.0 && z < 100.0) {
+                bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");
+            }
+        }
         let zupt = args.zupt.or(args
             .static_aid
             .as_ref()

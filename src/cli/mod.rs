@@ -4,6 +4,7 @@ pub mod align;
 pub mod allan;
 pub mod bench;
 pub mod data;
+pub mod explain;
 pub mod filter;
 pub mod jacobian;
 pub mod model;

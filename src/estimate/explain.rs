@@ -280,8 +280,8 @@ impl Observer for Signatures {
                 }
             }
             sparse_mul(a, n, pattern, &self.w, &mut self.aw);
-            for i in 0..n {
-                d[i] += dt * (self.w[i] + 0.5 * dt * self.aw[i]);
+            for ((di, wi), awi) in d.iter_mut().zip(&self.w).zip(&self.aw) {
+                *di += dt * (wi + 0.5 * dt * awi);
             }
         }
     }
@@ -677,7 +677,7 @@ pub struct Finding {
     /// Which excitation would separate it from its equivalents.
     pub separate_by: Vec<String>,
     /// Prior σ the extended filter used (display unit): the spec's (or `--prior`), widened to
-    /// 3 (|θ̂| + σ̂) of the GLR estimate when the data put the term beyond it.
+    /// 3 (|θ̂| + σ̂) when the GLR estimate θ̂ lies beyond 2 spec prior σ.
     pub prior_sigma: f64,
     /// True when the spec's prior σ was too small for what the data say.
     pub prior_widened: bool,
@@ -1228,9 +1228,12 @@ pub fn explain(
                 prior_widened: false,
                 words: String::new(),
             });
-            // the extended filter's prior must hold what the data say: at least 3 (|θ̂| + σ̂)
-            let to_si = common::TERMS[t].display_to_si;
-            widened.push((t, 3.0 * (s.glr.abs() + s.glr_sigma) * to_si));
+            // the extended filter's prior must hold what the data say: a GLR estimate beyond
+            // 2 prior σ widens it to 3 (|θ̂| + σ̂)
+            let info_t = &common::TERMS[t];
+            if s.glr.abs() * info_t.display_to_si > 2.0 * info_t.sigma {
+                widened.push((t, 3.0 * (s.glr.abs() + s.glr_sigma) * info_t.display_to_si));
+            }
             added.push(t);
         }
         let mut text = model.name.clone();
@@ -1400,7 +1403,8 @@ fn finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> String 
     }
     if f.prior_widened {
         s.push_str(&format!(
-            "; far beyond the spec's prior σ {} {}, so the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
+            "; at {} of the spec's prior σ ({} {}) the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
+            sig3(f.glr_estimate.abs() / (info.sigma / info.display_to_si)),
             sig3(info.sigma / info.display_to_si),
             f.unit,
             sig3(f.prior_sigma),

@@ -130,7 +130,7 @@ pub fn ljung_box(x: &[f64], lags: usize) -> Option<(f64, f64)> {
     }
     let mean = x.iter().sum::<f64>() / n as f64;
     let c0: f64 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
-    if !(c0 > 0.0) {
+    if c0.is_nan() || c0 <= 0.0 {
         return None;
     }
     let mut q = 0.0;

@@ -62,3 +62,100 @@ pub fn write_text(target: &Path, text: &str) -> Result<()> {
     f.writer().write_all(text.as_bytes())?;
     f.commit()
 }
+
+/// Name of the marker file in every directory an [`OutputDir`] writes.
+pub const RUN_MARKER: &str = ".sinsmodel-run";
+
+/// An output directory that holds one run's outputs, complete or none: files are written into
+/// a staging directory beside the target, which replaces the target only on
+/// [`OutputDir::commit`]. A target that exists is replaced only when a sinsmodel run wrote it
+/// (it holds [`RUN_MARKER`]) or it is empty; anything else is refused, so no input is lost.
+pub struct OutputDir {
+    staging: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl OutputDir {
+    /// Checks `target` can be replaced and that no `inputs` lie inside it, then creates the
+    /// staging directory.
+    pub fn create(target: &Path, inputs: &[&Path]) -> Result<OutputDir> {
+        if target.exists() {
+            if !target.is_dir() {
+                anyhow::bail!("--out {}: exists and is not a directory", target.display());
+            }
+            let empty = std::fs::read_dir(target)
+                .with_context(|| format!("cannot read {}", target.display()))?
+                .next()
+                .is_none();
+            if !empty && !target.join(RUN_MARKER).exists() {
+                anyhow::bail!(
+                    "--out {}: the directory exists and was not written by sinsmodel; choose another (nothing is overwritten)",
+                    target.display()
+                );
+            }
+            let canon = target.canonicalize()?;
+            for inp in inputs {
+                if let Ok(c) = inp.canonicalize() {
+                    if c.starts_with(&canon) {
+                        anyhow::bail!(
+                            "--out {}: the input {} is inside it; choose another output directory",
+                            target.display(),
+                            inp.display()
+                        );
+                    }
+                }
+            }
+        }
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent)
+            .with_context(|| format!("cannot create {}", parent.display()))?;
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".into());
+        let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&staging);
+        std::fs::create_dir(&staging)
+            .with_context(|| format!("cannot create {}", staging.display()))?;
+        Ok(OutputDir {
+            staging,
+            target: target.to_path_buf(),
+            committed: false,
+        })
+    }
+
+    /// Path of a file `name` inside the staging directory.
+    pub fn file(&self, name: &str) -> PathBuf {
+        self.staging.join(name)
+    }
+
+    /// Marks the run complete and moves it into place (replacing the previous run, if any).
+    pub fn commit(mut self) -> Result<()> {
+        write_text(&self.staging.join(RUN_MARKER), "written by sinsmodel\n")?;
+        if self.target.exists() {
+            std::fs::remove_dir_all(&self.target)
+                .with_context(|| format!("cannot replace {}", self.target.display()))?;
+        }
+        std::fs::rename(&self.staging, &self.target).with_context(|| {
+            format!(
+                "cannot move {} to {}",
+                self.staging.display(),
+                self.target.display()
+            )
+        })?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for OutputDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}

@@ -133,3 +133,117 @@ pub fn line_plot(
         .map_err(|e| anyhow!("cannot move {} into place: {e}", path.display()))?;
     Ok(())
 }
+
+/// One bar: label, value and an optional ± error.
+pub struct Bar {
+    /// Category label (x axis).
+    pub label: String,
+    /// Height.
+    pub value: f64,
+    /// Half-length of the error bar, if any.
+    pub err: Option<f64>,
+}
+
+/// Draws a horizontal bar chart (one row per bar, first at the top) into a 1000×600 PNG at
+/// `path`, with an optional vertical threshold line.
+pub fn bar_plot(
+    path: &Path,
+    title: &str,
+    value_label: &str,
+    bars: &[Bar],
+    threshold: Option<(f64, &str)>,
+) -> Result<()> {
+    register_font();
+    let tmp = path.with_extension("partial.png");
+    {
+        let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
+        let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let mut lo: f64 = 0.0;
+        let mut hi: f64 = threshold.map(|t| t.0).unwrap_or(0.0);
+        for b in bars.iter().filter(|b| b.value.is_finite()) {
+            let e = b.err.filter(|e| e.is_finite()).unwrap_or(0.0);
+            lo = lo.min(b.value - e);
+            hi = hi.max(b.value + e);
+        }
+        if hi - lo <= 0.0 {
+            hi = lo + 1.0;
+        }
+        let pad = 0.05 * (hi - lo);
+        let n = bars.len().max(1);
+        // row k is drawn at y = n - 1 - k so the first bar is on top
+        let row = |k: usize| (n - 1 - k) as f64;
+        let labels: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(170)
+            .build_cartesian_2d((lo - pad)..(hi + pad), -0.5..(n as f64 - 0.5))
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .disable_y_mesh()
+            .y_labels(n)
+            .y_label_formatter(&|y| {
+                let k = y.round();
+                if (y - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < n {
+                    labels.get(n - 1 - k as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .x_desc(value_label)
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| err(&e))?;
+        let blue = RGBColor(31, 119, 180);
+        chart
+            .draw_series(
+                bars.iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.value.is_finite())
+                    .map(|(k, b)| {
+                        let y = row(k);
+                        Rectangle::new([(0.0, y - 0.35), (b.value, y + 0.35)], blue.filled())
+                    }),
+            )
+            .map_err(|e| err(&e))?;
+        for (k, b) in bars.iter().enumerate() {
+            if let Some(e) = b.err.filter(|e| e.is_finite() && b.value.is_finite()) {
+                let y = row(k);
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(b.value - e, y), (b.value + e, y)],
+                        BLACK.stroke_width(2),
+                    )))
+                    .map_err(|e| err(&e))?;
+            }
+        }
+        if let Some((t, label)) = threshold {
+            let red = RGBColor(214, 39, 40);
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(t, -0.5), (t, n as f64 - 0.5)],
+                    red.stroke_width(2),
+                )))
+                .map_err(|e| err(&e))?
+                .label(label.to_string())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(2))
+                });
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerRight)
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 15))
+                .draw()
+                .map_err(|e| err(&e))?;
+        }
+        root.present().map_err(|e| err(&e))?;
+    }
+    std::fs::rename(&tmp, path)
+        .map_err(|e| anyhow!("cannot move {} into place: {e}", path.display()))?;
+    Ok(())
+}

@@ -174,6 +174,35 @@ pub fn cases(quick: bool, seed: u64) -> Vec<Case> {
     ]
 }
 
+/// The `explain` demo: the paper's vibration (6 g at 90 Hz on N, E, D; 2 kHz) in on/off
+/// windows at two amplitudes (6 g, then 3 g), with the paper's sensor errors including
+/// d = 5e-5 s²/m on every axis; `seconds` long.
+pub fn explain_demo(seconds: f64, seed: u64) -> Case {
+    let period = seconds / 6.0;
+    let onoff = format!(
+        "schedule = [[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5], [{:.1}, {:.1}, 1.0]]\n",
+        period,
+        2.0 * period,
+        3.0 * period,
+        4.0 * period,
+        5.0 * period,
+        6.0 * period
+    );
+    Case {
+        name: "explain_demo",
+        scenario: rest_scenario(
+            "explain_demo",
+            2000.0,
+            seconds,
+            seed,
+            &sine3(6.0, &onoff),
+            PAPER_ERRORS,
+        ),
+        velocity_updates: true,
+        window: (seconds / 2.0, seconds),
+    }
+}
+
 /// Aiding epochs from the truth (1 Hz), with Gaussian noise of the priors' σ.
 pub fn aiding_from_truth(
     sim: &SimOutput,
