@@ -17,6 +17,9 @@ pub struct BenchArgs {
     /// Seconds of simulated IMU data per job (results are scaled to hours of data per second).
     #[arg(long, default_value_t = 600.0)]
     seconds: f64,
+    /// Seconds of 2 kHz IMU data for the explain job (the target: 7200 s in ≤ 30 s); 0 skips it.
+    #[arg(long, default_value_t = 7200.0)]
+    explain_seconds: f64,
 }
 
 fn data(rate: f64, seconds: f64) -> Result<(SimOutput, Vec<AidingEpoch>)> {
@@ -48,8 +51,88 @@ fn peak_rss_mib() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// Job 3: explain on `seconds` of the demo's 2 kHz vibration data, baseline P31, every library
+/// candidate; against one plain P31 filter pass over the same data.
+fn explain_job(seconds: f64) -> Result<()> {
+    use sinsmodel::estimate::explain::{self, ExplainData, ExplainOptions};
+    let case = reproduce::explain_demo(seconds, 3);
+    let sim = simulate(&Scenario::parse(&case.scenario, "bench explain")?, |_| {});
+    let priors = Priors::default();
+    let aid = reproduce::aiding_from_truth(&sim, &priors, true, 3)?;
+    let model = Model::parse("P31")?;
+    let cands = explain::parse_candidates(None, &model).map_err(anyhow::Error::msg)?;
+    let cfg = reproduce::config(&model, &priors)?;
+    let t = Instant::now();
+    let plain = filter::run(&model, &cfg, &sim.imu, sim.start, &aid, None, |_| {});
+    let t_plain = t.elapsed().as_secs_f64();
+    let data = ExplainData {
+        imu: &sim.imu,
+        aid: &aid,
+        truth: None,
+        start: sim.start,
+    };
+    let mut pass_start = Instant::now();
+    let mut passes: Vec<f64> = Vec::new();
+    let mut current = 0usize;
+    let t = Instant::now();
+    let e = explain::explain(
+        &model,
+        &cands,
+        &data,
+        &|m: &Model| reproduce::config(m, &priors),
+        &ExplainOptions::default(),
+        &mut |pass, _| {
+            if pass != current {
+                if current != 0 {
+                    passes.push(pass_start.elapsed().as_secs_f64());
+                }
+                current = pass;
+                pass_start = Instant::now();
+            }
+        },
+    )?;
+    passes.push(pass_start.elapsed().as_secs_f64());
+    let t_explain = t.elapsed().as_secs_f64();
+    println!(
+        "job 3 (explain): {:.0} s of 2 kHz IMU ({} samples), baseline P31, {} candidates, {} filter passes",
+        seconds,
+        sim.imu.samples.len(),
+        cands.len(),
+        e.rounds
+    );
+    println!(
+        "  explain: {:.2} s in all; passes {}; plain P31 filter pass: {:.2} s; ratio explain / plain pass {:.2}",
+        t_explain,
+        passes
+            .iter()
+            .map(|p| format!("{p:.2} s"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        t_plain,
+        t_explain / t_plain
+    );
+    println!(
+        "  the first pass carries the {} candidate signatures: {:.2} s against {:.2} s without ({:.2}x)",
+        cands.len(),
+        passes[0],
+        t_plain,
+        passes[0] / t_plain
+    );
+    drop(plain);
+    Ok(())
+}
+
 /// Runs the command.
 pub fn run(args: &BenchArgs) -> Result<()> {
+    if !(args.seconds.is_finite() && (10.0..=86_400.0).contains(&args.seconds)) {
+        anyhow::bail!("--seconds {}: expected 10 to 86400 s", args.seconds);
+    }
+    if !(args.explain_seconds.is_finite() && (0.0..=86_400.0).contains(&args.explain_seconds)) {
+        anyhow::bail!(
+            "--explain-seconds {}: expected 0 to 86400 s",
+            args.explain_seconds
+        );
+    }
     let model = Model::parse("P31")?;
     let hours = args.seconds / 3600.0;
 
@@ -173,6 +256,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         peak_rss_mib()
     );
     let _ = std::fs::remove_dir(&dir);
+    if args.explain_seconds > 0.0 {
+        explain_job(args.explain_seconds)?;
+    }
     Ok(())
 }
 

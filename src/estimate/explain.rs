@@ -57,6 +57,12 @@ pub struct ExplainOptions {
     /// |cos| between a candidate's and a same-axis baseline term's regressor sequences above
     /// which the candidate is not separable from that term (0.999: within 2.6°).
     pub confound_cos: f64,
+    /// A candidate whose estimate would exceed this many prior σ is not named but reported as
+    /// implausible (a weakly observable signature fitting some other mismatch).
+    pub max_prior_sigmas: f64,
+    /// Prior σ of candidate terms that replace the spec's (term index, σ in SI): the sensor
+    /// class of the data (`--prior` on the command line).
+    pub candidate_sigma: Vec<(usize, f64)>,
 }
 
 impl Default for ExplainOptions {
@@ -67,6 +73,8 @@ impl Default for ExplainOptions {
             max_rounds: 4,
             min_information: 1e-6,
             confound_cos: 0.999,
+            max_prior_sigmas: 100.0,
+            candidate_sigma: Vec::new(),
         }
     }
 }
@@ -127,15 +135,20 @@ struct Signatures {
     base_terms: Vec<(usize, usize)>,
     /// Accumulator of the candidates' and baseline terms' regressors (ids below).
     acc: RegressorAccumulator,
-    r_ids: Vec<usize>,
     r_mean: Vec<f64>,
-    /// Position of each model navigation state.
-    nav_pos: [Option<usize>; common::NAV_COUNT],
-    /// D_c, m × n.
+    /// D, state-major: D[i·m + c] is state i of candidate c's signature (the inner loops run
+    /// over the candidates, so one A entry serves all of them).
     d: Vec<f64>,
     w: Vec<f64>,
     aw: Vec<f64>,
     g: Vec<f64>,
+    /// Position in `r_mean` of each candidate's and each baseline term's regressor.
+    cand_r: Vec<usize>,
+    base_r_idx: Vec<usize>,
+    /// Baseline terms' regressor means of the current step.
+    base_r: Vec<f64>,
+    /// For each candidate, (model index, row of its term column) of the rows it reaches.
+    cand_rows: Vec<Vec<(usize, usize)>>,
     /// Information J (m × m) and score b (m).
     info: Vec<f64>,
     score: Vec<f64>,
@@ -183,18 +196,32 @@ impl Signatures {
         }
         let m = cands.len();
         let nb = base_terms.len();
+        let pos = |t: usize| r_ids.iter().position(|&x| x == reg_id(t)).unwrap_or(0);
+        let cand_r = cands.iter().map(|&t| pos(t)).collect();
+        let base_r_idx = base_terms.iter().map(|b| pos(b.1)).collect();
+        let cand_rows = cands
+            .iter()
+            .map(|&t| {
+                common::TERM_ROWS[t]
+                    .iter()
+                    .filter_map(|&row| nav_pos[row].map(|i| (i, row)))
+                    .collect()
+            })
+            .collect();
         Signatures {
             n,
             cands: cands.to_vec(),
             base_terms,
             acc: RegressorAccumulator::new(r_ids.clone()),
             r_mean: vec![0.0; r_ids.len()],
-            r_ids,
-            nav_pos,
             d: vec![0.0; m * n],
-            w: vec![0.0; n],
-            aw: vec![0.0; n],
+            w: vec![0.0; m * n],
+            aw: vec![0.0; m * n],
             g: vec![0.0; m],
+            cand_r,
+            base_r_idx,
+            base_r: vec![0.0; nb],
+            cand_rows,
             info: vec![0.0; m * m],
             score: vec![0.0; m],
             reg_sum: vec![0.0; m],
@@ -208,21 +235,24 @@ impl Signatures {
             count: 0,
         }
     }
-
-    fn r_of(&self, t: usize) -> f64 {
-        let id = reg_id(t);
-        self.r_ids
-            .iter()
-            .position(|&x| x == id)
-            .map(|k| self.r_mean[k])
-            .unwrap_or(0.0)
-    }
 }
 
-fn sparse_mul(a: &[f64], n: usize, pattern: &[(usize, usize)], v: &[f64], out: &mut [f64]) {
+/// out = A · v for m column vectors stored state-major (v[j·m + c]), over A's pattern.
+fn sparse_mul_block(
+    a: &[f64],
+    n: usize,
+    m: usize,
+    pattern: &[(usize, usize)],
+    v: &[f64],
+    out: &mut [f64],
+) {
     out.iter_mut().for_each(|x| *x = 0.0);
     for &(i, j) in pattern {
-        out[i] += a[i * n + j] * v[j];
+        let aij = a[i * n + j];
+        let (src, dst) = (&v[j * m..(j + 1) * m], &mut out[i * m..(i + 1) * m]);
+        for (o, x) in dst.iter_mut().zip(src) {
+            *o += aij * x;
+        }
     }
 }
 
@@ -235,7 +265,7 @@ impl Observer for Signatures {
     }
 
     fn step(&mut self, t: f64, dt: f64, np: &NavPoint, a: &[f64], pattern: &[(usize, usize)]) {
-        let n = self.n;
+        let (n, m) = (self.n, self.cands.len());
         self.acc.mean_into(&mut self.r_mean);
         self.acc.reset();
         if self.count > 0 {
@@ -249,40 +279,38 @@ impl Observer for Signatures {
         self.count = 0;
         self.steps += 1;
         let nb = self.base_terms.len();
-        let base_r: Vec<f64> = self
-            .base_terms
-            .iter()
-            .map(|&(_, bt)| self.r_of(bt))
-            .collect();
-        for (k, r) in base_r.iter().enumerate() {
+        for k in 0..nb {
+            let r = self.r_mean[self.base_r_idx[k]];
+            self.base_r[k] = r;
             self.base_sq[k] += r * r;
         }
-        for c in 0..self.cands.len() {
+        if m == 0 {
+            return;
+        }
+        // W = A D + [a_c], then D ← D + dt (W + dt/2 A W)
+        sparse_mul_block(a, n, m, pattern, &self.d, &mut self.w);
+        for c in 0..m {
             let t_c = self.cands[c];
-            let rv = self.r_of(t_c);
+            let rv = self.r_mean[self.cand_r[c]];
             self.reg_sum[c] += rv;
             self.cand_sq[c] += rv * rv;
             let info = &common::TERMS[t_c];
             for (k, &(_, bt)) in self.base_terms.iter().enumerate() {
                 let bi = &common::TERMS[bt];
                 if bi.sensor == info.sensor && bi.axis == info.axis {
-                    self.cross[c * nb + k] += rv * base_r[k];
+                    self.cross[c * nb + k] += rv * self.base_r[k];
                 }
             }
-            // w = A D + a_c ;  D ← D + dt (w + dt/2 A w)
             let mut col = [0.0; common::NAV_COUNT];
             common::term_column(t_c, np, rv, &mut col);
-            let d = &mut self.d[c * n..(c + 1) * n];
-            sparse_mul(a, n, pattern, d, &mut self.w);
-            for &row in common::TERM_ROWS[t_c] {
-                if let Some(i) = self.nav_pos[row] {
-                    self.w[i] += col[row];
-                }
+            for &(i, row) in &self.cand_rows[c] {
+                self.w[i * m + c] += col[row];
             }
-            sparse_mul(a, n, pattern, &self.w, &mut self.aw);
-            for ((di, wi), awi) in d.iter_mut().zip(&self.w).zip(&self.aw) {
-                *di += dt * (wi + 0.5 * dt * awi);
-            }
+        }
+        sparse_mul_block(a, n, m, pattern, &self.w, &mut self.aw);
+        let h = 0.5 * dt;
+        for ((di, wi), awi) in self.d.iter_mut().zip(&self.w).zip(&self.aw) {
+            *di += dt * (wi + h * awi);
         }
     }
 
@@ -296,16 +324,23 @@ impl Observer for Signatures {
         nu: f64,
         s: f64,
     ) {
-        let n = self.n;
-        let m = self.cands.len();
-        let nz: Vec<usize> = (0..n).filter(|&j| h[j] != 0.0).collect();
-        for c in 0..m {
-            let d = &mut self.d[c * n..(c + 1) * n];
-            let g: f64 = nz.iter().map(|&j| h[j] * d[j]).sum();
-            self.g[c] = g;
-            if g != 0.0 {
-                for (di, ki) in d.iter_mut().zip(k) {
-                    *di -= ki * g;
+        let (n, m) = (self.n, self.cands.len());
+        if m == 0 {
+            return;
+        }
+        // G = H D (per candidate), then D ← D − K G
+        self.g.iter_mut().for_each(|x| *x = 0.0);
+        for (j, &hj) in h.iter().enumerate().take(n) {
+            if hj != 0.0 {
+                for (g, d) in self.g.iter_mut().zip(&self.d[j * m..(j + 1) * m]) {
+                    *g += hj * d;
+                }
+            }
+        }
+        for (i, &ki) in k.iter().enumerate().take(n) {
+            if ki != 0.0 {
+                for (d, g) in self.d[i * m..(i + 1) * m].iter_mut().zip(&self.g) {
+                    *d -= ki * g;
                 }
             }
         }
@@ -732,6 +767,8 @@ pub struct Explanation {
     pub findings: Vec<Finding>,
     /// Candidates not testable on these data.
     pub not_testable: Vec<String>,
+    /// Significant candidates not named because their value would be implausible.
+    pub implausible: Vec<Implausible>,
     /// Candidates whose regressor is proportional on these data to a baseline term's on the
     /// same sensor axis: (candidate, baseline term). Never named; the baseline term takes it up.
     pub not_separable: Vec<(String, String)>,
@@ -791,16 +828,25 @@ fn run_pass(
 }
 
 /// Prior-scaled quantities of a pass: J' = D J D, b' = D b with D = diag(σ_prior).
-fn scaled(sig: &Signatures) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
+fn scaled(sig: &Signatures, opts: &ExplainOptions) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
     let m = sig.cands.len();
     let sd: Vec<f64> = sig
         .cands
         .iter()
-        .map(|&t| common::TERMS[t].sigma.max(f64::MIN_POSITIVE))
+        .map(|&t| prior_sigma(t, opts).max(f64::MIN_POSITIVE))
         .collect();
     let j = DMatrix::from_fn(m, m, |a, b| sig.info[a * m + b] * sd[a] * sd[b]);
     let b = (0..m).map(|a| sig.score[a] * sd[a]).collect();
     (j, b, sd)
+}
+
+/// Prior σ of term `t` (SI): the override in `opts`, else the spec's.
+pub fn prior_sigma(t: usize, opts: &ExplainOptions) -> f64 {
+    opts.candidate_sigma
+        .iter()
+        .find(|x| x.0 == t)
+        .map(|x| x.1)
+        .unwrap_or(common::TERMS[t].sigma)
 }
 
 /// Conditional information, score and correlation of candidate `c` given the set `s`.
@@ -867,14 +913,15 @@ fn forward_select(
     eligible: &[bool],
     innovations: usize,
     opts: &ExplainOptions,
-) -> Vec<Selected> {
-    let (j, b, sd) = scaled(sig);
+) -> (Vec<Selected>, Vec<Implausible>) {
+    let (j, b, sd) = scaled(sig, opts);
     let m = sig.cands.len();
     let margin = stats::chi2_isf(opts.alpha, 1.0);
     let bic = (innovations.max(2) as f64).ln();
     let mut pool: Vec<usize> = (0..m).filter(|&c| eligible[c]).collect();
     let mut chosen: Vec<usize> = Vec::new();
     let mut out = Vec::new();
+    let mut implausible = Vec::new();
     while !pool.is_empty() {
         // (llr, information, score) of c given the chosen set
         let cond = |c: usize, chosen: &[usize]| -> Option<(f64, f64, f64)> {
@@ -916,6 +963,22 @@ fn forward_select(
         };
         let (glr, glr_sigma) = display(named, theta, info);
         let named_llr = cond(named, &chosen).map(|x| x.0).unwrap_or(llr);
+        if theta.abs() > opts.max_prior_sigmas {
+            // even the most plausible member would need an implausible value: not named
+            for &(a, th, ia) in &members {
+                let (e, s) = display(a, th, ia);
+                implausible.push(Implausible {
+                    term: common::TERMS[sig.cands[a]].name.to_string(),
+                    estimate: e,
+                    sigma: s,
+                    unit: common::TERMS[sig.cands[a]].display.to_string(),
+                    prior_sigmas: th.abs(),
+                    llr: cond(a, &chosen).map(|x| x.0).unwrap_or(0.0),
+                });
+            }
+            pool.retain(|a| !members.iter().any(|m| m.0 == *a));
+            continue;
+        }
         out.push(Selected {
             idx: named,
             llr: named_llr,
@@ -933,14 +996,31 @@ fn forward_select(
         chosen.push(named);
         pool.retain(|a| !members.iter().any(|m| m.0 == *a));
     }
-    out
+    (out, implausible)
+}
+
+/// A significant candidate explain does not name: its value would be implausibly large.
+#[derive(Debug, Clone, Serialize)]
+pub struct Implausible {
+    /// Term name.
+    pub term: String,
+    /// The value it would need (display unit).
+    pub estimate: f64,
+    /// σ of that value (display unit).
+    pub sigma: f64,
+    /// Display unit.
+    pub unit: String,
+    /// |estimate| in prior σ.
+    pub prior_sigmas: f64,
+    /// Conditional log-likelihood ratio.
+    pub llr: f64,
 }
 
 /// Every candidate's test alone in this pass, and which may be named: testable and not
 /// proportional at the regressor level to a baseline term of the same sensor axis (that term's
 /// state already absorbs it; what is left of its signature is the filter's transient).
 fn candidate_tests(sig: &Signatures, opts: &ExplainOptions) -> (Vec<CandidateTest>, Vec<bool>) {
-    let (j, b, sd) = scaled(sig);
+    let (j, b, sd) = scaled(sig, opts);
     let m = sig.cands.len();
     let nb = sig.base_terms.len();
     let testable: Vec<bool> = (0..m).map(|c| j[(c, c)] > opts.min_information).collect();
@@ -1166,12 +1246,24 @@ pub fn explain(
     let mut excluded: Vec<usize> = Vec::new(); // term indices in a class or added
     let mut model = baseline.clone();
     let mut pass = base;
-    let mut selected_now = forward_select(&pass.sig, &eligible, pass.run.innovations.len(), opts);
+    let mut implausible: Vec<Implausible> = Vec::new();
+    let (mut selected_now, imp) =
+        forward_select(&pass.sig, &eligible, pass.run.innovations.len(), opts);
+    implausible.extend(imp);
     let mut rounds = 1;
     let mut pool_terms: Vec<usize> = cands.clone();
     let mut widened: Vec<(usize, f64)> = Vec::new(); // (term, least prior σ, SI)
     let config_ext = |m: &Model, widened: &[(usize, f64)]| -> anyhow::Result<FilterConfig> {
         let mut cfg = config_for(m)?;
+        // an added term starts from its candidate prior (the data's sensor class) …
+        for &(t, sigma) in &opts.candidate_sigma {
+            if !baseline.states.contains(&StateRef::Term(t)) {
+                if let Some(i) = m.index_of(common::TERMS[t].name) {
+                    cfg.prior_sigma[i] = sigma;
+                }
+            }
+        }
+        // … widened where the data put it beyond
         for &(t, sigma) in widened {
             if let Some(i) = m.index_of(common::TERMS[t].name) {
                 cfg.prior_sigma[i] = cfg.prior_sigma[i].max(sigma);
@@ -1205,13 +1297,14 @@ pub fn explain(
                     .class
                     .iter()
                     .map(|&(c, estimate, sigma)| {
-                        let info = &common::TERMS[pass.sig.cands[c]];
+                        let tc = pass.sig.cands[c];
+                        let info = &common::TERMS[tc];
                         EquivalentTerm {
                             term: info.name.to_string(),
                             estimate,
                             sigma,
                             unit: info.display.to_string(),
-                            prior_sigmas: estimate / (info.sigma / info.display_to_si),
+                            prior_sigmas: estimate * info.display_to_si / prior_sigma(tc, opts),
                         }
                     })
                     .collect(),
@@ -1231,7 +1324,7 @@ pub fn explain(
             // the extended filter's prior must hold what the data say: a GLR estimate beyond
             // 2 prior σ widens it to 3 (|θ̂| + σ̂)
             let info_t = &common::TERMS[t];
-            if s.glr.abs() * info_t.display_to_si > 2.0 * info_t.sigma {
+            if s.glr.abs() * info_t.display_to_si > 2.0 * prior_sigma(t, opts) {
                 widened.push((t, 3.0 * (s.glr.abs() + s.glr_sigma) * info_t.display_to_si));
             }
             added.push(t);
@@ -1255,7 +1348,13 @@ pub fn explain(
         });
         rounds += 1;
         let (_, eligible_now) = candidate_tests(&pass.sig, opts);
-        selected_now = forward_select(&pass.sig, &eligible_now, pass.run.innovations.len(), opts);
+        let (sel, imp) = forward_select(&pass.sig, &eligible_now, pass.run.innovations.len(), opts);
+        selected_now = sel;
+        for i in imp {
+            if !implausible.iter().any(|x| x.term == i.term) {
+                implausible.push(i);
+            }
+        }
     }
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let extended_stats = pass.stats.clone();
@@ -1270,10 +1369,9 @@ pub fn explain(
         if let (Some(i), Some(r)) = (model.index_of(info.name), last) {
             f.estimate = r.x[i] * to_display;
             f.sigma = r.sigma[i] * to_display;
-            let spec_prior = config_for(&model)?.prior_sigma[i];
             let used = config_ext(&model, &widened)?.prior_sigma[i];
             f.prior_sigma = used * to_display;
-            f.prior_widened = used > spec_prior;
+            f.prior_widened = used > prior_sigma(t, opts);
         }
         let c = pass_cands_mean(&pass, data, t);
         let (rm, ru) = regressor_in_natural_units(info.regressor, c);
@@ -1286,7 +1384,7 @@ pub fn explain(
         };
         f.effect = effect;
         f.effect_unit = eu.into();
-        f.words = finding_words(f, info);
+        f.words = finding_words(f, info, prior_sigma(t, opts) / info.display_to_si);
     }
     let gain = Gain {
         loglik: extended_stats.loglik - base_pass_stats.loglik,
@@ -1308,6 +1406,7 @@ pub fn explain(
         candidates: ranked,
         findings,
         not_testable,
+        implausible,
         not_separable,
         extended_model: model.name.clone(),
         extended: extended_stats,
@@ -1363,7 +1462,11 @@ fn model_error_series(run: &FilterRun) -> Vec<(f64, f64, f64)> {
         .collect()
 }
 
-fn finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> String {
+fn finding_words(
+    f: &Finding,
+    info: &crate::model::catalog::TermInfo,
+    prior_display: f64,
+) -> String {
     let sensor = sensor_word(info.sensor);
     let axis = ["x", "y", "z"][info.axis];
     let reg = common::REGRESSORS[info.regressor];
@@ -1403,9 +1506,9 @@ fn finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> String 
     }
     if f.prior_widened {
         s.push_str(&format!(
-            "; at {} of the spec's prior σ ({} {}) the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
-            sig3(f.glr_estimate.abs() / (info.sigma / info.display_to_si)),
-            sig3(info.sigma / info.display_to_si),
+            "; at {} prior σ ({} {}) the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
+            sig3(f.glr_estimate.abs() / prior_display),
+            sig3(prior_display),
             f.unit,
             sig3(f.prior_sigma),
             f.unit,
@@ -1522,6 +1625,26 @@ fn summary(e: &Explanation) -> Vec<String> {
         s.push('.');
         out.push(s);
     }
+    if !e.implausible.is_empty() {
+        let list: Vec<String> = e
+            .implausible
+            .iter()
+            .map(|i| {
+                format!(
+                    "{} (would need {} ± {} {}, {} prior σ)",
+                    i.term,
+                    sig3(i.estimate),
+                    sig3(i.sigma),
+                    i.unit,
+                    sig3(i.prior_sigmas)
+                )
+            })
+            .collect();
+        out.push(format!(
+            "Significant but not named, their values would be implausible (a weak signature fitting some other mismatch; if your sensor can have such errors, widen its prior with --prior): {}.",
+            list.join(", ")
+        ));
+    }
     if !e.not_separable.is_empty() {
         let list: Vec<String> = e
             .not_separable
@@ -1567,13 +1690,22 @@ pub fn run_hidden_case(
         start: sim.start,
     };
     let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(FilterConfig::new(m)) };
-    let expl = explain(&baseline, &cands, &data, &config_for, opts, &mut |_, _| {})?;
+    let mut opts = opts.clone();
+    for (name, sigma) in &case.priors {
+        if let Some(t) = common::TERMS.iter().position(|x| x.name == name) {
+            opts.candidate_sigma.retain(|x| x.0 != t);
+            opts.candidate_sigma.push((t, *sigma));
+        }
+    }
+    let expl = explain(&baseline, &cands, &data, &config_for, &opts, &mut |_, _| {})?;
     let oracle = Model::parse(&case.oracle_model())?;
     // the oracle knows the terms and their size: a prior that holds the true value
     let mut oracle_cfg = FilterConfig::new(&oracle);
     for (name, v) in &case.hidden {
         if let Some(i) = oracle.index_of(name) {
-            oracle_cfg.prior_sigma[i] = oracle_cfg.prior_sigma[i].max(3.0 * v.abs());
+            let declared = case.priors.iter().find(|p| &p.0 == name).map(|p| p.1);
+            let sigma = declared.unwrap_or(oracle_cfg.prior_sigma[i]);
+            oracle_cfg.prior_sigma[i] = sigma.max(3.0 * v.abs());
         }
     }
     let run = filter::run(

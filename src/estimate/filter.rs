@@ -569,6 +569,9 @@ pub fn run_observed(
         prev_t = smp.t;
         e.navigate(smp, dt, obs);
         on_sample(&e.nav.state);
+        if k % report == 0 {
+            progress(k as f64 / imu.samples.len() as f64);
+        }
         let aid_due = next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9;
         let step_done = smp.t - e.step_t0 + 1e-9 >= cfg.step_s;
         if !step_done && !aid_due && k + 1 < imu.samples.len() {
@@ -583,9 +586,6 @@ pub fn run_observed(
             if cfg.mode == Mode::ClosedLoop {
                 e.feedback();
             }
-        }
-        if k % report == 0 {
-            progress(k as f64 / imu.samples.len() as f64);
         }
     }
     progress(1.0);

@@ -39,6 +39,9 @@ pub struct HiddenCase {
     pub description: String,
     /// Effect size used to size the magnitude (mg for accelerometer, deg/h for gyro terms).
     pub effect: f64,
+    /// Prior σ (SI) the case declares for candidate terms, replacing the spec's RLG-grade ones
+    /// where the hidden magnitude belongs to another sensor class (as `--prior` would).
+    pub priors: Vec<(String, f64)>,
 }
 
 impl HiddenCase {
@@ -314,6 +317,18 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
          [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}\
          [noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n"
     );
+    // g-sensitivities of several deg/h/g belong to a MEMS-class gyro, not to the spec's laser
+    // gyro (0.01 deg/h/g): the case declares that class, as a user would with --prior
+    let priors = if group == "kgf" {
+        let sigma = 10.0 * std::f64::consts::PI / 180.0 / 3600.0 / G0; // 10 deg/h/g
+        common::TERMS
+            .iter()
+            .filter(|t| t.name.starts_with("kgf_"))
+            .map(|t| (t.name.to_string(), sigma))
+            .collect()
+    } else {
+        Vec::new()
+    };
     HiddenCase {
         seed,
         group,
@@ -322,5 +337,6 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
         scenario,
         description,
         effect,
+        priors,
     }
 }
