@@ -85,6 +85,20 @@ impl DataArgs {
             .collect()
     }
 
+    /// Prints the sensor noise `--noise` gives, if any (once per run).
+    pub fn print_noise(&self) -> Result<()> {
+        if let Some(path) = &self.noise {
+            let (arw, vrw) = noise_from_allan(path)?;
+            eprintln!(
+                "noise from {}: ARW {:.3e} rad/sqrt(s), VRW {:.3e} m/s/sqrt(s)",
+                path.display(),
+                arw,
+                vrw
+            );
+        }
+        Ok(())
+    }
+
     /// A description of the data for reports.
     pub fn describe(&self) -> String {
         let mut s = String::new();
@@ -101,6 +115,55 @@ impl DataArgs {
             s.push_str(&format!(", truth {}", p.display()));
         }
         s
+    }
+
+    /// The `--prior` options that name spec terms (names or prefixes): (term index, σ in SI),
+    /// for explain's candidates (the sensor class of the data).
+    pub fn term_priors(&self) -> Result<Vec<(usize, f64)>> {
+        use sinsmodel::model::generated::common;
+        let mut out: Vec<(usize, f64)> = Vec::new();
+        for spec in &self.prior {
+            let (name, value) = spec
+                .split_once('=')
+                .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
+            let (name, value) = (name.trim(), value.trim());
+            for (t, info) in common::TERMS.iter().enumerate() {
+                let hit = match name.strip_suffix('*') {
+                    Some(prefix) => info.name.starts_with(prefix),
+                    None => info.name == name,
+                };
+                if hit {
+                    let si = sinsmodel::io::units::parse_quantity_as(value, info.unit)
+                        .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+                    if !(si.is_finite() && si > 0.0) {
+                        bail!("--prior `{spec}`: a prior σ must be positive and finite");
+                    }
+                    out.retain(|x| x.0 != t);
+                    out.push((t, si));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Every `--prior` must name a state of `model` or a spec term (explain's candidates).
+    pub fn check_prior_names(&self, model: &Model) -> Result<()> {
+        use sinsmodel::model::generated::common;
+        for spec in &self.prior {
+            let name = spec.split_once('=').map(|x| x.0.trim()).unwrap_or(spec);
+            let hit = |n: &str| match name.strip_suffix('*') {
+                Some(prefix) => n.starts_with(prefix),
+                None => n == name,
+            };
+            if !model.names.iter().any(|n| hit(n)) && !common::TERMS.iter().any(|t| hit(t.name)) {
+                bail!(
+                    "--prior `{spec}`: no state `{name}` in {} and no spec term of that name{}",
+                    model.name,
+                    sinsmodel::model::did_you_mean(name.trim_end_matches('*'))
+                );
+            }
+        }
+        Ok(())
     }
 
     /// Reads the IMU, aiding and truth files and builds the initial state.
@@ -269,18 +332,15 @@ impl DataArgs {
             for i in matches {
                 let si = sinsmodel::io::units::parse_quantity_as(value, model.unit(i))
                     .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+                if !(si.is_finite() && si > 0.0) {
+                    bail!("--prior `{spec}`: a prior σ must be positive and finite");
+                }
                 cfg.prior_sigma[i] = si;
             }
         }
         if let Some(path) = &args.noise {
             let (arw, vrw) = noise_from_allan(path)?;
             cfg = cfg.with_sensor_noise(model, arw, vrw);
-            eprintln!(
-                "noise from {}: ARW {:.3e} rad/sqrt(s), VRW {:.3e} m/s/sqrt(s)",
-                path.display(),
-                arw,
-                vrw
-            );
         }
         Ok(cfg)
     }

@@ -72,8 +72,12 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
             .map_err(anyhow::Error::msg)?;
         let skipped = already_in_baseline(args.candidates.as_deref(), &baseline);
         // every option is checked before the (long) run
-        args.data.config(&baseline, false)?;
+        args.data.check_prior_names(&baseline)?;
+        args.data.config(&baseline, true)?;
+        let mut opts = opts.clone();
+        opts.candidate_sigma = args.data.term_priors()?;
         let out = OutputDir::create(&args.out, &args.data.input_paths())?;
+        args.data.print_noise()?;
         let inputs = args.data.load()?;
         let data = ExplainData {
             imu: &inputs.imu,
@@ -228,8 +232,19 @@ fn finish(
 }
 
 /// Figures: normalised innovations before/after, candidate ranking, estimates, model error.
+/// Times count from the first update when the data carry large (GPS) times.
 fn figures(out: &OutputDir, e: &Explanation) -> Result<Vec<(String, String)>> {
     let mut figs = Vec::new();
+    let t_ref = if e.baseline.t_start.abs() > 1e5 {
+        e.baseline.t_start.floor()
+    } else {
+        0.0
+    };
+    let t_label = if t_ref != 0.0 {
+        format!("t − {t_ref:.0} [s]")
+    } else {
+        "t [s]".to_string()
+    };
     for (file, title, series) in [
         (
             "innovations_before.png",
@@ -255,14 +270,14 @@ fn figures(out: &OutputDir, e: &Explanation) -> Result<Vec<(String, String)>> {
                 points: series
                     .iter()
                     .filter(|(_, ch, _)| ch == c)
-                    .map(|(t, _, v)| (*t, *v))
+                    .map(|(t, _, v)| (*t - t_ref, *v))
                     .collect(),
             })
             .collect();
         plot::line_plot(
             &out.file(file),
             &title,
-            "t [s]",
+            &t_label,
             "ν / √S (1 = as predicted)",
             &curves,
             Scale::Linear,
@@ -320,7 +335,7 @@ fn figures(out: &OutputDir, e: &Explanation) -> Result<Vec<(String, String)>> {
     if !e.model_error_before.is_empty() {
         let pick = |v: &[(f64, f64, f64)], k: usize| -> Vec<(f64, f64)> {
             v.iter()
-                .map(|r| (r.0, if k == 0 { r.1 } else { r.2 }))
+                .map(|r| (r.0 - t_ref, if k == 0 { r.1 } else { r.2 }))
                 .collect()
         };
         let curves = vec![
@@ -344,7 +359,7 @@ fn figures(out: &OutputDir, e: &Explanation) -> Result<Vec<(String, String)>> {
         plot::line_plot(
             &out.file("model_error.png"),
             "Model error e = φ̂ − φ before and after",
-            "t [s]",
+            &t_label,
             "arcsec",
             &curves,
             Scale::Linear,

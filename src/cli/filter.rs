@@ -27,6 +27,7 @@ pub struct FilterArgs {
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
     let cfg = args.data.config(&model, false)?;
+    args.data.print_noise()?;
     let inputs = args.data.load()?;
     let (imu, aid, truth_rows, start) = (&inputs.imu, &inputs.aid, &inputs.truth, inputs.start);
     let pb = progress::bar(1000, "filter");

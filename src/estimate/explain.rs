@@ -149,6 +149,8 @@ struct Signatures {
     base_r: Vec<f64>,
     /// For each candidate, (model index, row of its term column) of the rows it reaches.
     cand_rows: Vec<Vec<(usize, usize)>>,
+    /// Mean NIS of the pass (the dispersion φ of the quasi-likelihood; 1 when consistent).
+    dispersion: f64,
     /// Information J (m × m) and score b (m).
     info: Vec<f64>,
     score: Vec<f64>,
@@ -222,6 +224,7 @@ impl Signatures {
             base_r_idx,
             base_r: vec![0.0; nb],
             cand_rows,
+            dispersion: 1.0,
             info: vec![0.0; m * m],
             score: vec![0.0; m],
             reg_sum: vec![0.0; m],
@@ -416,6 +419,8 @@ pub struct TruthCheck {
 pub struct PassStats {
     /// Model as a string.
     pub model: String,
+    /// Time of the first innovation [s] (data time; the words count from here).
+    pub t_start: f64,
     /// Total log-likelihood of the innovations, Σ −½(ν²/S + ln 2πS).
     pub loglik: f64,
     /// Mean NIS over all scalar innovations.
@@ -584,6 +589,7 @@ fn pass_stats(
     let truth_check = truth.map(|_| truth_check(model, run)).unwrap_or_default();
     PassStats {
         model: model.name.clone(),
+        t_start,
         loglik,
         nis_mean: nis_all / n_all.max(1) as f64,
         whiteness_p,
@@ -769,6 +775,9 @@ pub struct Explanation {
     pub not_testable: Vec<String>,
     /// Significant candidates not named because their value would be implausible.
     pub implausible: Vec<Implausible>,
+    /// Terms the signatures selected but the extended filter did not confirm: (term, 2Δℓ of
+    /// the round, its BIC penalty k ln N).
+    pub unconfirmed: Vec<(String, f64, f64)>,
     /// Candidates whose regressor is proportional on these data to a baseline term's on the
     /// same sensor axis: (candidate, baseline term). Never named; the baseline term takes it up.
     pub not_separable: Vec<(String, String)>,
@@ -824,6 +833,7 @@ fn run_pass(
         &mut sig,
     );
     let stats = pass_stats(model, &run, &sig.level, data.truth);
+    sig.dispersion = stats.nis_mean;
     Pass { run, sig, stats }
 }
 
@@ -835,8 +845,11 @@ fn scaled(sig: &Signatures, opts: &ExplainOptions) -> (DMatrix<f64>, Vec<f64>, V
         .iter()
         .map(|&t| prior_sigma(t, opts).max(f64::MIN_POSITIVE))
         .collect();
-    let j = DMatrix::from_fn(m, m, |a, b| sig.info[a * m + b] * sd[a] * sd[b]);
-    let b = (0..m).map(|a| sig.score[a] * sd[a]).collect();
+    // quasi-likelihood: innovations φ times larger than S predicts scale the information and
+    // score by 1/φ, so an inconsistent baseline does not make every candidate significant
+    let phi = sig.dispersion.max(1.0);
+    let j = DMatrix::from_fn(m, m, |a, b| sig.info[a * m + b] * sd[a] * sd[b] / phi);
+    let b = (0..m).map(|a| sig.score[a] * sd[a] / phi).collect();
     (j, b, sd)
 }
 
@@ -1023,7 +1036,11 @@ fn candidate_tests(sig: &Signatures, opts: &ExplainOptions) -> (Vec<CandidateTes
     let (j, b, sd) = scaled(sig, opts);
     let m = sig.cands.len();
     let nb = sig.base_terms.len();
-    let testable: Vec<bool> = (0..m).map(|c| j[(c, c)] > opts.min_information).collect();
+    // testability is a property of the data's excitation, not of the dispersion
+    let phi = sig.dispersion.max(1.0);
+    let testable: Vec<bool> = (0..m)
+        .map(|c| j[(c, c)] * phi > opts.min_information)
+        .collect();
     let p: Vec<f64> = (0..m)
         .map(|c| {
             if testable[c] {
@@ -1253,6 +1270,7 @@ pub fn explain(
     let mut rounds = 1;
     let mut pool_terms: Vec<usize> = cands.clone();
     let mut widened: Vec<(usize, f64)> = Vec::new(); // (term, least prior σ, SI)
+    let mut unconfirmed: Vec<(String, f64, f64)> = Vec::new(); // (term, 2Δℓ, penalty)
     let config_ext = |m: &Model, widened: &[(usize, f64)]| -> anyhow::Result<FilterConfig> {
         let mut cfg = config_for(m)?;
         // an added term starts from its candidate prior (the data's sensor class) …
@@ -1276,6 +1294,7 @@ pub fn explain(
             break;
         }
         let mut added = Vec::new();
+        let (findings_before, widened_before) = (findings.len(), widened.len());
         for s in &selected_now {
             let t = pass.sig.cands[s.idx];
             let class: Vec<usize> = s.class.iter().map(|c| pass.sig.cands[c.0]).collect();
@@ -1334,19 +1353,38 @@ pub fn explain(
             text.push('+');
             text.push_str(common::TERMS[t].name);
         }
-        model = Model::parse(&text)?;
+        let next_model = Model::parse(&text)?;
         pool_terms.retain(|t| !excluded.contains(t));
-        if rounds >= opts.max_rounds {
-            let cfg = config_ext(&model, &widened)?;
-            pass = run_pass(&model, &[], data, &cfg, &mut |f| progress(rounds + 1, f));
-            rounds += 1;
+        let last_round = rounds >= opts.max_rounds;
+        let cfg = config_ext(&next_model, &widened)?;
+        let next_pass = run_pass(
+            &next_model,
+            if last_round { &[] } else { &pool_terms },
+            data,
+            &cfg,
+            &mut |f| progress(rounds + 1, f),
+        );
+        rounds += 1;
+        // the filter must confirm what the signatures predicted: the added terms must raise the
+        // log-likelihood by more than their BIC penalty (k ln N); else the linearisation did not
+        // hold (or the misfit is something else) and the round is undone
+        let gain = next_pass.stats.loglik - pass.stats.loglik;
+        let penalty = added.len() as f64 * (next_pass.run.innovations.len().max(2) as f64).ln();
+        if 2.0 * gain <= penalty {
+            unconfirmed.extend(
+                added
+                    .iter()
+                    .map(|&t| (common::TERMS[t].name.to_string(), 2.0 * gain, penalty)),
+            );
+            findings.truncate(findings_before);
+            widened.truncate(widened_before);
             break;
         }
-        let cfg = config_ext(&model, &widened)?;
-        pass = run_pass(&model, &pool_terms, data, &cfg, &mut |f| {
-            progress(rounds + 1, f)
-        });
-        rounds += 1;
+        model = next_model;
+        pass = next_pass;
+        if last_round {
+            break;
+        }
         let (_, eligible_now) = candidate_tests(&pass.sig, opts);
         let (sel, imp) = forward_select(&pass.sig, &eligible_now, pass.run.innovations.len(), opts);
         selected_now = sel;
@@ -1356,6 +1394,7 @@ pub fn explain(
             }
         }
     }
+    implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let extended_stats = pass.stats.clone();
     let last = pass.run.records.last();
@@ -1407,6 +1446,7 @@ pub fn explain(
         findings,
         not_testable,
         implausible,
+        unconfirmed,
         not_separable,
         extended_model: model.name.clone(),
         extended: extended_stats,
@@ -1558,6 +1598,12 @@ fn channel_word(c: &str) -> String {
 /// The plain-words summary: what the baseline gets wrong, what was found, the gain.
 fn summary(e: &Explanation) -> Vec<String> {
     let mut out = Vec::new();
+    // data times (GPS seconds on real data) are counted from the first update when large
+    let t_ref = if e.baseline.t_start.abs() > 1e5 {
+        e.baseline.t_start.floor()
+    } else {
+        0.0
+    };
     let mut consistent = true;
     for ch in &e.baseline.channels {
         let inconsistent = ch.nis_mean > ch.nis_band[1] * 1.5
@@ -1574,11 +1620,12 @@ fn summary(e: &Explanation) -> Vec<String> {
             .max_by(|a, b| a.nis_mean.total_cmp(&b.nis_mean));
         match worst {
             Some(sg) if sg.nis_mean > ch.nis_band[1] => out.push(format!(
-                "{} innovations are {}× larger than the model predicts during {:.0}–{:.0} s (mean NIS {}), biased by {:+.1}σ; the model does not explain the data there.",
+                "{} innovations are {}× larger than the model predicts during {:.0}–{:.0} s{} (mean NIS {}), biased by {:+.1}σ; the model does not explain the data there.",
                 channel_word(&ch.channel),
                 sig3(sg.nis_mean.sqrt()),
-                sg.t0,
-                sg.t1,
+                sg.t0 - t_ref,
+                sg.t1 - t_ref,
+                if t_ref != 0.0 { " from the first update" } else { "" },
                 sig3(sg.nis_mean),
                 sg.bias_sigma
             )),
@@ -1643,6 +1690,16 @@ fn summary(e: &Explanation) -> Vec<String> {
         out.push(format!(
             "Significant but not named, their values would be implausible (a weak signature fitting some other mismatch; if your sensor can have such errors, widen its prior with --prior): {}.",
             list.join(", ")
+        ));
+    }
+    if !e.unconfirmed.is_empty() {
+        let names: Vec<&str> = e.unconfirmed.iter().map(|u| u.0.as_str()).collect();
+        let (g, p) = (e.unconfirmed[0].1, e.unconfirmed[0].2);
+        out.push(format!(
+            "The signatures pointed at {} but the filter with them did not confirm it (2Δ log-likelihood {} against a BIC penalty of {}): not named; the misfit is something the candidates do not describe.",
+            names.join(", "),
+            sig3(g),
+            sig3(p)
         ));
     }
     if !e.not_separable.is_empty() {

@@ -40,6 +40,11 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         "gain": gain,
         "candidates": e.candidates,
         "not_testable": e.not_testable,
+        "implausible": e.implausible,
+        "unconfirmed": e.unconfirmed
+            .iter()
+            .map(|(t, g, p)| json!({"term": t, "two_delta_loglik": g, "bic_penalty": p}))
+            .collect::<Vec<_>>(),
         "not_separable": e.not_separable
             .iter()
             .map(|(c, b)| json!({"term": c, "like": b}))
@@ -234,6 +239,13 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
             num(a)
         ));
     }
+    s.push_str(
+        "\nThe candidate tests are quasi-likelihood tests: when the baseline's innovations are \
+         larger than predicted (mean NIS φ > 1), information and score are divided by φ. A term \
+         is named only when its value is within 100 prior σ (`--prior` sets the sensor class) \
+         and the filter with it confirms the gain the signatures predicted (2Δ log-likelihood \
+         above the BIC penalty k ln N).\n",
+    );
     s.push_str(
         "\n**Not testable** means the data carry no information on the term (its regressor is \
          zero or its signature never reaches the innovations): explain cannot say whether it is \
