@@ -168,7 +168,8 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
          d_x = d_y = d_z = 5e-5 s^2/m (490 ug/g^2) hidden, seed {}",
         args.demo_seconds, args.demo_seed
     );
-    finish(args, out, &e, &what, &[])
+    let skipped = already_in_baseline(args.candidates.as_deref(), &baseline);
+    finish(args, out, &e, &what, &skipped)
 }
 
 /// Writes the report, figures, JSON and extended preset; prints the summary.

@@ -1,0 +1,330 @@
+//! `sinsmodel explain` from the command line: the embedded demo end to end (JSON of DESIGN §9,
+//! report, figures, extended preset), its refusals of bad input, and both measured data sets.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn sinsmodel(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
+        .args(args)
+        .output()
+        .expect("run sinsmodel");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!(
+        "sinsmodel-explain-cli-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn demo_finds_d_and_writes_the_design_contract() {
+    let out = tmp("demo");
+    let j = tmp("demo.json");
+    let (ok, stdout, stderr) = sinsmodel(&[
+        "explain",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+        j.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("report.md"), "{stdout}");
+    for f in [
+        "report.md",
+        "report.html",
+        "explain.json",
+        "extended.toml",
+        "innovations_before.png",
+        "innovations_after.png",
+        "candidates.png",
+        "estimates.png",
+        "model_error.png",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let v = json(&out.join("explain.json"));
+    assert_eq!(v, json(&j), "--json and the directory's copy agree");
+    // DESIGN §9 names
+    assert!(v["model"].as_array().unwrap().len() >= 28);
+    for k in ["loglik", "nis_mean", "whiteness_p"] {
+        assert!(v["baseline"][k].is_number(), "baseline.{k}");
+        assert!(v["extended"][k].is_number(), "extended.{k}");
+    }
+    assert!(v["extended"]["terms"].as_array().unwrap().len() > 28);
+    for k in ["loglik", "model_error_rms_before", "model_error_rms_after"] {
+        assert!(v["gain"][k].is_number(), "gain.{k}");
+    }
+    let findings = v["findings"].as_array().unwrap();
+    let named: Vec<&str> = findings
+        .iter()
+        .map(|f| f["term"].as_str().unwrap())
+        .collect();
+    // the hidden d (5e-5 s^2/m = 490 ug/g^2 on every axis), each named or in a named class
+    for axis in ["d_x", "d_y", "d_z"] {
+        let f = findings
+            .iter()
+            .find(|f| {
+                f["term"] == axis
+                    || f["equivalent"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .any(|e| e == axis)
+            })
+            .unwrap_or_else(|| panic!("{axis} not found; named {named:?}"));
+        for k in ["estimate", "sigma", "llr"] {
+            assert!(f[k].is_number(), "finding.{k}");
+        }
+        assert!(f["unit"].is_string());
+        if f["term"] == axis {
+            let est = f["estimate"].as_f64().unwrap();
+            assert!((est - 490.3).abs() < 49.0, "{axis} = {est} ug/g^2");
+        }
+    }
+    let before = v["gain"]["model_error_rms_before"].as_f64().unwrap();
+    let after = v["gain"]["model_error_rms_after"].as_f64().unwrap();
+    assert!(after < 0.2 * before, "model error {before} -> {after}");
+    let preset = std::fs::read_to_string(out.join("extended.toml")).unwrap();
+    assert!(preset.contains("[[preset]]") && preset.contains("base = \"P28\""));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("data:image/png;base64,"), "figures embedded");
+    assert!(
+        !html.contains("src=\"innovations"),
+        "no links to files beside it"
+    );
+    // a second run replaces the first one's directory (it holds the run marker)
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--out",
+        out.to_str().unwrap(),
+        "--demo-seconds",
+        "120",
+    ]);
+    assert!(ok, "{stderr}");
+    std::fs::remove_dir_all(&out).unwrap();
+    std::fs::remove_file(&j).unwrap();
+}
+
+#[test]
+fn explain_refuses_bad_input_with_the_reason() {
+    let rlg = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/data/psins-lasergyro/lasergyro.imu"
+    );
+    let init = "34.246048,108.909664,380,0.3878,1.0026,90.603";
+    let out = tmp("bad");
+    let o = out.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "explain", "--model", "P28", "--imu", rlg, "--init", init, "--out", o,
+            ],
+            "no aiding",
+        ),
+        (
+            vec![
+                "explain",
+                "--model",
+                "P28",
+                "--imu",
+                rlg,
+                "--static-aid",
+                "34.2,108.9,380",
+                "--init",
+                init,
+                "--candidates",
+                "d_q",
+                "--out",
+                o,
+            ],
+            "unknown term `d_q`",
+        ),
+        (vec!["explain", "--alpha", "1.5", "--out", o], "--alpha 1.5"),
+        (vec!["explain", "--alpha", "NaN", "--out", o], "--alpha NaN"),
+        (
+            vec![
+                "explain",
+                "--model",
+                "P28",
+                "--imu",
+                rlg,
+                "--static-aid",
+                "34.2,108.9",
+                "--init",
+                init,
+                "--out",
+                o,
+            ],
+            "--static-aid takes LAT,LON,H",
+        ),
+        (
+            vec![
+                "explain",
+                "--model",
+                "P28",
+                "--imu",
+                rlg,
+                "--static-aid",
+                "34.2,108.9,380",
+                "--init",
+                init,
+                "--prior",
+                "epz_x=1 deg/h",
+                "--out",
+                o,
+            ],
+            "--prior `epz_x=1 deg/h`",
+        ),
+        (
+            vec!["explain", "--aid", "x.txt", "--out", o],
+            "--model BASELINE is required",
+        ),
+        (
+            vec!["explain", "--demo-seconds", "inf", "--out", o],
+            "--demo-seconds",
+        ),
+    ];
+    for (args, expect) in cases {
+        let (ok, _, stderr) = sinsmodel(&args);
+        assert!(!ok, "{args:?} was accepted");
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+        assert!(!out.exists(), "{args:?} left an output directory");
+    }
+    // an existing directory that sinsmodel did not write is never replaced
+    let foreign = tmp("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), "mine").unwrap();
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--demo-seconds",
+        "60",
+        "--out",
+        foreign.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("was not written by sinsmodel"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    std::fs::remove_dir_all(&foreign).unwrap();
+}
+
+/// Candidates the baseline already has are skipped with a note; "not testable" is listed.
+#[test]
+fn candidates_in_the_baseline_are_skipped_and_untestable_ones_listed() {
+    let out = tmp("skip");
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P31",
+        "--candidates",
+        "d_x,size_*",
+        "--demo-seconds",
+        "120",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stderr.contains("d_x is already in the baseline"),
+        "{stderr}"
+    );
+    let v = json(&out.join("explain.json"));
+    let nt: Vec<&str> = v["not_testable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap())
+        .collect();
+    // no angular motion in the demo: the size effect has no information
+    assert_eq!(nt, vec!["size_x", "size_y", "size_z"]);
+    assert!(v["findings"].as_array().unwrap().is_empty());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Both measured sets (docs/explain.md): only what is stable is asserted.
+#[test]
+fn measured_data() {
+    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
+    let rlg = format!("{shared}/psins-lasergyro/lasergyro.imu");
+    let out = tmp("rlg");
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P28",
+        "--imu",
+        &rlg,
+        "--static-aid",
+        "34.246048,108.909664,380",
+        "--init",
+        "34.246048,108.909664,380,0.3878,1.0026,90.603",
+        "--noise",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/docs/real-data/rlg_allan.json"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let v = json(&out.join("explain.json"));
+    // the parked car's motion is no error term: nothing is named
+    assert!(v["findings"].as_array().unwrap().is_empty(), "{stderr}");
+    std::fs::remove_dir_all(&out).unwrap();
+
+    let d = format!("{shared}/gnss-imu-drive");
+    let out = tmp("mems");
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P28+vertical",
+        "--imu",
+        &format!("{d}/imu_1934.csv"),
+        "--aid",
+        &format!("{d}/gnss_1934_sf.pos"),
+        "--init",
+        "40.0966268,-105.1474483,1601.476,-178.192,6.687,-181.028",
+        "--mode",
+        "closed",
+        "--noise",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/docs/real-data/mems_static_allan.json"
+        ),
+        "--prior",
+        "eps_*=0.5 deg/s",
+        "--prior",
+        "nabla_*=0.5 m/s^2",
+        "--prior",
+        "phi_n=2 deg",
+        "--prior",
+        "phi_e=2 deg",
+        "--prior",
+        "phi_d=10 deg",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let v = json(&out.join("explain.json"));
+    // the MEMS baseline does not explain the drive (NIS well above 1) and whatever explain
+    // adds must lower it
+    let before = v["baseline"]["nis_mean"].as_f64().unwrap();
+    let after = v["extended"]["nis_mean"].as_f64().unwrap();
+    assert!(before > 2.0, "baseline NIS {before}");
+    assert!(after <= before, "NIS {before} -> {after}");
+    assert!(v["gain"]["loglik"].as_f64().unwrap() >= 0.0);
+    std::fs::remove_dir_all(&out).unwrap();
+}
