@@ -236,6 +236,13 @@ impl DataArgs {
             Some(p) => Some(truth::read(p)?),
             None => None,
         };
+        if args.step < 0.999 * imu.interval() {
+            bail!(
+                "--step {} s is shorter than the IMU interval ({} s)",
+                args.step,
+                imu.interval()
+            );
+        }
         let t0 = imu.samples[0].t - imu.interval();
         let d = std::f64::consts::PI / 180.0;
         let start = match (&args.init, &truth_rows) {
@@ -245,6 +252,24 @@ impl DataArgs {
                         "--init takes lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (6 or 9 numbers), got {}",
                         v.len()
                     );
+                }
+                let names = ["lat", "lon", "h", "roll", "pitch", "yaw", "vn", "ve", "vd"];
+                let ranges = [
+                    (-90.0, 90.0, "deg"),
+                    (-360.0, 360.0, "deg"),
+                    (-1000.0, 50_000.0, "m"),
+                    (-180.0, 180.0, "deg"),
+                    (-90.0, 90.0, "deg"),
+                    (-360.0, 360.0, "deg"),
+                    (-1000.0, 1000.0, "m/s"),
+                    (-1000.0, 1000.0, "m/s"),
+                    (-1000.0, 1000.0, "m/s"),
+                ];
+                for (k, x) in v.iter().enumerate() {
+                    let (lo, hi, unit) = ranges[k];
+                    if !(x.is_finite() && (lo..=hi).contains(x)) {
+                        bail!("--init: {} = {x} is outside [{lo}, {hi}] {unit}", names[k]);
+                    }
                 }
                 let c = dcm_from_euler(v[3] * d, v[4] * d, v[5] * d);
                 NavState {
@@ -277,6 +302,27 @@ impl DataArgs {
             }
             (None, None) => bail!("give --init or --truth for the initial state"),
         };
+        let t_last = imu.samples[imu.samples.len() - 1].t;
+        let inside = fixes.iter().filter(|f| f.t > t0 && f.t <= t_last).count();
+        if inside < 10 {
+            bail!(
+                "only {inside} of {} aiding epochs fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (the filter works on innovations)",
+                fixes.len()
+            );
+        }
+        // the initial position and the first aiding fix must describe the same place
+        if let Some(f) = fixes.iter().find(|f| f.t > t0) {
+            let dn = (f.lat - start.lat) * 6.371e6;
+            let de = (f.lon - start.lon) * 6.371e6 * start.lat.cos();
+            let dist = dn.hypot(de);
+            if dist > 20_000.0 {
+                bail!(
+                    "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
+                    dist / 1000.0,
+                    f.t
+                );
+            }
+        }
         let aid: Vec<AidingEpoch> = fixes
             .iter()
             .filter(|f| f.t > t0)
@@ -305,8 +351,8 @@ impl DataArgs {
             "closed" => Mode::ClosedLoop,
             m => bail!("--mode `{m}`: expected open or closed"),
         };
-        if args.step.is_nan() || args.step <= 0.0 {
-            bail!("--step must be positive");
+        if !(args.step.is_finite() && args.step > 0.0 && args.step <= 10.0) {
+            bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
         cfg.step_s = args.step;
         if !model.vertical {
@@ -358,9 +404,10 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
             let w = v["fit"][n]["white"]
                 .as_f64()
                 .with_context(|| format!("{}: fit.{n}.white missing", path.display()))?;
-            if !w.is_finite() || w <= 0.0 {
+            let max = if n.starts_with("gyro") { 1.0 } else { 100.0 };
+            if !w.is_finite() || w <= 0.0 || w > max {
                 bail!(
-                    "{}: fit.{n}.white = {w} is not a positive density",
+                    "{}: fit.{n}.white = {w} is not a plausible noise density (0 < w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
                     path.display()
                 );
             }

@@ -1,10 +1,10 @@
 //! `sinsmodel filter --model MODEL --imu FILE --aid FILE [--truth FILE] [--init …] --out DIR`.
 
 use super::data::DataArgs;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use sinsmodel::estimate::filter;
-use sinsmodel::io::atomic_file::AtomicFile;
+use sinsmodel::io::atomic_file::{AtomicFile, OutputDir};
 use sinsmodel::model::Model;
 use sinsmodel::report::progress;
 use std::io::Write;
@@ -18,7 +18,8 @@ pub struct FilterArgs {
     model: String,
     #[command(flatten)]
     data: DataArgs,
-    /// Output directory: states.txt, innovations.txt, model_error.txt (with truth).
+    /// Output directory: states.txt, innovations.txt, model_error.txt (with truth); written
+    /// complete or not at all, replacing only an earlier sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
 }
@@ -27,6 +28,7 @@ pub struct FilterArgs {
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
     let cfg = args.data.config(&model, false)?;
+    let out = OutputDir::create(&args.out, &args.data.input_paths())?;
     args.data.print_noise()?;
     let inputs = args.data.load()?;
     let (imu, aid, truth_rows, start) = (&inputs.imu, &inputs.aid, &inputs.truth, inputs.start);
@@ -35,10 +37,9 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         pb.set_position((f * 1000.0) as u64)
     });
     pb.finish_and_clear();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    run.check().map_err(anyhow::Error::msg)?;
 
-    let mut f = AtomicFile::create(&args.out.join("states.txt"))?;
+    let mut f = AtomicFile::create(&out.file("states.txt"))?;
     let w = f.writer();
     writeln!(
         w,
@@ -62,7 +63,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     f.commit()?;
 
-    let mut f = AtomicFile::create(&args.out.join("innovations.txt"))?;
+    let mut f = AtomicFile::create(&out.file("innovations.txt"))?;
     let w = f.writer();
     writeln!(w, "# t measurement component nu S (SI; nu = z - H x)")?;
     for i in &run.innovations {
@@ -75,7 +76,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     f.commit()?;
 
     if truth_rows.is_some() {
-        let mut f = AtomicFile::create(&args.out.join("model_error.txt"))?;
+        let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
         let w = f.writer();
         let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
         writeln!(
@@ -102,6 +103,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         }
         f.commit()?;
     }
+    out.commit()?;
     let nis = run
         .innovations
         .iter()

@@ -100,6 +100,12 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
         return Ok((0..common::TERM_COUNT).filter(|&t| !in_base(t)).collect());
     };
     let mut out = Vec::new();
+    if spec.split(',').all(|s| s.trim().is_empty()) {
+        return Err(
+            "--candidates: the list is empty (give names or prefix groups, e.g. `kaq_*,d_x`, or leave the option out for every term)"
+                .into(),
+        );
+    }
     for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let matched: Vec<usize> = match item.strip_suffix('*') {
             Some(prefix) => (0..common::TERM_COUNT)
@@ -819,7 +825,7 @@ fn run_pass(
     data: &ExplainData,
     cfg: &FilterConfig,
     progress: &mut dyn FnMut(f64),
-) -> Pass {
+) -> anyhow::Result<Pass> {
     let mut sig = Signatures::new(model, cands);
     let run = filter::run_observed(
         model,
@@ -832,9 +838,11 @@ fn run_pass(
         &mut |_| {},
         &mut sig,
     );
+    run.check()
+        .map_err(|e| anyhow::anyhow!("{} pass: {e}", model.name))?;
     let stats = pass_stats(model, &run, &sig.level, data.truth);
     sig.dispersion = stats.nis_mean;
-    Pass { run, sig, stats }
+    Ok(Pass { run, sig, stats })
 }
 
 /// Prior-scaled quantities of a pass: J' = D J D, b' = D b with D = diag(σ_prior).
@@ -1244,7 +1252,7 @@ pub fn explain(
         .filter(|&t| !baseline.states.contains(&StateRef::Term(t)))
         .collect();
     let cfg = config_for(baseline)?;
-    let base = run_pass(baseline, &cands, data, &cfg, &mut |f| progress(1, f));
+    let base = run_pass(baseline, &cands, data, &cfg, &mut |f| progress(1, f))?;
     let base_pass_stats = base.stats.clone();
     let innovations_before = normalised(&base.run);
     let model_error_before = model_error_series(&base.run);
@@ -1363,7 +1371,7 @@ pub fn explain(
             data,
             &cfg,
             &mut |f| progress(rounds + 1, f),
-        );
+        )?;
         rounds += 1;
         // the filter must confirm what the signatures predicted: the added terms must raise the
         // log-likelihood by more than their BIC penalty (k ln N); else the linearisation did not
@@ -1510,9 +1518,12 @@ fn finding_words(
     let sensor = sensor_word(info.sensor);
     let axis = ["x", "y", "z"][info.axis];
     let reg = common::REGRESSORS[info.regressor];
+    let group = info
+        .group
+        .trim_start_matches("accel ")
+        .trim_start_matches("gyro ");
     let mut s = format!(
-        "{sensor} {axis} {} {} = {} ± {} {}: with the data's mean {reg} of {} {} it acts as a {} {} {} along {axis}",
-        info.group,
+        "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {} along {axis}",
         f.term,
         sig3(f.estimate),
         sig3(f.sigma),
@@ -1529,7 +1540,7 @@ fn finding_words(
             .iter()
             .map(|e| {
                 format!(
-                    "{} (= {} ± {} {}, {} prior σ)",
+                    "{} (would need {} ± {} {} by the signatures, {} prior σ)",
                     e.term,
                     sig3(e.estimate),
                     sig3(e.sigma),
@@ -1547,7 +1558,7 @@ fn finding_words(
     if f.prior_widened {
         s.push_str(&format!(
             "; at {} prior σ ({} {}) the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
-            sig3(f.glr_estimate.abs() / prior_display),
+            sig3(f.estimate.abs() / prior_display),
             sig3(prior_display),
             f.unit,
             sig3(f.prior_sigma),
@@ -1636,6 +1647,17 @@ fn summary(e: &Explanation) -> Vec<String> {
             )),
         }
     }
+    for ch in &e.baseline.channels {
+        if ch.nis_mean < 0.5 * ch.nis_band[0] {
+            consistent = false;
+            out.push(format!(
+                "{} innovations are {}× smaller than the model predicts (mean NIS {}): its measurement or process noise is set too high for these data.",
+                channel_word(&ch.channel),
+                sig3((1.0 / ch.nis_mean.max(1e-12)).sqrt()),
+                sig3(ch.nis_mean)
+            ));
+        }
+    }
     if consistent {
         out.push(format!(
             "The baseline {} is consistent with the data: mean NIS {} and white innovations in every channel.",
@@ -1644,11 +1666,27 @@ fn summary(e: &Explanation) -> Vec<String> {
         ));
     }
     if e.findings.is_empty() {
-        out.push(format!(
-            "No candidate term is significant at α = {} (Holm-corrected over {} testable candidates).",
-            e.alpha,
-            e.candidates.iter().filter(|c| c.testable).count()
-        ));
+        let nameable = e
+            .candidates
+            .iter()
+            .filter(|c| c.testable && c.confounded_with.is_none())
+            .count();
+        let masked = e
+            .candidates
+            .iter()
+            .filter(|c| c.testable && c.confounded_with.is_some() && c.p_holm <= e.alpha)
+            .count();
+        let mut line = format!(
+            "No candidate that could be named is significant at α = {} (Holm over the {} testable ones that are separable from the baseline)",
+            e.alpha, nameable
+        );
+        if masked > 0 {
+            line.push_str(&format!(
+                "; {masked} significant alone are not separable from a baseline term (listed below)"
+            ));
+        }
+        line.push('.');
+        out.push(line);
     }
     for f in &e.findings {
         out.push(format!("Found: {}.", f.words));

@@ -173,6 +173,40 @@ pub struct FilterRun {
     pub innovations: Vec<Innovation>,
     /// Final navigation state.
     pub final_state: NavState,
+    /// Scalar updates whose innovation or its variance was not finite (skipped), and the time
+    /// of the first: the filter diverged or was fed non-physical numbers.
+    pub nonfinite_updates: usize,
+    /// Time of the first non-finite update [s].
+    pub first_nonfinite_t: Option<f64>,
+}
+
+impl FilterRun {
+    /// An error when the run cannot support an answer: non-finite updates or states, or no
+    /// innovations at all.
+    pub fn check(&self) -> Result<(), String> {
+        if self.nonfinite_updates > 0 {
+            return Err(format!(
+                "the filter diverged: {} of {} scalar updates were not finite (first at t = {:.3} s); check --init, --prior, --noise and the IMU values",
+                self.nonfinite_updates,
+                self.nonfinite_updates + self.innovations.len(),
+                self.first_nonfinite_t.unwrap_or(f64::NAN)
+            ));
+        }
+        if let Some(r) = self
+            .records
+            .iter()
+            .find(|r| r.x.iter().chain(&r.sigma).any(|v| !v.is_finite()))
+        {
+            return Err(format!(
+                "the filter diverged: non-finite state estimates at t = {:.3} s; check --init, --prior, --noise and the IMU values",
+                r.t
+            ));
+        }
+        if self.innovations.is_empty() {
+            return Err("no aiding update fell inside the IMU data: nothing to test".into());
+        }
+        Ok(())
+    }
 }
 
 /// Watches a filter run from inside: every IMU sample, every propagation step and every scalar
@@ -251,6 +285,8 @@ pub const FORMED_MEASUREMENTS: [&str; 3] = ["vel_ne", "pos_ne", "pos_h"];
 
 /// The running filter: navigator, error state, covariance and the per-step buffers.
 struct Engine<'a> {
+    nonfinite: usize,
+    first_nonfinite_t: Option<f64>,
     model: &'a Model,
     cfg: &'a FilterConfig,
     n: usize,
@@ -336,6 +372,8 @@ impl<'a> Engine<'a> {
             i_dv: [idx("dv_n"), idx("dv_e"), idx("dv_d")],
             i_pos: [idx("dlat"), idx("dlon"), idx("dh")],
             innovations: Vec::new(),
+            nonfinite: 0,
+            first_nonfinite_t: None,
             records: Vec::new(),
             truth_i: 0,
         }
@@ -425,7 +463,12 @@ impl<'a> Engine<'a> {
                 .expect("the model supports the measurements it lists");
             for (comp, (&zc, &sc)) in z.iter().zip(&sigma).enumerate() {
                 let h_row = &self.h[comp * n..(comp + 1) * n];
-                if let Some((nu, sv)) = joseph_update(
+                if !(zc.is_finite() && sc.is_finite()) {
+                    self.nonfinite += 1;
+                    self.first_nonfinite_t.get_or_insert(ep.t);
+                    continue;
+                }
+                let upd = joseph_update(
                     &mut self.x,
                     &mut self.p,
                     h_row,
@@ -433,7 +476,13 @@ impl<'a> Engine<'a> {
                     sc * sc,
                     &mut self.u,
                     &mut self.k,
-                ) {
+                );
+                let upd = upd.filter(|(nu, sv)| nu.is_finite() && sv.is_finite());
+                if upd.is_none() {
+                    self.nonfinite += 1;
+                    self.first_nonfinite_t.get_or_insert(ep.t);
+                }
+                if let Some((nu, sv)) = upd {
                     obs.scalar_update(ep.t, name, comp, h_row, &self.k, nu, sv);
                     self.innovations.push(Innovation {
                         t: ep.t,
@@ -594,6 +643,8 @@ pub fn run_observed(
         records: e.records,
         innovations: e.innovations,
         final_state: e.nav.state,
+        nonfinite_updates: e.nonfinite,
+        first_nonfinite_t: e.first_nonfinite_t,
     }
 }
 
@@ -615,10 +666,13 @@ fn joseph_update(
     }
     let hph: f64 = nz.iter().map(|&j| h[j] * u[j]).sum();
     let s = hph + r;
-    if s.is_nan() || s <= 0.0 {
+    if !s.is_finite() || s <= 0.0 {
         return None;
     }
     let nu = z - nz.iter().map(|&j| h[j] * x[j]).sum::<f64>();
+    if !nu.is_finite() {
+        return None;
+    }
     for (ki, ui) in k.iter_mut().zip(u.iter()) {
         *ki = ui / s;
     }

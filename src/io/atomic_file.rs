@@ -13,8 +13,12 @@ pub struct AtomicFile {
 }
 
 impl AtomicFile {
-    /// Starts writing `target` (through `target` + `.partial`).
+    /// Starts writing `target` (through `target` + `.partial`), creating its directory.
     pub fn create(target: &Path) -> Result<AtomicFile> {
+        if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create {}", parent.display()))?;
+        }
         let mut tmp = target.as_os_str().to_owned();
         tmp.push(".partial");
         let tmp = PathBuf::from(tmp);
@@ -38,9 +42,10 @@ impl AtomicFile {
         w.flush()
             .with_context(|| format!("cannot write {}", self.tmp.display()))?;
         drop(w);
-        std::fs::rename(&self.tmp, &self.target).with_context(|| {
-            format!(
-                "cannot move {} to {}",
+        std::fs::rename(&self.tmp, &self.target).map_err(|e| {
+            let _ = std::fs::remove_file(&self.tmp);
+            anyhow::anyhow!(
+                "cannot move {} to {}: {e}",
                 self.tmp.display(),
                 self.target.display()
             )

@@ -122,10 +122,10 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     }
     s.push_str("\n## 1. What the baseline gets wrong\n\n");
     s.push_str(&format!(
-        "Baseline {}: log-likelihood {:.1}, mean NIS {} (1 when consistent), whiteness p {} \
+        "Baseline {}: log-likelihood {}, mean NIS {} (1 when consistent), whiteness p {} \
          (smallest over channels, Bonferroni-corrected).\n\n",
         e.baseline.model,
-        e.baseline.loglik,
+        num(e.baseline.loglik),
         num(e.baseline.nis_mean),
         num(e.baseline.whiteness_p)
     ));
@@ -224,9 +224,9 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     }
     s.push_str(".\n\n## 4. Gain\n\n| | baseline | extended |\n|---|---|---|\n");
     s.push_str(&format!(
-        "| log-likelihood | {:.1} | {:.1} |\n| mean NIS | {} | {} |\n| whiteness p | {} | {} |\n",
-        e.baseline.loglik,
-        e.extended.loglik,
+        "| log-likelihood | {} | {} |\n| mean NIS | {} | {} |\n| whiteness p | {} | {} |\n",
+        num(e.baseline.loglik),
+        num(e.extended.loglik),
         num(e.baseline.nis_mean),
         num(e.extended.nis_mean),
         num(e.baseline.whiteness_p),

@@ -87,6 +87,21 @@ fn sine3(amp_g: f64, schedule: &str) -> String {
         .collect()
 }
 
+/// On/off vibration schedule over `seconds`: six windows, on at full amplitude in the second,
+/// at half in the fourth, at full in the sixth (whole seconds: whole cycles at 90 Hz).
+fn onoff_schedule(seconds: f64) -> String {
+    let period = seconds / 6.0;
+    format!(
+        "schedule = [[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5], [{:.1}, {:.1}, 1.0]]\n",
+        period,
+        2.0 * period,
+        3.0 * period,
+        4.0 * period,
+        5.0 * period,
+        6.0 * period
+    )
+}
+
 /// The cases, full length (2 h; 4 h for fig1) or shortened for CI (`quick`).
 pub fn cases(quick: bool, seed: u64) -> Vec<Case> {
     let (t2h, t4h) = if quick {
@@ -104,17 +119,7 @@ pub fn cases(quick: bool, seed: u64) -> Vec<Case> {
     let random = "[[vibration]]\nkind = \"random\"\naxis = \"x\"\npsd = \"0.01 g^2/Hz\"\nband_hz = [20.0, 500.0]\ncomponents = 100\n\
                   [[vibration]]\nkind = \"random\"\naxis = \"y\"\npsd = \"0.01 g^2/Hz\"\nband_hz = [20.0, 500.0]\ncomponents = 100\n\
                   [[vibration]]\nkind = \"random\"\naxis = \"z\"\npsd = \"0.01 g^2/Hz\"\nband_hz = [20.0, 500.0]\ncomponents = 100\n";
-    // on/off: vibration in whole-second windows (90 Hz: whole cycles), 6 g then 3 g
-    let period = t2h / 6.0;
-    let onoff = format!(
-        "schedule = [[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5], [{:.1}, {:.1}, 1.0]]\n",
-        period,
-        2.0 * period,
-        3.0 * period,
-        4.0 * period,
-        5.0 * period,
-        6.0 * period
-    );
+    let onoff = onoff_schedule(t2h);
     vec![
         Case {
             name: "static",
@@ -178,16 +183,7 @@ pub fn cases(quick: bool, seed: u64) -> Vec<Case> {
 /// windows at two amplitudes (6 g, then 3 g), with the paper's sensor errors including
 /// d = 5e-5 s²/m on every axis; `seconds` long.
 pub fn explain_demo(seconds: f64, seed: u64) -> Case {
-    let period = seconds / 6.0;
-    let onoff = format!(
-        "schedule = [[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5], [{:.1}, {:.1}, 1.0]]\n",
-        period,
-        2.0 * period,
-        3.0 * period,
-        4.0 * period,
-        5.0 * period,
-        6.0 * period
-    );
+    let onoff = onoff_schedule(seconds);
     Case {
         name: "explain_demo",
         scenario: rest_scenario(
