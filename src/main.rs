@@ -37,6 +37,9 @@ enum Command {
     /// What the model gets wrong on the data, the missing error term, the extended model and
     /// its gain; without data options, the embedded demo (the paper's case with d hidden).
     Explain(cli::explain::ExplainArgs),
+    /// How well explain finds hidden effects: seeded cases in parallel, power curve, false alarms.
+    #[command(name = "explain-eval")]
+    ExplainEval(cli::explain_eval::EvalArgs),
     /// Reproduce the paper's experiments (P28 vs P31), with figures, priors study, consistency.
     Reproduce(cli::reproduce::ReproduceArgs),
 }
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => cli::reproduce::run(&args),
         Command::Filter(args) => cli::filter::run(&args),
         Command::Explain(args) => cli::explain::run(&args),
+        Command::ExplainEval(args) => cli::explain_eval::run(&args),
         Command::Bench(args) => cli::bench::run(&args),
         Command::Allan(args) => cli::allan::run(&args),
         Command::Align(args) => cli::align::run(&args),

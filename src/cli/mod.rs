@@ -5,6 +5,7 @@ pub mod allan;
 pub mod bench;
 pub mod data;
 pub mod explain;
+pub mod explain_eval;
 pub mod filter;
 pub mod jacobian;
 pub mod model;

@@ -63,6 +63,9 @@ pub struct ExplainOptions {
     /// Prior σ of candidate terms that replace the spec's (term index, σ in SI): the sensor
     /// class of the data (`--prior` on the command line).
     pub candidate_sigma: Vec<(usize, f64)>,
+    /// Test only: when a candidate passes, name a pseudo-random one of the pool instead of the
+    /// best (the evaluation must catch such a selector).
+    pub broken_selector: bool,
 }
 
 impl Default for ExplainOptions {
@@ -75,6 +78,7 @@ impl Default for ExplainOptions {
             confound_cos: 0.999,
             max_prior_sigmas: 100.0,
             candidate_sigma: Vec::new(),
+            broken_selector: false,
         }
     }
 }
@@ -964,6 +968,12 @@ fn forward_select(
         if p * pool.len() as f64 > opts.alpha || llr <= bic {
             break;
         }
+        let (c, llr) = if opts.broken_selector {
+            let k = (chosen.len() * 7 + pool.len() * 13 + 5) % pool.len();
+            (pool[k], cond(pool[k], &chosen).map(|x| x.0).unwrap_or(llr))
+        } else {
+            (c, llr)
+        };
         let mut members: Vec<(usize, f64, f64)> = vec![]; // (cand, θ' prior-scaled, info)
         for &a in &pool {
             let equivalent = a == c
@@ -1768,6 +1778,15 @@ pub fn run_hidden_case(
     case: &crate::sim::hidden::HiddenCase,
     opts: &ExplainOptions,
 ) -> anyhow::Result<HiddenOutcome> {
+    let (sim, aid) = simulate_case(case)?;
+    run_hidden_on(case, &sim, &aid, opts)
+}
+
+/// Simulates a hidden-effect case and its aiding (1 Hz position σ 0.1 m and velocity σ 0.01 m/s
+/// from the truth).
+pub fn simulate_case(
+    case: &crate::sim::hidden::HiddenCase,
+) -> anyhow::Result<(crate::sim::simulator::SimOutput, Vec<AidingEpoch>)> {
     use crate::report::reproduce::{aiding_from_truth, Priors};
     let sc = crate::sim::scenario::Scenario::parse(&case.scenario, &format!("case {}", case.seed))?;
     let sim = crate::sim::simulator::simulate(&sc, |_| {});
@@ -1776,6 +1795,31 @@ pub fn run_hidden_case(
         ..Priors::default()
     };
     let aid = aiding_from_truth(&sim, &priors, true, case.seed)?;
+    Ok((sim, aid))
+}
+
+/// Information (SI, 1/θ²) the signature of term `term` carries through `model`'s filter on
+/// these data: λ = θ² I is the noncentrality of its test (independent of θ and of the data's
+/// values, so it can be computed before the term is put into the data).
+pub fn signature_information(
+    model: &Model,
+    term: usize,
+    data: &ExplainData,
+    cfg: &FilterConfig,
+) -> anyhow::Result<f64> {
+    let pass = run_pass(model, &[term], data, cfg, &mut |_| {})?;
+    Ok(pass.sig.info[0])
+}
+
+/// Runs explain and the oracle on already simulated data of `case` (the IMU may carry the
+/// hidden terms injected after simulation, see `inject`).
+pub fn run_hidden_on(
+    case: &crate::sim::hidden::HiddenCase,
+    sim: &crate::sim::simulator::SimOutput,
+    aid: &[AidingEpoch],
+    opts: &ExplainOptions,
+) -> anyhow::Result<HiddenOutcome> {
+    let aid = aid.to_vec();
     let baseline = Model::parse(&case.baseline)?;
     let cands = parse_candidates(None, &baseline).map_err(anyhow::Error::msg)?;
     let data = ExplainData {
@@ -1831,6 +1875,25 @@ pub fn run_hidden_case(
         oracle_model_error_rms: oracle_rms,
         oracle_estimates,
     })
+}
+
+/// Adds term `term` with value `theta` (SI) to IMU increments: the sensor's output along its
+/// axis gains θ · regressor(f, ω) · Δt, the regressor formed from each increment's mean rates.
+pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
+    let info = &common::TERMS[term];
+    let mut prev = start_t;
+    for smp in &mut imu.samples {
+        let dt = smp.t - prev;
+        prev = smp.t;
+        if dt <= 0.0 {
+            continue;
+        }
+        let r = common::regressor_value(info.regressor, &(smp.dv / dt), &(smp.dtheta / dt));
+        match info.sensor {
+            Sensor::Accel => smp.dv[info.axis] += theta * r * dt,
+            Sensor::Gyro => smp.dtheta[info.axis] += theta * r * dt,
+        }
+    }
 }
 
 /// What explain did on a hidden-effect case, with the oracle's reference.

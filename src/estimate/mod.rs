@@ -4,6 +4,7 @@
 pub mod align;
 pub mod allan;
 pub mod explain;
+pub mod explain_eval;
 pub mod filter;
 pub mod mounting;
 pub mod stats;
