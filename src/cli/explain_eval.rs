@@ -263,7 +263,7 @@ fn write(out: &OutputDir, spec: &EvalSpec, cases: &[CaseResult], wall: Option<f6
                 points: theory,
             },
         ],
-        Scale::LogLog,
+        Scale::LogX,
     )?;
     atomic_file::write_text(&out.file("eval.md"), &markdown(&s, cases.len()))?;
     Ok(())

@@ -64,7 +64,7 @@ pub struct ExplainOptions {
     /// class of the data (`--prior` on the command line).
     pub candidate_sigma: Vec<(usize, f64)>,
     /// Test only: when a candidate passes, name a pseudo-random one of the pool instead of the
-    /// best (the evaluation must catch such a selector).
+    /// best, unconfirmed (a selector naming terms at random, which the evaluation must catch).
     pub broken_selector: bool,
 }
 
@@ -1388,7 +1388,7 @@ pub fn explain(
         // hold (or the misfit is something else) and the round is undone
         let gain = next_pass.stats.loglik - pass.stats.loglik;
         let penalty = added.len() as f64 * (next_pass.run.innovations.len().max(2) as f64).ln();
-        if 2.0 * gain <= penalty {
+        if 2.0 * gain <= penalty && !opts.broken_selector {
             unconfirmed.extend(
                 added
                     .iter()

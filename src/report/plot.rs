@@ -33,6 +33,8 @@ pub enum Scale {
     Linear,
     /// Log-log axes (positive data only).
     LogLog,
+    /// Logarithmic x, linear y (positive x only).
+    LogX,
 }
 
 /// Draws `series` into a 1000×600 PNG at `path`.
@@ -53,7 +55,12 @@ pub fn line_plot(
         let pts = series.iter().flat_map(|s| s.points.iter());
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for &(x, y) in pts {
-            if x.is_finite() && y.is_finite() && (scale == Scale::Linear || (x > 0.0 && y > 0.0)) {
+            let ok = match scale {
+                Scale::Linear => true,
+                Scale::LogLog => x > 0.0 && y > 0.0,
+                Scale::LogX => x > 0.0,
+            };
+            if x.is_finite() && y.is_finite() && ok {
                 x0 = x0.min(x);
                 x1 = x1.max(x);
                 y0 = y0.min(y);
@@ -125,6 +132,12 @@ pub fn line_plot(
             Scale::LogLog => draw!(builder
                 .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
                 .map_err(|e| anyhow!("plot {}: {e}", path.display()))?),
+            Scale::LogX => {
+                let pad = 0.05 * (y1 - y0);
+                draw!(builder
+                    .build_cartesian_2d((x0..x1).log_scale(), (y0 - pad)..(y1 + pad))
+                    .map_err(|e| anyhow!("plot {}: {e}", path.display()))?)
+            }
         }
         root.present()
             .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
