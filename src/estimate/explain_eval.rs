@@ -118,7 +118,7 @@ pub fn run_case(
     if let Some((name, reference)) = drawn.hidden.first() {
         let t = common::TERMS
             .iter()
-            .position(|x| &x.name == name)
+            .position(|x| x.name == name)
             .ok_or_else(|| anyhow::anyhow!("hidden term `{name}` is not a spec term"))?;
         let baseline = Model::parse(&case.baseline)?;
         let data = ExplainData {
