@@ -59,6 +59,10 @@ struct Stored {
 /// Runs the command.
 pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
+        if args.cases.is_some() || args.first != 0 || args.groups.is_some() || args.broken_selector
+        {
+            bail!("--merge combines finished runs: give only the directories and --out");
+        }
         return merge(args);
     }
     let n = args
