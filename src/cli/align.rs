@@ -77,6 +77,7 @@ pub fn run(args: &AlignArgs) -> Result<()> {
     );
     if let Some(j) = &args.json {
         atomic_file::write_text(j, &serde_json::to_string_pretty(&a)?)?;
+        eprintln!("wrote {}", j.display());
     }
     Ok(())
 }

@@ -99,33 +99,17 @@ pub fn run(args: &AllanArgs) -> Result<()> {
                 "m/s^2 (fit: white m/s/sqrt(s), random_walk m/s^2/sqrt(s))"
             },
         );
-        if k < 3 {
-            println!(
-                "{:<8} ARW {:.4} deg/sqrt(h)  bias instability {:.4} deg/h  RRW {:.4} deg/h/sqrt(h)",
-                NAMES[k],
-                f.white * r2dh / 60.0,
-                f.bias_instability * r2dh,
-                f.random_walk * r2dh * 60.0
-            );
-        } else {
-            let ug = 1e6 / sinsmodel::io::units::STANDARD_GRAVITY;
-            println!(
-                "{:<8} VRW {:.2} ug/sqrt(Hz)  bias instability {:.2} ug  RRW {:.3} ug/sqrt(s)",
-                NAMES[k],
-                f.white * ug,
-                f.bias_instability * ug,
-                f.random_walk * ug
-            );
-        }
+        println!("{}", fit_line(NAMES[k], &f));
     }
+    println!(
+        "(fits use tau <= {:.3e} s, a ninth of the {:.1} s of data: at least 9 independent clusters)",
+        curves[0].span_s / 9.0,
+        curves[0].span_s
+    );
     if let Some(j) = &args.json {
         atomic_file::write_text(j, &serde_json::to_string_pretty(&out)?)?;
     }
-    let prefix = args
-        .plot
-        .clone()
-        .or_else(|| args.json.as_ref().map(|j| j.with_extension("")));
-    if let Some(p) = prefix {
+    if let Some(p) = prefix_shown(args) {
         let series = |range: std::ops::Range<usize>, scale: f64| -> Vec<Series> {
             range
                 .map(|k| Series {
@@ -157,5 +141,70 @@ pub fn run(args: &AllanArgs) -> Result<()> {
             Scale::LogLog,
         )?;
     }
+    match (&args.json, &prefix_shown(args)) {
+        (Some(j), Some(p)) => eprintln!(
+            "wrote {}, {}_gyro.png and {}_accel.png",
+            j.display(),
+            p.display(),
+            p.display()
+        ),
+        (None, Some(p)) => eprintln!(
+            "wrote {}_gyro.png and {}_accel.png",
+            p.display(),
+            p.display()
+        ),
+        (Some(j), None) => eprintln!("wrote {}", j.display()),
+        (None, None) => {
+            eprintln!("(no files written: --json or --plot writes the curves and plots)")
+        }
+    }
     Ok(())
+}
+
+fn prefix_shown(args: &AllanArgs) -> Option<PathBuf> {
+    args.plot
+        .clone()
+        .or_else(|| args.json.as_ref().map(|j| j.with_extension("")))
+}
+
+/// One channel's noise terms in display units, saying where the data do not support a value.
+fn fit_line(name: &str, f: &NoiseFit) -> String {
+    let gyro = name.starts_with("gyro");
+    let r2dh = 180.0 / std::f64::consts::PI * 3600.0;
+    let ug = 1e6 / sinsmodel::io::units::STANDARD_GRAVITY;
+    let (white, bi, rw) = if gyro {
+        (
+            format!("ARW {} deg/sqrt(h)", num(f.white * r2dh / 60.0)),
+            format!("{} deg/h", num(f.bias_instability * r2dh)),
+            format!("RRW {} deg/h/sqrt(h)", num(f.random_walk * r2dh * 60.0)),
+        )
+    } else {
+        (
+            format!("VRW {} ug/sqrt(Hz)", num(f.white * ug)),
+            format!("{} ug", num(f.bias_instability * ug)),
+            format!("RRW {} ug/sqrt(s)", num(f.random_walk * ug)),
+        )
+    };
+    let white = if f.white.is_finite() {
+        white
+    } else {
+        "white noise not determined (no -1/2 slope)".into()
+    };
+    let bi = if !f.bias_instability.is_finite() {
+        "bias instability not determined (too little data)".to_string()
+    } else if f.bias_instability_upper_bound {
+        format!("bias instability <= {bi} (curve still falling: an upper bound)")
+    } else {
+        format!("bias instability {bi}")
+    };
+    let rw = if f.random_walk.is_finite() {
+        rw
+    } else {
+        "RRW not resolved by these data (no +1/2 slope within the supported tau)".into()
+    };
+    format!("{name:<8} {white}  {bi}  {rw}")
+}
+
+fn num(v: f64) -> String {
+    sinsmodel::estimate::explain::sig3(v)
 }

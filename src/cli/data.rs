@@ -394,20 +394,29 @@ impl DataArgs {
 
 /// Mean gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from an `allan --json` file.
 pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not valid JSON", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "--noise {}: not valid JSON (expected the output of `sinsmodel allan --json`)",
+            path.display()
+        )
+    })?;
     let white = |names: [&str; 3]| -> Result<f64> {
         let mut s = 0.0;
         for n in names {
             let w = v["fit"][n]["white"]
                 .as_f64()
-                .with_context(|| format!("{}: fit.{n}.white missing", path.display()))?;
+                .with_context(|| {
+                    format!(
+                        "--noise {}: fit.{n}.white missing (expected the output of `sinsmodel allan --json`)",
+                        path.display()
+                    )
+                })?;
             let max = if n.starts_with("gyro") { 1.0 } else { 100.0 };
             if !w.is_finite() || w <= 0.0 || w > max {
                 bail!(
-                    "{}: fit.{n}.white = {w} is not a plausible noise density (0 < w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
+                    "--noise {}: fit.{n}.white = {w} is not a plausible noise density (0 < w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
                     path.display()
                 );
             }

@@ -41,10 +41,14 @@ pub fn run(args: &FilterArgs) -> Result<()> {
 
     let mut f = AtomicFile::create(&out.file("states.txt"))?;
     let w = f.writer();
+    let provenance = super::command_line();
+    writeln!(w, "# {provenance}")?;
     writeln!(
         w,
-        "# sinsmodel filter --model {} ({:?}); SI units (rad, m/s, rad/s, m/s^2, 1, s^2/m …)",
-        model.name, cfg.mode
+        "# model {} ({} states), mode {}; estimate and 1-sigma of every state, SI units (rad, m/s, rad/s, m/s^2, 1, s^2/m …)",
+        model.name,
+        model.n(),
+        cfg.mode.word()
     )?;
     write!(w, "# t")?;
     for (i, n) in model.names.iter().enumerate() {
@@ -65,6 +69,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
 
     let mut f = AtomicFile::create(&out.file("innovations.txt"))?;
     let w = f.writer();
+    writeln!(w, "# {provenance}")?;
     writeln!(w, "# t measurement component nu S (SI; nu = z - H x)")?;
     for i in &run.innovations {
         writeln!(
@@ -79,6 +84,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
         let w = f.writer();
         let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
+        writeln!(w, "# {provenance}")?;
         writeln!(
             w,
             "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
@@ -104,19 +110,44 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         f.commit()?;
     }
     out.commit()?;
-    let nis = run
-        .innovations
-        .iter()
-        .map(|i| i.nu * i.nu / i.s)
-        .sum::<f64>()
-        / run.innovations.len().max(1) as f64;
     eprintln!(
-        "filtered {} samples with {} ({} states), {} updates, mean NIS {nis:.3}; wrote {}",
+        "filtered {} samples ({:.1} s) with {} ({} states, {} loop): {} scalar updates",
         imu.samples.len(),
+        imu.duration(),
         model.name,
         model.n(),
-        run.records.len(),
-        args.out.display()
+        cfg.mode.word(),
+        run.innovations.len(),
     );
+    eprint!("{}", nis_table(&run));
+    let mut files = vec!["states.txt", "innovations.txt"];
+    if truth_rows.is_some() {
+        files.push("model_error.txt");
+    }
+    eprintln!("wrote {} in {}", files.join(", "), args.out.display());
     Ok(())
+}
+
+/// The mean NIS of every channel against its 95 % band, with a word on each.
+fn nis_table(run: &filter::FilterRun) -> String {
+    let mut s = String::from(
+        "innovations: mean NIS per channel (1 for a consistent filter; 95 % band for the count)\n",
+    );
+    for c in filter::nis_by_channel(run) {
+        s.push_str(&format!(
+            "  {:<6} {:>6} updates  mean NIS {:>9}  band {:.2}..{:.2}  {}\n",
+            c.channel,
+            c.count,
+            sinsmodel::estimate::explain::sig3(c.mean),
+            c.band[0],
+            c.band[1],
+            match c.verdict() {
+                "too large" =>
+                    "too large: the model misses an error or the noise/priors are too small",
+                "too small" => "too small: the noise or the measurement sigma is pessimistic",
+                v => v,
+            }
+        ));
+    }
+    s
 }

@@ -12,3 +12,30 @@ pub mod model;
 pub mod navigate;
 pub mod reproduce;
 pub mod simulate;
+
+/// The command line that started this run, for the provenance header of output files: the
+/// arguments joined by spaces, quoted where they hold spaces, control characters shown as `?`.
+pub fn command_line() -> String {
+    let args: Vec<String> = std::env::args()
+        .enumerate()
+        .map(|(k, a)| {
+            let a: String = if k == 0 {
+                "sinsmodel".into()
+            } else {
+                a.chars()
+                    .map(|c| if c.is_control() { '?' } else { c })
+                    .collect()
+            };
+            if a.contains(' ') || a.is_empty() {
+                format!("'{a}'")
+            } else {
+                a
+            }
+        })
+        .collect();
+    format!(
+        "{} (sinsmodel {})",
+        args.join(" "),
+        env!("CARGO_PKG_VERSION")
+    )
+}

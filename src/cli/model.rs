@@ -65,9 +65,12 @@ fn list_text() -> String {
             ));
         }
         s.push_str(&format!(
-            "  {:<9} {:?} {}  <{}>  [{}]  sigma {} {}\n",
+            "  {:<9} {} {}  <{}>  [{}]  sigma {} {}\n",
             t.name,
-            t.sensor,
+            match t.sensor {
+                sinsmodel::model::catalog::Sensor::Gyro => "gyro",
+                sinsmodel::model::catalog::Sensor::Accel => "accel",
+            },
             ["x", "y", "z"][t.axis],
             common::REGRESSORS[t.regressor],
             t.unit,
@@ -131,14 +134,15 @@ pub fn show_text(m: &Model) -> String {
         ));
     }
     s.push_str("\nSparsity of A (# = structural non-zero; columns in state order):\n");
-    let mut header = String::from("             ");
+    let w = m.names.iter().map(|n| n.chars().count()).max().unwrap_or(1);
+    let mut header = " ".repeat(6 + w);
     for j in 0..n {
         header.push(char::from_digit((j % 10) as u32, 10).unwrap_or('?'));
     }
     s.push_str(&header);
     s.push('\n');
     for i in 0..n {
-        let mut row = format!("  {:>2} {:<8}", i, truncate(m.names[i], 7));
+        let mut row = format!("  {:>2} {:<w$} ", i, m.names[i]);
         for j in 0..n {
             row.push(if m.a_pattern().binary_search(&(i, j)).is_ok() {
                 '#'
@@ -162,8 +166,4 @@ fn generic_point() -> sinsmodel::nav::nav_point::NavPoint {
         &c,
         &nalgebra::Vector3::new(0.3, -0.2, -9.8),
     )
-}
-
-fn truncate(s: &str, k: usize) -> &str {
-    &s[..s.len().min(k)]
 }

@@ -25,8 +25,13 @@ pub struct NavigateArgs {
     /// Initial height [m].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     h: f64,
-    /// Initial roll,pitch,yaw [deg] (NED/FRD).
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    /// Initial roll,pitch,yaw [deg] (NED/FRD), e.g. from `sinsmodel align`.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        required = true
+    )]
     att: Vec<f64>,
     /// Initial NED velocity N,E,D [m/s].
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
@@ -47,8 +52,24 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.lat.abs() >= 89.0 || !args.lat.is_finite() {
         bail!("--lat {} must be within ±89°", args.lat);
     }
-    if args.att.len() != 3 || args.vel.as_ref().is_some_and(|v| v.len() != 3) {
-        bail!("--att and --vel take three comma-separated numbers");
+    if args.att.len() != 3 || args.att.iter().any(|a| !a.is_finite()) {
+        bail!("--att: expected roll,pitch,yaw in degrees (three finite comma-separated numbers)");
+    }
+    if args
+        .vel
+        .as_ref()
+        .is_some_and(|v| v.len() != 3 || v.iter().any(|x| !x.is_finite() || x.abs() > 1e4))
+    {
+        bail!("--vel: expected N,E,D in m/s (three finite comma-separated numbers within ±1e4)");
+    }
+    if !args.lon.is_finite() || args.lon.abs() > 360.0 {
+        bail!(
+            "--lon {}: expected a longitude in degrees within ±360",
+            args.lon
+        );
+    }
+    if !args.h.is_finite() || args.h.abs() > 1e5 {
+        bail!("--h {}: expected a height in metres within ±1e5", args.h);
     }
     if args.out_rate.is_nan() || args.out_rate <= 0.0 {
         bail!("--out-rate must be positive");
@@ -96,9 +117,9 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         &args.out,
         &rows,
         &format!(
-            "sinsmodel navigate --imu {} (vertical {:?})",
-            args.imu.display(),
-            args.vertical
+            "{} (vertical {})",
+            super::command_line(),
+            args.vertical.word()
         ),
     )?;
     eprintln!(
@@ -107,6 +128,18 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         data.duration(),
         rows.len(),
         args.out.display()
+    );
+    let (s0, s1) = (&start, &nav.state);
+    let r = sinsmodel::nav::earth::A;
+    let dn = (s1.lat - s0.lat) * r;
+    let de = (s1.lon - s0.lon) * r * s0.lat.cos();
+    eprintln!(
+        "final position {:.3} km from the start ({:.3} km north, {:.3} km east): free-inertial \
+         navigation, no aiding; its drift grows with the initial attitude and sensor errors (use \
+         `sinsmodel align` for --att on a static start, `sinsmodel filter` to estimate the errors)",
+        dn.hypot(de) / 1000.0,
+        dn / 1000.0,
+        de / 1000.0
     );
     Ok(())
 }

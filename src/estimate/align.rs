@@ -217,7 +217,8 @@ pub fn align(
         heading_sigma_deg: last.sigma[i_phid] * deg,
         lat_deg: lat_used * deg,
         lat_sigma_deg: if lat.is_some() { 0.0 } else { lat_sigma * deg },
-        skipped_s: q0 as f64 * dt,
+        // rounded to the microsecond: q0·dt carries the interval's binary rounding
+        skipped_s: (q0 as f64 * dt * 1e6).round() / 1e6,
         heading_windows_deg: windows
             .iter()
             .map(|x| (x.euler.z * deg).rem_euclid(360.0))

@@ -19,6 +19,8 @@ pub struct AllanCurve {
     pub adev: Vec<f64>,
     /// 1-σ uncertainty of each value.
     pub adev_err: Vec<f64>,
+    /// Length of the data [s].
+    pub span_s: f64,
 }
 
 /// Overlapping ADEV of a rate series `y` sampled every `dt` seconds.
@@ -54,6 +56,7 @@ pub fn oadev(y: &[f64], dt: f64) -> AllanCurve {
         tau_s,
         adev,
         adev_err,
+        span_s: n as f64 * dt,
     }
 }
 
@@ -65,9 +68,15 @@ pub struct NoiseFit {
     pub white: f64,
     /// Bias instability: min σ / 0.664 (unit of the rate).
     pub bias_instability: f64,
-    /// Rate random walk K: σ(τ) = K √(τ/3), read where the local slope is closest to +1/2
-    /// (NaN when no segment has a slope within ±0.15 of +1/2).
+    /// Rate random walk K: σ(τ) = K √(τ/3), read where the local slope is within ±0.15 of
+    /// +1/2 on the rising branch (beyond the curve's minimum) on segments ending at τ ≤ span/9 (at least 9 independent clusters, ADEV known to
+    /// about 25 %); NaN (JSON null) when the data do not resolve it.
     pub random_walk: f64,
+    /// True when the curve is still falling at the longest τ it supports (span/9): the bias
+    /// instability is then only an upper bound.
+    pub bias_instability_upper_bound: bool,
+    /// Longest τ [s] with at least 9 independent clusters (span/9): the curve beyond is noise.
+    pub tau_supported_s: f64,
 }
 
 fn slope_points(c: &AllanCurve) -> Vec<(usize, f64)> {
@@ -111,9 +120,21 @@ pub fn fit(c: &AllanCurve) -> NoiseFit {
         .flat_map(|k| [k, k + 1])
         .map(|k| c.adev[k] * c.tau_s[k].sqrt())
         .collect();
+    // bias instability: the minimum over the supported τ; an upper bound when the curve is
+    // still falling where the support ends
+    let tau_ok = c.span_s / 9.0;
+    let supported: Vec<usize> = (0..c.tau_s.len())
+        .filter(|&k| c.tau_s[k] <= tau_ok)
+        .collect();
+    let (kmin, min) = supported
+        .iter()
+        .map(|&k| (k, c.adev[k]))
+        .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+    let last = supported.last().copied();
+    // rate random walk: the rising branch beyond the minimum, within the supported τ
     let rw_idx: Vec<usize> = slopes
         .iter()
-        .filter(|(_, s)| (s - 0.5).abs() <= 0.15)
+        .filter(|(k, s)| (s - 0.5).abs() <= 0.15 && *k >= kmin && c.tau_s[k + 1] <= tau_ok)
         .map(|(k, _)| *k)
         .collect();
     let rw: Vec<f64> = rw_idx
@@ -121,11 +142,16 @@ pub fn fit(c: &AllanCurve) -> NoiseFit {
         .flat_map(|k| [k, k + 1])
         .map(|k| c.adev[k] * (3.0 / c.tau_s[k]).sqrt())
         .collect();
-    let min = c.adev.iter().copied().fold(f64::INFINITY, f64::min);
     NoiseFit {
         white: geo(w),
-        bias_instability: min / 0.664,
+        bias_instability: if min.is_finite() {
+            min / 0.664
+        } else {
+            f64::NAN
+        },
         random_walk: geo(rw),
+        bias_instability_upper_bound: last.is_none_or(|l| l == kmin),
+        tau_supported_s: tau_ok,
     }
 }
 

@@ -26,7 +26,7 @@
 //! 4. **Gain.** The extended model's innovations (NIS, whiteness, log-likelihood) and, with
 //!    truth, the paper's model error e = φ̂ − φ before and after.
 
-use crate::estimate::filter::{self, AidingEpoch, FilterConfig, FilterRun, Observer};
+use crate::estimate::filter::{self, channel_name, AidingEpoch, FilterConfig, FilterRun, Observer};
 use crate::estimate::stats;
 use crate::io::imu::ImuData;
 use crate::io::truth::TruthRow;
@@ -443,13 +443,6 @@ pub struct PassStats {
     pub model_error_rms_arcsec: Option<[f64; 2]>,
     /// Predicted σ against actual error (with truth).
     pub truth_check: Vec<TruthCheck>,
-}
-
-fn channel_name(meas: &str, comp: usize) -> String {
-    match meas.strip_suffix("_ne") {
-        Some(prefix) => format!("{prefix}_{}", ["n", "e"].get(comp).unwrap_or(&"?")),
-        None => meas.to_string(),
-    }
 }
 
 /// Segments of constant excitation: 1-s bins of the level merged while within 30 % (and

@@ -37,6 +37,16 @@ pub enum Mode {
     ClosedLoop,
 }
 
+impl Mode {
+    /// The command line's word for the mode (`open`, `closed`).
+    pub fn word(self) -> &'static str {
+        match self {
+            Mode::OpenLoop => "open",
+            Mode::ClosedLoop => "closed",
+        }
+    }
+}
+
 /// Filter settings (SI units).
 #[derive(Debug, Clone)]
 pub struct FilterConfig {
@@ -715,4 +725,64 @@ pub fn model_error_rms_arcsec(run: &FilterRun, t0: f64, t1: f64) -> Option<[f64;
         (sum[0] / k as f64).sqrt() * arcsec,
         (sum[1] / k as f64).sqrt() * arcsec,
     ])
+}
+
+/// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.
+pub fn channel_name(meas: &str, component: usize) -> String {
+    match meas.strip_suffix("_ne") {
+        Some(prefix) => format!("{prefix}_{}", ["n", "e"].get(component).unwrap_or(&"?")),
+        None => meas.to_string(),
+    }
+}
+
+/// Mean normalised innovation squared (NIS) of one scalar channel against what a consistent
+/// filter gives (1, with the 95 % band of the mean of `count` χ²₁ values).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ChannelNis {
+    /// `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.
+    pub channel: String,
+    /// Number of scalar innovations.
+    pub count: usize,
+    /// Mean of ν²/S (dimensionless; 1 expected).
+    pub mean: f64,
+    /// 95 % band of the mean for a consistent filter with this count.
+    pub band: [f64; 2],
+}
+
+impl ChannelNis {
+    /// One word on the channel: `consistent`, `too large` (the model misses something or the
+    /// noise is too small) or `too small` (noise or priors pessimistic).
+    pub fn verdict(&self) -> &'static str {
+        if self.mean > self.band[1] {
+            "too large"
+        } else if self.mean < self.band[0] {
+            "too small"
+        } else {
+            "consistent"
+        }
+    }
+}
+
+/// Mean NIS per channel, in the order the channels first appear.
+pub fn nis_by_channel(run: &FilterRun) -> Vec<ChannelNis> {
+    let mut out: Vec<(String, f64, usize)> = Vec::new();
+    for i in &run.innovations {
+        let name = channel_name(i.meas, i.component);
+        let v = i.nu * i.nu / i.s;
+        match out.iter_mut().find(|c| c.0 == name) {
+            Some(c) => {
+                c.1 += v;
+                c.2 += 1;
+            }
+            None => out.push((name, v, 1)),
+        }
+    }
+    out.into_iter()
+        .map(|(channel, sum, count)| ChannelNis {
+            channel,
+            count,
+            mean: sum / count as f64,
+            band: crate::estimate::stats::mean_chi2_band(1.0, count, 1.96),
+        })
+        .collect()
 }

@@ -28,6 +28,17 @@ pub enum Vertical {
     Free,
 }
 
+impl Vertical {
+    /// The command line's word for the mode (`fixed`, `damped`, `free`).
+    pub fn word(self) -> &'static str {
+        match self {
+            Vertical::Fixed => "fixed",
+            Vertical::Damped => "damped",
+            Vertical::Free => "free",
+        }
+    }
+}
+
 impl std::str::FromStr for Vertical {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {

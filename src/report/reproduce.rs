@@ -418,10 +418,41 @@ pub struct Consistency {
     pub nis_band: [f64; 2],
     /// Fraction of epochs with the averaged NIS in its band.
     pub nis_fraction_in_band: f64,
+    /// One sentence: consistent, overconfident or pessimistic, and on what evidence.
+    pub verdict: String,
 
     /// Seed-averaged NEES per update epoch (not divided by n).
     #[serde(skip)]
     pub nees_avg: Vec<f64>,
+}
+
+impl Consistency {
+    /// The verdict on the run: a consistent filter has the mean NEES/n and NIS inside their
+    /// 95 % bands and about 95 % of the epochs in band (90 % accepted).
+    fn judge(&self) -> String {
+        let side = |mean: f64, band: [f64; 2]| {
+            if mean > band[1] {
+                Some("overconfident (errors larger than its covariance says)")
+            } else if mean < band[0] {
+                Some("pessimistic (covariance larger than its errors)")
+            } else {
+                None
+            }
+        };
+        match (
+            side(self.nees_mean, self.nees_band),
+            side(self.nis_mean, self.nis_band),
+        ) {
+            (Some(w), _) => format!("NOT consistent: the state estimate is {w}, mean NEES/n {:.3} outside {:.3}..{:.3}", self.nees_mean, self.nees_band[0], self.nees_band[1]),
+            (None, Some(w)) => format!("NOT consistent: the innovations say the filter is {w}, mean NIS {:.3} outside {:.3}..{:.3}", self.nis_mean, self.nis_band[0], self.nis_band[1]),
+            (None, None) if self.nees_fraction_in_band < 0.9 || self.nis_fraction_in_band < 0.9 => format!(
+                "consistent on average, but only {:.0} % (NEES) and {:.0} % (NIS) of the epochs are in band (about 95 % expected)",
+                100.0 * self.nees_fraction_in_band,
+                100.0 * self.nis_fraction_in_band
+            ),
+            (None, None) => "consistent: mean NEES/n and NIS inside their 95 % bands, and most epochs in band".into(),
+        }
+    }
 }
 
 /// 20-seed Monte Carlo with the true model: every seed draws the initial navigation errors and
@@ -537,7 +568,9 @@ pub fn consistency(
         nis_mean: nis_avg.iter().sum::<f64>() / nis_avg.len().max(1) as f64,
         nis_band: ib,
         nis_fraction_in_band: frac(&nis_avg, ib),
+        verdict: String::new(),
         nees_avg,
     };
-    Ok(out)
+    let verdict = out.judge();
+    Ok(Consistency { verdict, ..out })
 }
