@@ -174,6 +174,9 @@ mod tests {
             "white {} vs {dens}",
             f.white
         );
+        // white noise alone: no random walk to read, and the curve never turns up
+        assert!(f.random_walk.is_nan(), "{f:?}");
+        assert!(f.bias_instability_upper_bound, "{f:?}");
         // rate random walk K: increments of σ K √dt per sample
         let k = 1e-3;
         let mut b = 0.0;
@@ -189,5 +192,28 @@ mod tests {
             "random walk {} vs {k}",
             f.random_walk
         );
+    }
+
+    #[test]
+    fn a_disturbance_bump_is_not_read_as_rate_random_walk() {
+        // a 0.5 Hz vibration on small white noise: the curve rises (through slope +1/2) to a
+        // peak near 0.7 s and falls again; no random walk is there to report
+        let dt: f64 = 0.01;
+        let mut rng = Rng::new(5);
+        let y: Vec<f64> = (0..100_000)
+            .map(|i| {
+                let t = i as f64 * dt;
+                1e-3 * (std::f64::consts::PI * t).sin() + 1e-5 / dt.sqrt() * rng.normal()
+            })
+            .collect();
+        let c = oadev(&y, dt);
+        let rising = c
+            .adev
+            .windows(2)
+            .zip(c.tau_s.windows(2))
+            .any(|(a, t)| ((a[1] / a[0]).ln() / (t[1] / t[0]).ln() - 0.5).abs() < 0.15);
+        assert!(rising, "the test needs a +1/2 segment on the bump: {c:?}");
+        let f = fit(&c);
+        assert!(f.random_walk.is_nan(), "{f:?}");
     }
 }

@@ -574,3 +574,41 @@ pub fn consistency(
     let verdict = out.judge();
     Ok(Consistency { verdict, ..out })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Consistency;
+
+    fn run(nees: f64, nis: f64, frac: f64) -> Consistency {
+        Consistency {
+            seeds: 20,
+            model: "P31".into(),
+            nees_dim: 31,
+            nees_mean: nees,
+            nees_band: [0.89, 1.11],
+            nees_fraction_in_band: frac,
+            nis_mean: nis,
+            nis_band: [0.9, 1.1],
+            nis_fraction_in_band: frac,
+            verdict: String::new(),
+            nees_avg: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_consistency_verdict_follows_the_bands() {
+        assert!(run(0.95, 1.0, 0.95).judge().starts_with("consistent:"));
+        let v = run(1.5, 1.0, 0.95).judge();
+        assert!(
+            v.starts_with("NOT consistent") && v.contains("overconfident"),
+            "{v}"
+        );
+        let v = run(0.95, 0.5, 0.95).judge();
+        assert!(
+            v.starts_with("NOT consistent") && v.contains("pessimistic"),
+            "{v}"
+        );
+        let v = run(1.0, 1.0, 0.6).judge();
+        assert!(v.contains("only 60 %"), "{v}");
+    }
+}
