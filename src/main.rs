@@ -30,6 +30,10 @@ enum Command {
     Filter(cli::filter::FilterArgs),
     /// Static alignment: roll, pitch, heading with σ, latitude when not given.
     Align(cli::align::AlignArgs),
+    /// What an IMU log holds as read (rate, jitter, gaps, gravity and Earth rate, attitude):
+    /// catches a wrong unit, axis or clock in a format description.
+    #[command(name = "imu-check")]
+    ImuCheck(cli::imu_check::ImuCheckArgs),
     /// Overlapping Allan deviation of the six IMU channels, noise fit and plots.
     Allan(cli::allan::AllanArgs),
     /// Throughput of navigation + filter jobs (generated kernels vs dense), peak memory.
@@ -57,6 +61,7 @@ fn main() -> ExitCode {
         Command::ExplainEval(args) => cli::explain_eval::run(&args),
         Command::Bench(args) => cli::bench::run(&args),
         Command::Allan(args) => cli::allan::run(&args),
+        Command::ImuCheck(args) => cli::imu_check::run(&args),
         Command::Align(args) => cli::align::run(&args),
     };
     match result {

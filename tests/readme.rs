@@ -3,7 +3,7 @@
 //!
 //! Every ```` ```sh ```` block of `README.md` is split into commands (`\` continuations joined,
 //! trailing `# comments` dropped). Each runs under `bash` in a scratch copy of the checkout's
-//! layout (`scenarios/` and `examples/` linked read-only, `../shared` linked, everything the
+//! layout (`scenarios/`, `examples/` and `formats/` linked read-only, `../shared` linked, everything the
 //! commands write lands in the scratch directory), with `sinsmodel` on the PATH being the binary
 //! this test suite built. Three kinds of command are treated specially, each listed below with
 //! its reason, and each entry must match a README command (so the lists cannot go stale):
@@ -166,7 +166,7 @@ fn readme_commands_run_verbatim_in_order() {
     let work = tmp.path().join("main");
     std::fs::create_dir(&work).unwrap();
     link(&shared.canonicalize().unwrap(), &tmp.path().join("shared"));
-    for dir in ["scenarios", "examples"] {
+    for dir in ["scenarios", "examples", "formats"] {
         link(&root.join(dir), &work.join(dir));
     }
     let bin_dir = tmp.path().join("bin");

@@ -120,6 +120,8 @@ fn base(name: &str) -> Option<Unit> {
         "km" => (1e3, M),
         "s" => (1.0, S),
         "ms" => (1e-3, S),
+        "us" | "µs" => (1e-6, S),
+        "ns" => (1e-9, S),
         "min" => (60.0, S),
         "h" => (3600.0, S),
         "Hz" => (1.0, S.scale(-1)),
@@ -211,7 +213,7 @@ fn parse_factor(f: &str) -> Result<Unit, String> {
     };
     let u = base(name).ok_or_else(|| {
         format!(
-            "unknown unit `{name}` (known: 1 ppm ppb m mm cm km s ms min h Hz rad mrad urad deg \
+            "unknown unit `{name}` (known: 1 ppm ppb m mm cm km s ms us ns min h Hz rad mrad urad deg \
              arcmin arcsec g mg ug gal, combined with * / ^n sqrt())"
         )
     })?;

@@ -17,6 +17,10 @@ pub struct AllanArgs {
     /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
     #[arg(long)]
     imu: PathBuf,
+    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
+    /// IMU file if there is one, else chosen by the file's extension.
+    #[arg(long)]
+    imu_format: Option<PathBuf>,
     /// Skip this many seconds at the start (e.g. a disturbed start).
     #[arg(long, default_value_t = 0.0)]
     skip: f64,
@@ -47,7 +51,8 @@ const NAMES: [&str; 6] = [
 
 /// Runs the command.
 pub fn run(args: &AllanArgs) -> Result<()> {
-    let data = readers::read_any_imu(&args.imu)?;
+    let (data, how) = readers::read_imu(&args.imu, args.imu_format.as_deref())?;
+    eprintln!("reading {} {how}", args.imu.display());
     let dt = data.interval();
     let t0 = data.samples[0].t + args.skip;
     let t1 = args.seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);

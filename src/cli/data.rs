@@ -16,9 +16,13 @@ use std::path::PathBuf;
 /// The data options of `filter` and `explain`.
 #[derive(Args, Clone, Debug)]
 pub struct DataArgs {
-    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
+    /// IMU file (text, PSINS .imu, GNSS_IMU .csv, or any layout --imu-format describes).
     #[arg(long)]
     imu: Option<PathBuf>,
+    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
+    /// IMU file if there is one, else chosen by the file's extension.
+    #[arg(long)]
+    imu_format: Option<PathBuf>,
     /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
     #[arg(long)]
     aid: Option<PathBuf>,
@@ -67,6 +71,7 @@ impl DataArgs {
     /// True when any data option was given (explain runs its embedded demo when none is).
     pub fn any_given(&self) -> bool {
         self.imu.is_some()
+            || self.imu_format.is_some()
             || self.aid.is_some()
             || self.static_aid.is_some()
             || !self.prior.is_empty()
@@ -78,11 +83,17 @@ impl DataArgs {
 
     /// The input files named by the options (so outputs never land on them).
     pub fn input_paths(&self) -> Vec<&std::path::Path> {
-        [&self.imu, &self.aid, &self.noise, &self.truth]
-            .into_iter()
-            .flatten()
-            .map(|p| p.as_path())
-            .collect()
+        [
+            &self.imu,
+            &self.imu_format,
+            &self.aid,
+            &self.noise,
+            &self.truth,
+        ]
+        .into_iter()
+        .flatten()
+        .map(|p| p.as_path())
+        .collect()
     }
 
     /// Prints the sensor noise `--noise` gives, if any (once per run).
@@ -173,7 +184,8 @@ impl DataArgs {
             bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
         let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
-        let imu = readers::read_any_imu(imu_path)?;
+        let (imu, how) = readers::read_imu(imu_path, args.imu_format.as_deref())?;
+        eprintln!("reading {} {how}", imu_path.display());
         imu.check_time(&imu_path.display().to_string(), 5.0)?;
         let fixes = match (&args.aid, &args.static_aid) {
             (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {

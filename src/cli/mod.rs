@@ -7,6 +7,7 @@ pub mod data;
 pub mod explain;
 pub mod explain_eval;
 pub mod filter;
+pub mod imu_check;
 pub mod jacobian;
 pub mod model;
 pub mod navigate;

@@ -1,10 +1,11 @@
 //! Estimation on IMU data: the error-state Kalman filter over any model, static alignment,
-//! Allan deviation and noise identification, IMU mounting from the data.
+//! Allan deviation and noise identification, IMU mounting from the data, IMU log plausibility.
 
 pub mod align;
 pub mod allan;
 pub mod explain;
 pub mod explain_eval;
 pub mod filter;
+pub mod imu_check;
 pub mod mounting;
 pub mod stats;

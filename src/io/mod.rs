@@ -5,6 +5,7 @@ pub mod aiding;
 pub mod atomic_file;
 pub mod fixed;
 pub mod imu;
+pub mod imu_format;
 pub mod readers;
 pub mod truth;
 pub mod units;

@@ -1,0 +1,259 @@
+//! What an IMU log says about itself, to catch a wrong unit, axis or clock before any
+//! navigation: sampling (rate, jitter, gaps), and on a static stretch the mean specific force
+//! against local gravity, the mean angular rate against Earth rate, and the attitude that
+//! follows. FRD body frame, SI inside; the report carries display units.
+
+use crate::io::imu::ImuData;
+use crate::nav::earth;
+use nalgebra::Vector3;
+use serde::Serialize;
+
+/// The result of checking one IMU log.
+#[derive(Debug, Clone, Serialize)]
+pub struct ImuCheck {
+    /// Number of samples.
+    pub samples: usize,
+    /// First to last sample [s].
+    pub duration_s: f64,
+    /// Rate from the median interval [Hz].
+    pub rate_hz: f64,
+    /// Shortest and longest interval [s].
+    pub interval_min_s: f64,
+    /// Longest interval [s].
+    pub interval_max_s: f64,
+    /// RMS deviation of the intervals from their median [s].
+    pub jitter_rms_s: f64,
+    /// Intervals longer than twice the median.
+    pub gaps: usize,
+    /// Start and end of the window the static checks used [s].
+    pub window_s: [f64; 2],
+    /// RMS of the specific force about its mean over the window [m/s²].
+    pub f_spread_mps2: f64,
+    /// The window looks static (specific-force spread below 0.5 m/s²).
+    pub is_static: bool,
+    /// Mean specific force over the window, FRD [m/s²] (Σ Δv / Σ Δt with each sample's own interval).
+    pub f_mean_mps2: [f64; 3],
+    /// Mean angular rate, FRD [rad/s].
+    pub w_mean_radps: [f64; 3],
+    /// |mean f| / local normal gravity.
+    pub gravity_ratio: f64,
+    /// Local normal gravity used [m/s²].
+    pub gravity_mps2: f64,
+    /// |mean ω| / Earth rate.
+    pub earth_rate_ratio: f64,
+    /// Roll and pitch from the mean specific force [deg].
+    pub roll_deg: f64,
+    /// Pitch [deg].
+    pub pitch_deg: f64,
+    /// Heading by gyrocompassing [deg], when the gyros resolve Earth rate (|ω| within 0.5–2×
+    /// Earth rate on a static window); None otherwise.
+    pub heading_deg: Option<f64>,
+    /// Angle between the mean specific force and the body's up axis [deg].
+    pub tilt_deg: f64,
+    /// What is wrong, each with what to check; empty when the log is plausible.
+    pub problems: Vec<String>,
+    /// Remarks that are not errors.
+    pub notes: Vec<String>,
+}
+
+/// Checks `imu` on the window [first + skip_s, first + skip_s + window_s]; `lat` [rad] gives
+/// local gravity (45° when None, which is within 0.3 % of every latitude); `tilted_ok` accepts a
+/// mounting far from level.
+pub fn check(
+    imu: &ImuData,
+    lat: Option<f64>,
+    skip_s: f64,
+    window_s: f64,
+    tilted_ok: bool,
+) -> ImuCheck {
+    let s = &imu.samples;
+    let mut intervals: Vec<f64> = s.windows(2).map(|w| w[1].t - w[0].t).collect();
+    let median = imu.interval();
+    let jitter = if intervals.is_empty() {
+        0.0
+    } else {
+        (intervals.iter().map(|d| (d - median).powi(2)).sum::<f64>() / intervals.len() as f64)
+            .sqrt()
+    };
+    let gaps = intervals.iter().filter(|d| **d > 2.0 * median).count();
+    intervals.sort_by(f64::total_cmp);
+    let t_first = s.first().map(|x| x.t).unwrap_or(0.0);
+    let (w0, w1) = (t_first + skip_s, t_first + skip_s + window_s);
+    // means with each sample's own interval (the first sample's interval is unknown: skipped)
+    let (mut sdv, mut sdth, mut sdt) = (Vector3::zeros(), Vector3::zeros(), 0.0);
+    let mut rates: Vec<Vector3<f64>> = Vec::new();
+    for w in s.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if b.t <= w0 || b.t > w1 {
+            continue;
+        }
+        let dt = b.t - a.t;
+        sdv += b.dv;
+        sdth += b.dtheta;
+        sdt += dt;
+        rates.push(b.dv / dt);
+    }
+    let mut problems = Vec::new();
+    let mut notes = Vec::new();
+    let g = earth::gravity(lat.unwrap_or(std::f64::consts::FRAC_PI_4), 0.0);
+    let omega = earth::OMEGA;
+    let (f, w) = if sdt > 0.0 {
+        (sdv / sdt, sdth / sdt)
+    } else {
+        (Vector3::zeros(), Vector3::zeros())
+    };
+    let spread = if rates.is_empty() {
+        f64::NAN
+    } else {
+        (rates.iter().map(|r| (r - f).norm_squared()).sum::<f64>() / rates.len() as f64).sqrt()
+    };
+    let is_static = rates.len() >= 10 && spread < 0.5;
+    let gravity_ratio = f.norm() / g;
+    let earth_rate_ratio = w.norm() / omega;
+    let roll = (-f.y).atan2(-f.z);
+    let pitch = f.x.atan2(f.y.hypot(f.z));
+    let tilt = if f.norm() > 0.0 {
+        (-f.z / f.norm()).clamp(-1.0, 1.0).acos()
+    } else {
+        f64::NAN
+    };
+    let deg = 180.0 / std::f64::consts::PI;
+    let mut heading = None;
+
+    if rates.len() < 10 {
+        problems.push(format!(
+            "only {} samples between {:.3} s and {:.3} s: give --skip and --seconds inside the data ({:.3} .. {:.3} s)",
+            rates.len(),
+            w0,
+            w1,
+            t_first,
+            s.last().map(|x| x.t).unwrap_or(0.0)
+        ));
+    } else if !is_static {
+        notes.push(format!(
+            "the window {w0:.1}–{w1:.1} s is not static (specific force varies by {spread:.2} m/s² RMS): \
+             the gravity, Earth-rate and attitude checks need a static stretch (--skip, --seconds)"
+        ));
+    } else {
+        if (gravity_ratio - 1.0).abs() > 0.05 {
+            let k = g / f.norm();
+            let hint = [
+                (
+                    crate::io::units::STANDARD_GRAVITY,
+                    "the values look like g: accel_unit = \"g\" (or \"g*s\" for increments)",
+                ),
+                (
+                    crate::io::units::STANDARD_GRAVITY * 1e-3,
+                    "the values look like mg: accel_unit = \"mg\"",
+                ),
+                (
+                    1.0 / crate::io::units::STANDARD_GRAVITY,
+                    "the values look like m/s^2 described as g: accel_unit = \"m/s^2\"",
+                ),
+                (
+                    1e-3,
+                    "a factor 1000 off: the time unit ([time] unit) or mm/s vs m/s",
+                ),
+                (
+                    1e3,
+                    "a factor 1000 off: the time unit ([time] unit) or mm/s vs m/s",
+                ),
+            ]
+            .iter()
+            .find(|(r, _)| (k / r - 1.0).abs() < 0.05)
+            .map(|(_, h)| format!("; {h}"))
+            .unwrap_or_default();
+            problems.push(format!(
+                "mean specific force |f| = {:.4} m/s² on a static stretch is {:.3}× local gravity ({g:.4} m/s²): \
+                 the accelerometer unit (or scale, or the clock) is wrong — check accel_unit and [time] unit{hint}",
+                f.norm(),
+                gravity_ratio
+            ));
+        }
+        let r2d = 180.0 / std::f64::consts::PI;
+        if (earth_rate_ratio / r2d - 1.0).abs() < 0.05 {
+            problems.push(format!(
+                "mean angular rate on a static stretch is {earth_rate_ratio:.2}× Earth rate, within 5 % of 57.3 (degrees per radian): the gyro values look like deg/s read as rad/s — check gyro_unit"
+            ));
+        } else if earth_rate_ratio > 1000.0 {
+            problems.push(format!(
+                "mean angular rate {:.4} deg/s on a static stretch is {:.0}× Earth rate (even MEMS gyro \
+                 biases stay below ~100×): check gyro_unit (deg/s read as rad/s gives 57.3×)",
+                w.norm() * deg,
+                earth_rate_ratio
+            ));
+        } else if earth_rate_ratio < 0.2 {
+            problems.push(format!(
+                "mean angular rate {:.3e} deg/h on a static stretch is {:.3}× Earth rate (15.04 deg/h), which \
+                 any gyro at rest measures: check gyro_unit (rad/s read as deg/s gives 1/57.3)",
+                w.norm() * deg * 3600.0,
+                earth_rate_ratio
+            ));
+        }
+        if tilt * deg > 45.0 && !tilted_ok {
+            problems.push(format!(
+                "the static specific force points {:.1}° away from the body's up axis (roll {:.1}°, pitch {:.1}°): \
+                 if the vehicle stands level, [axes] is wrong (a flipped z gives roll 180°, swapped x and z \
+                 pitch ±90°); --tilted accepts a tilted mounting",
+                tilt * deg,
+                roll * deg,
+                pitch * deg
+            ));
+        }
+        if (0.5..2.0).contains(&earth_rate_ratio) {
+            // level the mean rate with roll and pitch; its horizontal part points north
+            let c = crate::nav::attitude::dcm_from_euler(roll, pitch, 0.0);
+            let wl = c * w;
+            let h = (-wl.y).atan2(wl.x).to_degrees().rem_euclid(360.0);
+            // no "-0.0" and no "360.0" for north
+            heading = Some(if h.abs() < 1e-9 || h > 360.0 - 1e-9 {
+                0.0
+            } else {
+                h
+            });
+        } else {
+            notes.push(format!(
+                "heading cannot be found from these gyros: |ω| is {earth_rate_ratio:.1}× Earth rate, so the \
+                 gyro bias hides the Earth-rate direction; use --init or a GNSS course"
+            ));
+        }
+    }
+    if jitter > 0.01 * median {
+        notes.push(format!(
+            "the clock jitters: intervals {:.6}–{:.6} s, RMS {:.2e} s about the median {median:.6} s \
+             (each sample's own interval is used)",
+            intervals.first().copied().unwrap_or(0.0),
+            intervals.last().copied().unwrap_or(0.0),
+            jitter
+        ));
+    }
+    if gaps > 0 {
+        notes.push(format!(
+            "{gaps} intervals longer than twice the median (the longest {:.4} s)",
+            intervals.last().copied().unwrap_or(0.0)
+        ));
+    }
+    ImuCheck {
+        samples: s.len(),
+        duration_s: imu.duration(),
+        rate_hz: 1.0 / median,
+        interval_min_s: intervals.first().copied().unwrap_or(0.0),
+        interval_max_s: intervals.last().copied().unwrap_or(0.0),
+        jitter_rms_s: jitter,
+        gaps,
+        window_s: [w0, w1],
+        f_spread_mps2: spread,
+        is_static,
+        f_mean_mps2: [f.x, f.y, f.z],
+        w_mean_radps: [w.x, w.y, w.z],
+        gravity_ratio,
+        gravity_mps2: g,
+        earth_rate_ratio,
+        roll_deg: roll * deg,
+        pitch_deg: pitch * deg,
+        heading_deg: heading,
+        tilt_deg: tilt * deg,
+        problems,
+        notes,
+    }
+}

@@ -1,0 +1,494 @@
+//! IMU logs described, not converted by hand: a TOML description of a logger's file layout
+//! (delimiter, header row, comment prefix), its time column and clock unit, the kind of signal
+//! (rates or increments) with their units (the project's unit parser, raw counts as
+//! `"0.1 arcsec"` per count), and where the sensor's axes point on the body. Read into the
+//! project's FRD increments over each sample interval. Format: `docs/formats.md`.
+
+use crate::io::imu::{ImuData, ImuSample};
+use crate::io::units::{parse_quantity, parse_unit};
+use anyhow::{anyhow, bail, Context, Result};
+use nalgebra::{Matrix3, Vector3};
+use serde::Deserialize;
+use std::path::Path;
+use toml::Spanned;
+
+/// How fields are separated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delimiter {
+    /// Runs of spaces or tabs.
+    Whitespace,
+    /// One character (`,`, `;`, tab, `|`).
+    Char(char),
+}
+
+/// A column by header name or by 1-based index.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(untagged)]
+pub enum ColumnRef {
+    /// Name in the header row.
+    Name(String),
+    /// 1-based index.
+    Index(i64),
+}
+
+/// What the six signal columns hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Angular rate and specific force, integrated over each interval.
+    Rate,
+    /// Angle and velocity increments over (t_prev, t].
+    Increment,
+}
+
+/// How a rate becomes an increment over (t_{k−1}, t_k].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Integration {
+    /// (y_{k−1} + y_k)/2 · (t_k − t_{k−1}).
+    Trapezoid,
+    /// y_k · (t_k − t_{k−1}): the sample is the mean rate over the interval ending at t_k.
+    Hold,
+}
+
+/// A parsed and checked IMU format description.
+#[derive(Debug, Clone)]
+pub struct ImuFormat {
+    /// Where the description came from (for messages).
+    pub origin: String,
+    /// Field separator.
+    pub delimiter: Delimiter,
+    /// The first data line (after `skip_lines`) holds column names.
+    pub header: bool,
+    /// Lines skipped before anything else.
+    pub skip_lines: usize,
+    /// Lines starting with this prefix are skipped (empty: none).
+    pub comment: String,
+    /// Time column.
+    pub time: ColumnRef,
+    /// Seconds per unit of the time column.
+    pub time_to_s: f64,
+    /// Rates or increments.
+    pub kind: Kind,
+    /// Integration rule for rates.
+    pub integration: Integration,
+    /// Gyro columns (sensor x, y, z).
+    pub gyro: [ColumnRef; 3],
+    /// SI per unit of the gyro columns (rad/s or rad).
+    pub gyro_to_si: f64,
+    /// Accelerometer columns (sensor x, y, z).
+    pub accel: [ColumnRef; 3],
+    /// SI per unit of the accelerometer columns (m/s² or m/s).
+    pub accel_to_si: f64,
+    /// Sensor axes to FRD body: v_body = axes · v_sensor (a proper rotation).
+    pub axes: Matrix3<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFormat {
+    file: Option<RawFile>,
+    time: RawTime,
+    signals: RawSignals,
+    axes: Option<RawAxes>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    delimiter: Option<Spanned<String>>,
+    header: Option<bool>,
+    skip_lines: Option<Spanned<i64>>,
+    comment: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTime {
+    column: Spanned<ColumnRef>,
+    unit: Option<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSignals {
+    kind: Spanned<String>,
+    integration: Option<Spanned<String>>,
+    gyro: Spanned<Vec<ColumnRef>>,
+    gyro_unit: Spanned<String>,
+    accel: Spanned<Vec<ColumnRef>>,
+    accel_unit: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAxes {
+    x: Spanned<String>,
+    y: Spanned<String>,
+    z: Spanned<String>,
+}
+
+/// The FRD body unit vector a direction word names.
+fn direction(word: &str) -> Option<Vector3<f64>> {
+    Some(match word.trim().to_ascii_lowercase().as_str() {
+        "forward" | "front" => Vector3::new(1.0, 0.0, 0.0),
+        "back" | "backward" | "rear" => Vector3::new(-1.0, 0.0, 0.0),
+        "right" => Vector3::new(0.0, 1.0, 0.0),
+        "left" => Vector3::new(0.0, -1.0, 0.0),
+        "down" => Vector3::new(0.0, 0.0, 1.0),
+        "up" => Vector3::new(0.0, 0.0, -1.0),
+        _ => return None,
+    })
+}
+
+/// SI value of one unit written as a unit (`"deg/s"`) or a quantity per count (`"0.1 arcsec"`),
+/// checked against the dimension of `si_unit`.
+fn unit_scale(text: &str, si_unit: &str) -> Result<f64, String> {
+    let t = text.trim();
+    let q = if t.starts_with(|c: char| c.is_ascii_digit() || c == '.' || c == '-' || c == '+') {
+        parse_quantity(t).map_err(|e| e.0)?
+    } else {
+        parse_quantity(&format!("1 {t}")).map_err(|e| e.0)?
+    };
+    let want = parse_unit(si_unit).map_err(|e| e.0)?;
+    if q.dim != want.dim {
+        return Err(format!(
+            "`{t}` has dimension {} but a {si_unit} unit is needed here",
+            q.dim
+        ));
+    }
+    let s = q.si / want.to_si;
+    if !(s.is_finite() && s > 0.0) {
+        return Err(format!("`{t}`: the scale must be positive and finite"));
+    }
+    Ok(s)
+}
+
+impl ImuFormat {
+    /// Reads and checks a description file.
+    pub fn load(path: &Path) -> Result<ImuFormat> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("--imu-format {}: cannot read the file", path.display()))?;
+        ImuFormat::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses and checks description text; `origin` names it in messages (`origin:line: …`).
+    pub fn parse(text: &str, origin: &str) -> Result<ImuFormat> {
+        let line = |start: usize| text[..start.min(text.len())].lines().count().max(1);
+        let at = |span: std::ops::Range<usize>, msg: String| {
+            anyhow!("{origin}:{}: {msg}", line(span.start + 1))
+        };
+        let raw: RawFormat = toml::from_str(text).map_err(|e| {
+            let l = e.span().map(|s| line(s.start + 1)).unwrap_or(0);
+            anyhow!("{origin}:{l}: {}", e.message().trim())
+        })?;
+        let file = raw.file.unwrap_or(RawFile {
+            delimiter: None,
+            header: None,
+            skip_lines: None,
+            comment: None,
+        });
+        let delimiter = match &file.delimiter {
+            None => Delimiter::Whitespace,
+            Some(d) => match d.get_ref().as_str() {
+                "whitespace" | " " => Delimiter::Whitespace,
+                "tab" | "\t" => Delimiter::Char('\t'),
+                s if s.chars().count() == 1 && !s.starts_with(|c: char| c.is_alphanumeric() || c == '.' || c == '-' || c == '+') => {
+                    Delimiter::Char(s.chars().next().unwrap_or(','))
+                }
+                s => {
+                    return Err(at(
+                        d.span(),
+                        format!("[file] delimiter `{s}`: use \"whitespace\", \"tab\" or one punctuation character such as \",\" or \";\""),
+                    ))
+                }
+            },
+        };
+        let skip_lines = match &file.skip_lines {
+            None => 0,
+            Some(s) if (0..=1_000_000).contains(s.get_ref()) => *s.get_ref() as usize,
+            Some(s) => {
+                return Err(at(
+                    s.span(),
+                    format!(
+                        "[file] skip_lines = {}: expected 0 ..= 1000000",
+                        s.get_ref()
+                    ),
+                ))
+            }
+        };
+        let header = file.header.unwrap_or(false);
+        let comment = file.comment.unwrap_or_else(|| "#".into());
+
+        let check_col = |c: &Spanned<ColumnRef>| -> Result<ColumnRef> {
+            match c.get_ref() {
+                ColumnRef::Index(i) if *i < 1 || *i > 10_000 => Err(at(
+                    c.span(),
+                    format!("column index {i}: columns count from 1 (and up to 10000)"),
+                )),
+                ColumnRef::Name(_) if !header => Err(at(
+                    c.span(),
+                    "a column named by its header needs `header = true` in [file]; or give its 1-based index".into(),
+                )),
+                ColumnRef::Name(n) if n.trim().is_empty() => {
+                    Err(at(c.span(), "empty column name".into()))
+                }
+                r => Ok(r.clone()),
+            }
+        };
+        let time = check_col(&raw.time.column)?;
+        let time_to_s = match &raw.time.unit {
+            None => 1.0,
+            Some(u) => unit_scale(u.get_ref(), "s")
+                .map_err(|e| at(u.span(), format!("[time] unit: {e}")))?,
+        };
+        let kind = match raw.signals.kind.get_ref().as_str() {
+            "rate" => Kind::Rate,
+            "increment" => Kind::Increment,
+            k => {
+                return Err(at(
+                    raw.signals.kind.span(),
+                    format!("[signals] kind `{k}`: expected \"rate\" or \"increment\""),
+                ))
+            }
+        };
+        let integration = match &raw.signals.integration {
+            None => Integration::Trapezoid,
+            Some(i) => match i.get_ref().as_str() {
+                "trapezoid" => Integration::Trapezoid,
+                "hold" => Integration::Hold,
+                s => {
+                    return Err(at(
+                        i.span(),
+                        format!("[signals] integration `{s}`: expected \"trapezoid\" or \"hold\""),
+                    ))
+                }
+            },
+        };
+        if kind == Kind::Increment {
+            if let Some(i) = &raw.signals.integration {
+                return Err(at(
+                    i.span(),
+                    "[signals] integration applies to kind = \"rate\" only".into(),
+                ));
+            }
+        }
+        let three = |v: &Spanned<Vec<ColumnRef>>, what: &str| -> Result<[ColumnRef; 3]> {
+            if v.get_ref().len() != 3 {
+                return Err(at(
+                    v.span(),
+                    format!(
+                        "[signals] {what}: expected three columns (sensor x, y, z), found {}",
+                        v.get_ref().len()
+                    ),
+                ));
+            }
+            let cols: Vec<ColumnRef> = v
+                .get_ref()
+                .iter()
+                .map(|c| check_col(&Spanned::new(v.span(), c.clone())))
+                .collect::<Result<_>>()?;
+            Ok([cols[0].clone(), cols[1].clone(), cols[2].clone()])
+        };
+        let gyro = three(&raw.signals.gyro, "gyro")?;
+        let accel = three(&raw.signals.accel, "accel")?;
+        let (gsi, asi) = match kind {
+            Kind::Rate => ("rad/s", "m/s^2"),
+            Kind::Increment => ("rad", "m/s"),
+        };
+        let gyro_to_si = unit_scale(raw.signals.gyro_unit.get_ref(), gsi).map_err(|e| {
+            at(
+                raw.signals.gyro_unit.span(),
+                format!(
+                    "[signals] gyro_unit (kind {}): {e}",
+                    raw.signals.kind.get_ref()
+                ),
+            )
+        })?;
+        let accel_to_si = unit_scale(raw.signals.accel_unit.get_ref(), asi).map_err(|e| {
+            at(
+                raw.signals.accel_unit.span(),
+                format!(
+                    "[signals] accel_unit (kind {}): {e}",
+                    raw.signals.kind.get_ref()
+                ),
+            )
+        })?;
+        let mut all: Vec<&ColumnRef> = vec![&time];
+        all.extend(gyro.iter());
+        all.extend(accel.iter());
+        for (i, a) in all.iter().enumerate() {
+            if all[..i].contains(a) {
+                return Err(anyhow!(
+                    "{origin}: column {a:?} is used twice among time, gyro and accel"
+                ));
+            }
+        }
+        let axes = match &raw.axes {
+            None => Matrix3::identity(),
+            Some(ax) => {
+                let mut m = Matrix3::zeros();
+                for (k, (name, w)) in [("x", &ax.x), ("y", &ax.y), ("z", &ax.z)]
+                    .iter()
+                    .enumerate()
+                {
+                    let d = direction(w.get_ref()).ok_or_else(|| {
+                        at(w.span(), format!("[axes] {name} = \"{}\": expected forward, back, right, left, down or up", w.get_ref()))
+                    })?;
+                    m.set_column(k, &d);
+                }
+                let det = m.determinant();
+                if det.abs() < 0.5 {
+                    return Err(at(ax.x.span(), "[axes] two sensor axes point the same way (or opposite): each of x, y, z needs its own body axis".into()));
+                }
+                if det < 0.0 {
+                    return Err(at(ax.x.span(), format!(
+                        "[axes] x = {}, y = {}, z = {} is a left-handed frame: one axis is flipped (an IMU's axes are right-handed; e.g. forward, left, up or forward, right, down)",
+                        ax.x.get_ref(), ax.y.get_ref(), ax.z.get_ref()
+                    )));
+                }
+                m
+            }
+        };
+        Ok(ImuFormat {
+            origin: origin.to_string(),
+            delimiter,
+            header,
+            skip_lines,
+            comment,
+            time,
+            time_to_s,
+            kind,
+            integration,
+            gyro,
+            gyro_to_si,
+            accel,
+            accel_to_si,
+            axes,
+        })
+    }
+
+    fn split<'a>(&self, line: &'a str) -> Vec<&'a str> {
+        match self.delimiter {
+            Delimiter::Whitespace => line.split_whitespace().collect(),
+            Delimiter::Char(c) => line.split(c).map(|f| f.trim().trim_matches('"')).collect(),
+        }
+    }
+
+    /// Reads a data file described by this format into FRD increments; errors name the data
+    /// file and line (or the description's line for a column name it lacks).
+    pub fn read(&self, path: &Path) -> Result<ImuData> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read IMU file {}", path.display()))?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let file = path.display().to_string();
+        let mut cols: Option<[usize; 7]> = None;
+        let mut prev: Option<(f64, Vector3<f64>, Vector3<f64>)> = None;
+        let mut samples = Vec::new();
+        let resolve = |names: &[&str], c: &ColumnRef, lineno: usize| -> Result<usize> {
+            match c {
+                ColumnRef::Index(i) => Ok(*i as usize - 1),
+                ColumnRef::Name(n) => names.iter().position(|h| h == n).ok_or_else(|| {
+                    anyhow!(
+                        "{}: column `{n}` is not in the header of {file}:{lineno} (it has: {})",
+                        self.origin,
+                        names.join(", ")
+                    )
+                }),
+            }
+        };
+        for (i, raw_line) in text.lines().enumerate().skip(self.skip_lines) {
+            let lineno = i + 1;
+            let line = raw_line.trim();
+            if line.is_empty() || (!self.comment.is_empty() && line.starts_with(&self.comment)) {
+                continue;
+            }
+            let fields = self.split(line);
+            if cols.is_none() {
+                let names: Vec<&str> = if self.header {
+                    fields.clone()
+                } else {
+                    Vec::new()
+                };
+                let mut c = [0usize; 7];
+                let all = [
+                    &self.time,
+                    &self.gyro[0],
+                    &self.gyro[1],
+                    &self.gyro[2],
+                    &self.accel[0],
+                    &self.accel[1],
+                    &self.accel[2],
+                ];
+                for (k, r) in all.iter().enumerate() {
+                    c[k] = resolve(&names, r, lineno)?;
+                }
+                cols = Some(c);
+                if self.header {
+                    continue;
+                }
+            }
+            let c = cols.unwrap_or([0; 7]);
+            let mut v = [0.0f64; 7];
+            for k in 0..7 {
+                let f = fields.get(c[k]).ok_or_else(|| {
+                    anyhow!(
+                        "{file}:{lineno}: has {} fields, column {} is needed",
+                        fields.len(),
+                        c[k] + 1
+                    )
+                })?;
+                let x: f64 = f.parse().map_err(|_| {
+                    anyhow!(
+                        "{file}:{lineno}: column {}: `{}` is not a number",
+                        c[k] + 1,
+                        f.chars().take(40).collect::<String>()
+                    )
+                })?;
+                if !x.is_finite() {
+                    bail!("{file}:{lineno}: column {}: `{f}` is not finite", c[k] + 1);
+                }
+                v[k] = x;
+            }
+            let t = v[0] * self.time_to_s;
+            let g = self.axes * Vector3::new(v[1], v[2], v[3]) * self.gyro_to_si;
+            let a = self.axes * Vector3::new(v[4], v[5], v[6]) * self.accel_to_si;
+            if let Some((tp, _, _)) = prev {
+                if t <= tp {
+                    bail!("{file}:{lineno}: time {t} s does not increase (previous {tp} s)");
+                }
+            }
+            match self.kind {
+                Kind::Increment => samples.push(ImuSample {
+                    t,
+                    dtheta: g,
+                    dv: a,
+                }),
+                Kind::Rate => {
+                    if let Some((tp, gp, ap)) = prev {
+                        let dt = t - tp;
+                        let (dtheta, dv) = match self.integration {
+                            Integration::Hold => (g * dt, a * dt),
+                            Integration::Trapezoid => ((g + gp) * 0.5 * dt, (a + ap) * 0.5 * dt),
+                        };
+                        samples.push(ImuSample { t, dtheta, dv });
+                    }
+                }
+            }
+            prev = Some((t, g, a));
+        }
+        if samples.len() < 2 {
+            bail!(
+                "{file}: fewer than two IMU samples as described by {}",
+                self.origin
+            );
+        }
+        Ok(ImuData { samples })
+    }
+}
+
+/// The description beside a data file, `FILE.format.toml`, when there is one.
+pub fn beside(data: &Path) -> Option<std::path::PathBuf> {
+    let mut name = data.file_name()?.to_os_string();
+    name.push(".format.toml");
+    let p = data.with_file_name(name);
+    p.is_file().then_some(p)
+}
