@@ -531,3 +531,71 @@ fn bad_descriptions_get_file_and_line() {
     );
     assert!(err.contains("d.csv:3: column 3"), "{err}");
 }
+
+#[test]
+fn the_shipped_gnss_imu_description_reads_what_the_built_in_reader_reads() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let data = root.join("../shared/data/gnss-imu-drive/imu_1934.csv");
+    let builtin = sinsmodel::io::readers::gnss_imu::read(&data).unwrap();
+    let described = ImuFormat::load(&root.join("formats/gnss-imu-csv.toml"))
+        .unwrap()
+        .read(&data)
+        .unwrap();
+    // the built-in reader is on GPST (clock offset from the .tag); the description on the
+    // logger's clock: same increments, times shifted by the offset
+    assert_eq!(builtin.imu.samples.len(), described.samples.len());
+    for (a, b) in builtin.imu.samples.iter().zip(&described.samples) {
+        assert!(
+            (a.t - b.t - builtin.clock_offset).abs() < 1e-6,
+            "{} {}",
+            a.t,
+            b.t
+        );
+        // the built-in reader forms Δt from the millisecond counts, the description from the
+        // times in seconds (t ≈ 262 s: a rounding of ~6e-14 s in a 0.01 s interval)
+        let tol = |v: &Vector3<f64>| 1e-10 * v.amax() + 1e-18;
+        assert!(
+            (a.dtheta - b.dtheta).amax() <= tol(&a.dtheta),
+            "{:?} {:?}",
+            a.dtheta,
+            b.dtheta
+        );
+        assert!((a.dv - b.dv).amax() <= tol(&a.dv), "{:?} {:?}", a.dv, b.dv);
+    }
+}
+
+#[test]
+fn axes_as_a_rotation_matrix_equal_axes_as_directions() {
+    let words = STATIC_FMT.replace(
+        "x = \"forward\"\ny = \"left\"\nz = \"up\"",
+        "x = \"right\"\ny = \"forward\"\nz = \"up\"",
+    );
+    let matrix = STATIC_FMT.replace(
+        "x = \"forward\"\ny = \"left\"\nz = \"up\"",
+        "rotation = [[0, 1, 0], [1, 0, 0], [0, 0, -1]]",
+    );
+    let a = ImuFormat::parse(&words, "w.toml").unwrap().axes;
+    let b = ImuFormat::parse(&matrix, "m.toml").unwrap().axes;
+    assert_eq!(a, b);
+    for (bad, msg) in [
+        (
+            "rotation = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]",
+            "rotation matrix",
+        ),
+        ("rotation = [[1, 0, 0], [0, 1, 0]]", "three rows"),
+        (
+            "x = \"forward\"\nrotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+            "not a mix",
+        ),
+    ] {
+        let text = STATIC_FMT.replace("x = \"forward\"\ny = \"left\"\nz = \"up\"", bad);
+        let err = format!("{:#}", ImuFormat::parse(&text, "fmt.toml").unwrap_err());
+        let axes_line = text.lines().position(|l| l == "[axes]").unwrap() + 2;
+        assert!(
+            err.contains(msg)
+                && (err.starts_with(&format!("fmt.toml:{axes_line}:"))
+                    || err.starts_with(&format!("fmt.toml:{}:", axes_line - 1))),
+            "{bad}: {err}"
+        );
+    }
+}

@@ -121,9 +121,10 @@ struct RawSignals {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawAxes {
-    x: Spanned<String>,
-    y: Spanned<String>,
-    z: Spanned<String>,
+    x: Option<Spanned<String>>,
+    y: Option<Spanned<String>>,
+    z: Option<Spanned<String>>,
+    rotation: Option<Spanned<Vec<Vec<f64>>>>,
 }
 
 /// The FRD body unit vector a direction word names.
@@ -324,12 +325,37 @@ impl ImuFormat {
         }
         let axes = match &raw.axes {
             None => Matrix3::identity(),
-            Some(ax) => {
+            Some(RawAxes {
+                x: None,
+                y: None,
+                z: None,
+                rotation: Some(r),
+            }) => {
+                let rows = r.get_ref();
+                if rows.len() != 3 || rows.iter().any(|row| row.len() != 3) {
+                    return Err(at(
+                        r.span(),
+                        "[axes] rotation: expected three rows of three numbers (sensor to body, FRD)".into(),
+                    ));
+                }
+                let m = Matrix3::from_fn(|i, j| rows[i][j]);
+                let err = (m * m.transpose() - Matrix3::identity()).amax();
+                if !m.iter().all(|v| v.is_finite()) || err > 1e-6 || m.determinant() < 0.0 {
+                    return Err(at(
+                        r.span(),
+                        format!("[axes] rotation is not a rotation matrix (|M Mᵀ − I| = {err:.1e}, det {:.3}): rows must be orthonormal with determinant +1", m.determinant()),
+                    ));
+                }
+                m
+            }
+            Some(RawAxes {
+                x: Some(xw),
+                y: Some(yw),
+                z: Some(zw),
+                rotation: None,
+            }) => {
                 let mut m = Matrix3::zeros();
-                for (k, (name, w)) in [("x", &ax.x), ("y", &ax.y), ("z", &ax.z)]
-                    .iter()
-                    .enumerate()
-                {
+                for (k, (name, w)) in [("x", xw), ("y", yw), ("z", zw)].iter().enumerate() {
                     let d = direction(w.get_ref()).ok_or_else(|| {
                         at(w.span(), format!("[axes] {name} = \"{}\": expected forward, back, right, left, down or up", w.get_ref()))
                     })?;
@@ -337,15 +363,23 @@ impl ImuFormat {
                 }
                 let det = m.determinant();
                 if det.abs() < 0.5 {
-                    return Err(at(ax.x.span(), "[axes] two sensor axes point the same way (or opposite): each of x, y, z needs its own body axis".into()));
+                    return Err(at(xw.span(), "[axes] two sensor axes point the same way (or opposite): each of x, y, z needs its own body axis".into()));
                 }
                 if det < 0.0 {
-                    return Err(at(ax.x.span(), format!(
+                    return Err(at(xw.span(), format!(
                         "[axes] x = {}, y = {}, z = {} is a left-handed frame: one axis is flipped (an IMU's axes are right-handed; e.g. forward, left, up or forward, right, down)",
-                        ax.x.get_ref(), ax.y.get_ref(), ax.z.get_ref()
+                        xw.get_ref(), yw.get_ref(), zw.get_ref()
                     )));
                 }
                 m
+            }
+            Some(_) => {
+                let l = text
+                    .lines()
+                    .position(|l| l.trim() == "[axes]")
+                    .map(|k| k + 1)
+                    .unwrap_or(0);
+                bail!("{origin}:{l}: [axes] takes either x, y and z (directions) or rotation (a 3×3 matrix), not a mix or a part")
             }
         };
         Ok(ImuFormat {
