@@ -1,18 +1,13 @@
 //! Bad input gets a clear error naming the file, line and problem; outputs are never left
 //! half-written.
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 
 fn run(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let (ok, _, err) = common::sinsmodel(args);
+    (ok, err)
 }
 
 fn navigate(imu: &Path, out: &Path) -> (bool, String) {

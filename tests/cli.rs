@@ -1,18 +1,7 @@
 //! The `sinsmodel` binary: model listing, model show, jacobian output and its input errors.
 
-use std::process::Command;
-
-fn sinsmodel(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::sinsmodel;
 
 #[test]
 fn model_show_p31_lists_the_canonical_states_in_order() {

@@ -1,20 +1,10 @@
 //! `sinsmodel explain` from the command line: the embedded demo end to end (JSON of DESIGN §9,
 //! report, figures, extended preset), its refusals of bad input, and both measured data sets.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::sinsmodel;
 
-fn sinsmodel(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
-        .args(args)
-        .output()
-        .expect("run sinsmodel");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use std::path::{Path, PathBuf};
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!(

@@ -2,12 +2,14 @@
 //! conventions reads back to the same FRD increments; `imu-check` catches a wrong unit and a
 //! flipped axis; bad descriptions get `file:line` errors.
 
+mod common;
+use common::sinsmodel;
+
 use nalgebra::Vector3;
 use sinsmodel::io::imu::{ImuData, ImuSample};
 use sinsmodel::io::imu_format::ImuFormat;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::Command;
 
 const G: f64 = 9.80665;
 const D2R: f64 = std::f64::consts::PI / 180.0;
@@ -278,18 +280,6 @@ fn trapezoid_integrates_a_ramp_exactly_and_jitter_uses_each_interval() {
     }
 }
 
-fn sinsmodel(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 /// A static, level, north-facing navigation-grade IMU at 30° N written as FLU rates in deg/s and
 /// m/s^2, 100 Hz, 20 s.
 fn static_flu_deg_s(path: &Path) {
@@ -426,8 +416,8 @@ fn imu_check_accepts_the_right_description_and_catches_a_wrong_unit_or_axis() {
     );
     // a description beside the data is found and said
     std::fs::write(tmp.path().join("static.csv.format.toml"), STATIC_FMT).unwrap();
-    let (ok, out, _) = sinsmodel(&["imu-check", "--imu", d]);
-    assert!(ok && out.contains("found beside it"), "{out}");
+    let (ok, out, err) = sinsmodel(&["imu-check", "--imu", d]);
+    assert!(ok && err.contains("found beside it"), "{out}\n{err}");
 }
 
 #[test]

@@ -2,20 +2,10 @@
 //! expected NIS, provenance headers in the CLI's words, options named in errors, full state
 //! names, fits the data do not support said as such.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
+use common::sinsmodel;
 
-fn sinsmodel(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use std::path::Path;
 
 fn p(path: &Path) -> &str {
     path.to_str().unwrap()

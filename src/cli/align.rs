@@ -3,19 +3,14 @@
 use anyhow::Result;
 use clap::Args;
 use sinsmodel::estimate::align;
-use sinsmodel::io::{atomic_file, readers};
+use sinsmodel::io::atomic_file;
 use std::path::PathBuf;
 
 /// Arguments of `align`.
 #[derive(Args)]
 pub struct AlignArgs {
-    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
-    #[arg(long)]
-    imu: PathBuf,
-    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
-    /// IMU file if there is one, else chosen by the file's extension.
-    #[arg(long)]
-    imu_format: Option<PathBuf>,
+    #[command(flatten)]
+    src: super::data::ImuSource,
     /// Latitude [deg]; estimated from the Earth-rate and gravity directions when omitted.
     #[arg(long, allow_hyphen_values = true)]
     lat: Option<f64>,
@@ -43,8 +38,7 @@ pub fn run(args: &AlignArgs) -> Result<()> {
             anyhow::bail!("--lat {l} must be within ±89°");
         }
     }
-    let (data, how) = readers::read_imu(&args.imu, args.imu_format.as_deref())?;
-    eprintln!("reading {} {how}", args.imu.display());
+    let data = args.src.read()?;
     let d = std::f64::consts::PI / 180.0;
     let a = align::align(
         &data,

@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::allan::{fit, oadev, AllanCurve, NoiseFit};
-use sinsmodel::io::{atomic_file, readers};
+use sinsmodel::io::atomic_file;
 use sinsmodel::report::plot::{line_plot, Scale, Series};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -14,13 +14,8 @@ use std::path::PathBuf;
 /// Arguments of `allan`.
 #[derive(Args)]
 pub struct AllanArgs {
-    /// IMU file (text, PSINS .imu, GNSS_IMU .csv).
-    #[arg(long)]
-    imu: PathBuf,
-    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
-    /// IMU file if there is one, else chosen by the file's extension.
-    #[arg(long)]
-    imu_format: Option<PathBuf>,
+    #[command(flatten)]
+    src: super::data::ImuSource,
     /// Skip this many seconds at the start (e.g. a disturbed start).
     #[arg(long, default_value_t = 0.0)]
     skip: f64,
@@ -51,8 +46,7 @@ const NAMES: [&str; 6] = [
 
 /// Runs the command.
 pub fn run(args: &AllanArgs) -> Result<()> {
-    let (data, how) = readers::read_imu(&args.imu, args.imu_format.as_deref())?;
-    eprintln!("reading {} {how}", args.imu.display());
+    let data = args.src.read()?;
     let dt = data.interval();
     let t0 = data.samples[0].t + args.skip;
     let t1 = args.seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);
@@ -64,7 +58,7 @@ pub fn run(args: &AllanArgs) -> Result<()> {
     if samples.len() < 16 {
         anyhow::bail!(
             "{}: fewer than 16 samples in the chosen span",
-            args.imu.display()
+            args.src.imu.display()
         );
     }
     let curves: Vec<AllanCurve> = (0..6)

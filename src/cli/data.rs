@@ -13,6 +13,34 @@ use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::strapdown::{NavState, Vertical};
 use std::path::PathBuf;
 
+/// The IMU file and how to read it: the options of `navigate`, `align`, `allan`, `imu-check`.
+#[derive(Args, Clone, Debug)]
+pub struct ImuSource {
+    /// IMU file (text, PSINS .imu, GNSS_IMU .csv, or any layout --imu-format describes).
+    #[arg(long)]
+    pub imu: PathBuf,
+    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
+    /// IMU file if there is one, else chosen by the file's extension.
+    #[arg(long)]
+    pub imu_format: Option<PathBuf>,
+}
+
+impl ImuSource {
+    /// Reads the IMU file; says on stderr which format was used.
+    pub fn read(&self) -> Result<ImuData> {
+        let (data, how) = readers::read_imu(&self.imu, self.imu_format.as_deref())?;
+        eprintln!("reading {} {how}", self.imu.display());
+        Ok(data)
+    }
+
+    /// The input files (so outputs never land on them).
+    pub fn paths(&self) -> Vec<&std::path::Path> {
+        std::iter::once(self.imu.as_path())
+            .chain(self.imu_format.as_deref())
+            .collect()
+    }
+}
+
 /// The data options of `filter` and `explain`.
 #[derive(Args, Clone, Debug)]
 pub struct DataArgs {

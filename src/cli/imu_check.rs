@@ -4,19 +4,14 @@
 use anyhow::{bail, Result};
 use clap::Args;
 use sinsmodel::estimate::imu_check;
-use sinsmodel::io::{atomic_file, readers};
+use sinsmodel::io::atomic_file;
 use std::path::PathBuf;
 
 /// Arguments of `imu-check`.
 #[derive(Args)]
 pub struct ImuCheckArgs {
-    /// IMU file.
-    #[arg(long)]
-    imu: PathBuf,
-    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
-    /// IMU file if there is one, else chosen by the file's extension.
-    #[arg(long)]
-    imu_format: Option<PathBuf>,
+    #[command(flatten)]
+    src: super::data::ImuSource,
     /// Latitude [deg] for local gravity (default 45°, within 0.3 % of any latitude).
     #[arg(long, allow_hyphen_values = true)]
     lat: Option<f64>,
@@ -48,8 +43,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         bail!("--seconds {}: expected seconds > 0", args.seconds);
     }
     if let Some(j) = &args.json {
-        let inputs = [Some(&args.imu), args.imu_format.as_ref()];
-        for p in inputs.into_iter().flatten() {
+        for p in args.src.paths() {
             if j.exists() && j.canonicalize().ok() == p.canonicalize().ok() {
                 bail!(
                     "--json {}: is an input of this run; choose another path",
@@ -58,8 +52,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
             }
         }
     }
-    let (data, how) = readers::read_imu(&args.imu, args.imu_format.as_deref())?;
-    println!("read {} {how}", args.imu.display());
+    let data = args.src.read()?;
     let c = imu_check::check(
         &data,
         args.lat.map(f64::to_radians),
@@ -119,7 +112,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
     if !c.problems.is_empty() {
         bail!(
             "{}: implausible as read:\n  - {}",
-            args.imu.display(),
+            args.src.imu.display(),
             c.problems.join("\n  - ")
         );
     }

@@ -3,8 +3,8 @@
 use anyhow::{bail, Result};
 use clap::Args;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use sinsmodel::io::truth;
 use sinsmodel::io::truth::TruthRow;
-use sinsmodel::io::{readers, truth};
 use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::strapdown::{NavState, Navigator, Vertical};
 use sinsmodel::report::progress;
@@ -13,13 +13,8 @@ use std::path::PathBuf;
 /// Arguments of `navigate`.
 #[derive(Args)]
 pub struct NavigateArgs {
-    /// IMU file: project text format, PSINS `.imu` or GNSS_IMU `.csv`.
-    #[arg(long)]
-    imu: PathBuf,
-    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
-    /// IMU file if there is one, else chosen by the file's extension.
-    #[arg(long)]
-    imu_format: Option<PathBuf>,
+    #[command(flatten)]
+    src: super::data::ImuSource,
     /// Initial latitude [deg].
     #[arg(long, allow_hyphen_values = true)]
     lat: f64,
@@ -78,9 +73,8 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.out_rate.is_nan() || args.out_rate <= 0.0 {
         bail!("--out-rate must be positive");
     }
-    let (data, how) = readers::read_imu(&args.imu, args.imu_format.as_deref())?;
-    eprintln!("reading {} {how}", args.imu.display());
-    data.check_time(&args.imu.display().to_string(), 5.0)?;
+    let data = args.src.read()?;
+    data.check_time(&args.src.imu.display().to_string(), 5.0)?;
     let d = std::f64::consts::PI / 180.0;
     let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
     let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
