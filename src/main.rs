@@ -49,6 +49,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so a closed pipe (`sinsmodel … | head`) would make println! panic;
+    // restore the default: the process ends quietly when its reader goes away.
+    #[cfg(unix)]
+    // SAFETY: called first in main, before any thread exists; only resets a signal disposition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Model { action } => cli::model::run(action),

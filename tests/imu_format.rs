@@ -10,6 +10,7 @@ use sinsmodel::io::imu::{ImuData, ImuSample};
 use sinsmodel::io::imu_format::ImuFormat;
 use std::fmt::Write as _;
 use std::path::Path;
+use std::process::Command;
 
 const G: f64 = 9.80665;
 const D2R: f64 = std::f64::consts::PI / 180.0;
@@ -588,4 +589,180 @@ fn axes_as_a_rotation_matrix_equal_axes_as_directions() {
             "{bad}: {err}"
         );
     }
+}
+
+/// The ROS example and its description, copied into `dir`.
+fn ros_copy(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let d = dir.join("ros.csv");
+    let f = dir.join("ros.toml");
+    std::fs::copy(root.join("examples/ros_imu.csv"), &d).unwrap();
+    std::fs::copy(root.join("formats/ros-imu.toml"), &f).unwrap();
+    (d, f)
+}
+
+#[test]
+fn outputs_never_land_on_inputs_or_special_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (d, f) = ros_copy(tmp.path());
+    let before = std::fs::read(&d).unwrap();
+    let (ds, fs) = (d.to_str().unwrap(), f.to_str().unwrap());
+    let nav = |out: &str| {
+        sinsmodel(&[
+            "navigate",
+            "--imu",
+            ds,
+            "--imu-format",
+            fs,
+            "--lat",
+            "30",
+            "--lon",
+            "120",
+            "--att",
+            "1,-2,30",
+            "--out",
+            out,
+        ])
+    };
+    for out in [ds, fs] {
+        let (ok, _, err) = nav(out);
+        assert!(
+            !ok && err.contains("--out") && err.contains("input of this run"),
+            "{err}"
+        );
+    }
+    for cmd in ["align", "allan", "imu-check"] {
+        let (ok, _, err) = sinsmodel(&[cmd, "--imu", ds, "--imu-format", fs, "--json", ds]);
+        assert!(
+            !ok && err.contains("--json") && err.contains("input"),
+            "{cmd}: {err}"
+        );
+    }
+    let dir = tmp.path().join("adir");
+    std::fs::create_dir(&dir).unwrap();
+    let (ok, _, err) = sinsmodel(&[
+        "imu-check",
+        "--imu",
+        ds,
+        "--imu-format",
+        fs,
+        "--json",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("not a regular file"), "{err}");
+    assert_eq!(std::fs::read(&d).unwrap(), before, "the input changed");
+    // a device as input: refused at once, not read forever
+    let (ok, _, err) = sinsmodel(&["imu-check", "--imu", "/dev/zero", "--imu-format", fs]);
+    assert!(!ok && err.contains("not a regular file"), "{err}");
+}
+
+#[test]
+fn absurd_values_units_and_clocks_are_refused_with_file_and_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (d, f) = ros_copy(tmp.path());
+    let text = std::fs::read_to_string(&d).unwrap();
+    let fmt = std::fs::read_to_string(&f).unwrap();
+    let run = |data: &str, fmt: &str| {
+        let dd = tmp.path().join("x.csv");
+        let ff = tmp.path().join("x.toml");
+        std::fs::write(&dd, data).unwrap();
+        std::fs::write(&ff, fmt).unwrap();
+        sinsmodel(&[
+            "navigate",
+            "--imu",
+            dd.to_str().unwrap(),
+            "--imu-format",
+            ff.to_str().unwrap(),
+            "--lat",
+            "30",
+            "--lon",
+            "120",
+            "--att",
+            "1,-2,30",
+            "--out",
+            tmp.path().join("nav.txt").to_str().unwrap(),
+        ])
+    };
+    // a 1e20 m/s^2 value in row 10
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[10].split(',').map(String::from).collect();
+    cells[7] = "1e20".into();
+    lines[10] = cells.join(",");
+    let (ok, _, err) = run(&(lines.join("\n") + "\n"), &fmt);
+    assert!(
+        !ok && err.contains("x.csv:11") && err.contains("beyond any IMU"),
+        "{err}"
+    );
+    // ns stamps described as seconds
+    let (ok, _, err) = run(&text, &fmt.replace("unit = \"ns\"", "unit = \"s\""));
+    assert!(!ok && err.contains("[time] unit"), "{err}");
+    // a decimal comma: one field too many
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[20] = lines[20].replacen(".", ",", 1);
+    let (ok, _, err) = run(&(lines.join("\n") + "\n"), &fmt);
+    assert!(
+        !ok && err.contains("x.csv:21") && err.contains("decimal comma"),
+        "{err}"
+    );
+    // a column used by name and by index
+    let (ok, _, err) = run(&text, &fmt.replace("\"field.angular_velocity.y\"", "5"));
+    assert!(!ok && err.contains("used twice"), "{err}");
+    // the wrong delimiter
+    let (ok, _, err) = run(
+        &text,
+        &fmt.replace("delimiter = \",\"", "delimiter = \";\""),
+    );
+    assert!(!ok && err.contains("is [file] delimiter right"), "{err}");
+    // per-count scale forgotten on a moving log: imu-check still stops
+    let dd = tmp.path().join("x.csv");
+    std::fs::write(&dd, &text).unwrap();
+    let ff = tmp.path().join("y.toml");
+    std::fs::write(
+        &ff,
+        fmt.replace("accel_unit = \"m/s^2\"", "accel_unit = \"100 m/s^2\""),
+    )
+    .unwrap();
+    let (ok, _, err) = sinsmodel(&[
+        "imu-check",
+        "--imu",
+        dd.to_str().unwrap(),
+        "--imu-format",
+        ff.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("accel"), "{err}");
+    // messages for a float column index and a unit written as 1/s
+    let e = format!(
+        "{:#}",
+        ImuFormat::parse(&fmt.replace("column = \"%time\"", "column = 1.0"), "f.toml").unwrap_err()
+    );
+    assert!(e.contains("1-based index (a whole number)"), "{e}");
+    let e = format!(
+        "{:#}",
+        ImuFormat::parse(
+            &fmt.replace("gyro_unit = \"rad/s\"", "gyro_unit = \"1/s\""),
+            "f.toml"
+        )
+        .unwrap_err()
+    );
+    assert!(!e.contains("not a number"), "{e}");
+}
+
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("bash")
+        .args([
+            "-c",
+            &format!(
+                "'{}' imu-check --imu '{}' --imu-format '{}' | true; '{}' model list | head -1 >/dev/null",
+                env!("CARGO_BIN_EXE_sinsmodel"),
+                root.join("examples/ros_imu.csv").display(),
+                root.join("formats/ros-imu.toml").display(),
+                env!("CARGO_BIN_EXE_sinsmodel")
+            ),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
 }

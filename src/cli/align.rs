@@ -38,7 +38,11 @@ pub fn run(args: &AlignArgs) -> Result<()> {
             anyhow::bail!("--lat {l} must be within ±89°");
         }
     }
+    if let Some(j) = &args.json {
+        args.src.check_output("--json", j)?;
+    }
     let data = args.src.read()?;
+    data.check_time(&args.src.imu.display().to_string(), 5.0)?;
     let d = std::f64::consts::PI / 180.0;
     let a = align::align(
         &data,
@@ -53,23 +57,29 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         "roll {:.4} deg  pitch {:.4} deg  heading {:.3} deg (1-sigma {:.3} deg)",
         a.roll_deg, a.pitch_deg, a.heading_deg, a.heading_sigma_deg
     );
-    println!(
-        "latitude {:.4} deg{}",
-        a.lat_deg,
-        if a.lat_sigma_deg > 0.0 {
-            format!(" (estimated, 1-sigma {:.4} deg)", a.lat_sigma_deg)
-        } else {
-            " (given)".into()
-        }
-    );
-    let (lo, hi) = a
-        .heading_windows_deg
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-    println!(
-        "coarse heading over {} one-minute windows: {lo:.3} .. {hi:.3} deg",
-        a.heading_windows_deg.len()
-    );
+    match args.lat {
+        Some(_) => println!("latitude {:.4} deg (given)", a.lat_deg),
+        None if a.lat_sigma_deg > 0.0 => println!(
+            "latitude {:.4} deg (estimated from the Earth-rate and gravity directions, 1-sigma {:.4} deg)",
+            a.lat_deg, a.lat_sigma_deg
+        ),
+        None => println!(
+            "latitude {:.4} deg (estimated from one window only: no spread to give a sigma; pass --lat if known)",
+            a.lat_deg
+        ),
+    }
+    if a.heading_windows_deg.is_empty() {
+        println!("coarse heading: no complete one-minute window in the static data");
+    } else {
+        let (lo, hi) = a
+            .heading_windows_deg
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        println!(
+            "coarse heading over {} one-minute windows: {lo:.3} .. {hi:.3} deg",
+            a.heading_windows_deg.len()
+        );
+    }
     println!(
         "gyro bias estimates [deg/h]: {:.4} {:.4} {:.4}",
         a.gyro_bias_deg_h[0], a.gyro_bias_deg_h[1], a.gyro_bias_deg_h[2]

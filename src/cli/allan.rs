@@ -46,7 +46,17 @@ const NAMES: [&str; 6] = [
 
 /// Runs the command.
 pub fn run(args: &AllanArgs) -> Result<()> {
+    if let Some(j) = &args.json {
+        args.src.check_output("--json", j)?;
+    }
+    if let Some(p) = prefix_shown(args) {
+        for suffix in ["gyro", "accel"] {
+            let png = PathBuf::from(format!("{}_{suffix}.png", p.display()));
+            args.src.check_output("--plot", &png)?;
+        }
+    }
     let data = args.src.read()?;
+    data.check_time(&args.src.imu.display().to_string(), 5.0)?;
     let dt = data.interval();
     let t0 = data.samples[0].t + args.skip;
     let t1 = args.seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);

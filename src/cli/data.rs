@@ -34,10 +34,18 @@ impl ImuSource {
     }
 
     /// The input files (so outputs never land on them).
-    pub fn paths(&self) -> Vec<&std::path::Path> {
-        std::iter::once(self.imu.as_path())
-            .chain(self.imu_format.as_deref())
-            .collect()
+    pub fn paths(&self) -> Vec<PathBuf> {
+        let mut v = vec![self.imu.clone()];
+        v.extend(self.imu_format.clone());
+        v.extend(sinsmodel::io::imu_format::beside(&self.imu));
+        v
+    }
+
+    /// Refuses an output file that is one of the inputs or not a regular file.
+    pub fn check_output(&self, option: &str, path: &std::path::Path) -> Result<()> {
+        let inputs = self.paths();
+        let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+        sinsmodel::io::atomic_file::check_output_file(option, path, &refs)
     }
 }
 
@@ -62,8 +70,9 @@ pub struct DataArgs {
     /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`.
     #[arg(long)]
     prior: Vec<String>,
-    /// Sensor white noise from `sinsmodel allan --json` (mean ARW of the gyros, VRW of the
-    /// accelerometers) instead of the spec defaults.
+    /// Sensor white noise instead of the spec defaults: a `sinsmodel allan --json` file (mean
+    /// ARW of the gyros, VRW of the accelerometers), or inline with units:
+    /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`.
     #[arg(long)]
     noise: Option<PathBuf>,
     /// Truth file (t lat lon h vn ve vd roll pitch yaw): adds the true φ and the model error.
@@ -432,8 +441,13 @@ impl DataArgs {
     }
 }
 
-/// Mean gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from an `allan --json` file.
+/// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from `--noise`: inline
+/// `arw=Q, vrw=Q` with units, or an `allan --json` file (the mean over the three axes).
 pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
+    let text = path.to_string_lossy();
+    if text.contains('=') && !path.exists() {
+        return noise_inline(&text);
+    }
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
@@ -445,18 +459,18 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
     let white = |names: [&str; 3]| -> Result<f64> {
         let mut s = 0.0;
         for n in names {
-            let w = v["fit"][n]["white"]
-                .as_f64()
-                .with_context(|| {
-                    format!(
-                        "--noise {}: fit.{n}.white missing (expected the output of `sinsmodel allan --json`)",
-                        path.display()
-                    )
-                })?;
-            let max = if n.starts_with("gyro") { 1.0 } else { 100.0 };
-            if !w.is_finite() || w <= 0.0 || w > max {
+            let field = &v["fit"][n]["white"];
+            let w = field.as_f64().with_context(|| {
+                format!(
+                    "--noise {}: fit.{n}.white {} (expected a number: the output of `sinsmodel allan --json`)",
+                    path.display(),
+                    if field.is_null() { "is missing or null (the fit was not determined)".to_string() } else { format!("is {field}, not a number") }
+                )
+            })?;
+            let (min, max) = noise_range(n.starts_with("gyro"));
+            if !(w.is_finite() && w >= min && w <= max) {
                 bail!(
-                    "--noise {}: fit.{n}.white = {w} is not a plausible noise density (0 < w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
+                    "--noise {}: fit.{n}.white = {w} is not a plausible noise density ({min:e} ≤ w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
                     path.display()
                 );
             }
@@ -468,4 +482,43 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
         white(["gyro_x", "gyro_y", "gyro_z"])?,
         white(["accel_x", "accel_y", "accel_z"])?,
     ))
+}
+
+/// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's.
+fn noise_inline(text: &str) -> Result<(f64, f64)> {
+    let (mut arw, mut vrw) = (None, None);
+    for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (k, v) = part
+            .split_once('=')
+            .with_context(|| format!("--noise `{part}`: expected arw=QUANTITY or vrw=QUANTITY"))?;
+        let (slot, unit, (min, max)) = match k.trim() {
+            "arw" => (&mut arw, "rad/sqrt(s)", noise_range(true)),
+            "vrw" => (&mut vrw, "m/s/sqrt(s)", noise_range(false)),
+            other => bail!("--noise: unknown key `{other}` (arw, vrw)"),
+        };
+        let q = sinsmodel::io::units::parse_quantity_as(v, unit)
+            .map_err(|e| anyhow::anyhow!("--noise {}: {}", k.trim(), e.0))?;
+        if !(q.is_finite() && q >= min && q <= max) {
+            bail!(
+                "--noise {}: {} is not a plausible noise density ({min:e} ..= {max} {unit})",
+                k.trim(),
+                v.trim()
+            );
+        }
+        *slot = Some(q);
+    }
+    match (arw, vrw) {
+        (Some(a), Some(v)) => Ok((a, v)),
+        _ => bail!("--noise `{text}`: give both arw and vrw, e.g. 'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'"),
+    }
+}
+
+/// Plausible white-noise densities (SI): gyro ARW 1e-9 ..= 1 rad/√s (the best ring-laser gyros
+/// are near 3e-7), accelerometer VRW 1e-7 ..= 100 m/s/√s (0.01 µg/√Hz upward).
+fn noise_range(gyro: bool) -> (f64, f64) {
+    if gyro {
+        (1e-9, 1.0)
+    } else {
+        (1e-7, 100.0)
+    }
 }

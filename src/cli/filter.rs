@@ -120,6 +120,15 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         run.innovations.len(),
     );
     eprint!("{}", nis_table(&run));
+    if let (Some(first), Some(last)) = (run.records.first(), run.records.last()) {
+        let mid = 0.5 * (first.t + last.t);
+        if let Some([n, e]) = filter::model_error_rms_arcsec(&run, mid, last.t) {
+            eprintln!(
+                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s): north {n:.2} arcsec, east {e:.2} arcsec",
+                last.t
+            );
+        }
+    }
     let mut files = vec!["states.txt", "innovations.txt"];
     if truth_rows.is_some() {
         files.push("model_error.txt");

@@ -43,14 +43,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         bail!("--seconds {}: expected seconds > 0", args.seconds);
     }
     if let Some(j) = &args.json {
-        for p in args.src.paths() {
-            if j.exists() && j.canonicalize().ok() == p.canonicalize().ok() {
-                bail!(
-                    "--json {}: is an input of this run; choose another path",
-                    j.display()
-                );
-            }
-        }
+        args.src.check_output("--json", j)?;
     }
     let data = args.src.read()?;
     let c = imu_check::check(
@@ -71,26 +64,33 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         c.jitter_rms_s,
         c.gaps
     );
-    println!(
-        "window {:.3}–{:.3} s: specific force FRD ({:.4}, {:.4}, {:.4}) m/s² (spread {:.3} m/s² RMS{}), |f| = {:.3}× local gravity {:.4} m/s²",
-        c.window_s[0],
-        c.window_s[1],
-        c.f_mean_mps2[0],
-        c.f_mean_mps2[1],
-        c.f_mean_mps2[2],
-        c.f_spread_mps2,
-        if c.is_static { ", static" } else { ", moving" },
-        c.gravity_ratio,
-        c.gravity_mps2
-    );
-    let d = 180.0 / std::f64::consts::PI;
-    println!(
-        "angular rate FRD ({:.3e}, {:.3e}, {:.3e}) deg/h, |ω| = {:.3}× Earth rate",
-        c.w_mean_radps[0] * d * 3600.0,
-        c.w_mean_radps[1] * d * 3600.0,
-        c.w_mean_radps[2] * d * 3600.0,
-        c.earth_rate_ratio
-    );
+    if c.f_spread_mps2.is_finite() {
+        println!(
+            "window {:.3}–{:.3} s: specific force FRD ({:.4}, {:.4}, {:.4}) m/s² (spread {:.3} m/s² RMS{}), |f| = {}× local gravity {:.4} m/s²",
+            c.window_s[0],
+            c.window_s[1],
+            c.f_mean_mps2[0],
+            c.f_mean_mps2[1],
+            c.f_mean_mps2[2],
+            c.f_spread_mps2,
+            if c.is_static { ", static" } else { ", moving" },
+            sinsmodel::estimate::explain::sig3(c.gravity_ratio),
+            c.gravity_mps2
+        );
+        let d = 180.0 / std::f64::consts::PI;
+        println!(
+            "angular rate FRD ({:.3e}, {:.3e}, {:.3e}) deg/h, |ω| = {}× Earth rate",
+            c.w_mean_radps[0] * d * 3600.0,
+            c.w_mean_radps[1] * d * 3600.0,
+            c.w_mean_radps[2] * d * 3600.0,
+            sinsmodel::estimate::explain::sig3(c.earth_rate_ratio)
+        );
+    } else {
+        println!(
+            "window {:.3}–{:.3} s: no samples in it",
+            c.window_s[0], c.window_s[1]
+        );
+    }
     if c.is_static {
         println!(
             "static attitude: roll {:.3}°, pitch {:.3}°, heading {}",
@@ -118,7 +118,15 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
     }
     if c.is_static {
         println!(
-            "plausible: gravity, Earth rate and attitude as expected for a static IMU with these units and axes"
+            "plausible: gravity and attitude as expected for a static IMU with these units and axes; {}",
+            if (0.5..2.0).contains(&c.earth_rate_ratio) {
+                "Earth rate as expected".to_string()
+            } else {
+                format!(
+                    "Earth rate not resolved (the gyro bias makes |ω| {}× Earth rate: gyro units checked only for gross errors)",
+                    sinsmodel::estimate::explain::sig3(c.earth_rate_ratio)
+                )
+            }
         );
     } else {
         println!("sampling read; units and axes not checked (no static stretch in the window)");

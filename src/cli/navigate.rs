@@ -51,8 +51,16 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.lat.abs() >= 89.0 || !args.lat.is_finite() {
         bail!("--lat {} must be within ±89°", args.lat);
     }
-    if args.att.len() != 3 || args.att.iter().any(|a| !a.is_finite()) {
-        bail!("--att: expected roll,pitch,yaw in degrees (three finite comma-separated numbers)");
+    if args.att.len() != 3
+        || args.att.iter().any(|a| !a.is_finite())
+        || args.att[0].abs() > 180.0
+        || args.att[1].abs() > 90.0
+        || args.att[2].abs() > 360.0
+    {
+        bail!(
+            "--att {}: expected roll,pitch,yaw in degrees (roll within ±180, pitch within ±90, yaw within ±360)",
+            args.att.iter().map(|a| a.to_string()).collect::<Vec<_>>().join(",")
+        );
     }
     if args
         .vel
@@ -73,8 +81,16 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.out_rate.is_nan() || args.out_rate <= 0.0 {
         bail!("--out-rate must be positive");
     }
+    args.src.check_output("--out", &args.out)?;
     let data = args.src.read()?;
     data.check_time(&args.src.imu.display().to_string(), 5.0)?;
+    // the same plausibility imu-check applies, on the first 10 s: warn, do not stop (a start
+    // that moves or a tilted mounting are legitimate here)
+    let check =
+        sinsmodel::estimate::imu_check::check(&data, Some(args.lat.to_radians()), 0.0, 10.0, true);
+    for p in &check.problems {
+        eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
+    }
     let d = std::f64::consts::PI / 180.0;
     let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
     let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
@@ -103,6 +119,20 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     for (k, s) in data.samples.iter().enumerate() {
         nav.step(&s.dtheta, &s.dv, s.t - prev_t);
         nav.state.t = s.t;
+        let st = &nav.state;
+        if ![st.lat, st.lon, st.h, st.v.x, st.v.y, st.v.z]
+            .iter()
+            .all(|v| v.is_finite())
+            || st.h.abs() > 1e7
+        {
+            bail!(
+                "{}: the navigation diverged at t = {:.3} s (sample {}): the increments are not physical there \
+                 (check the IMU values, units and clock; `sinsmodel imu-check` shows what was read)",
+                args.src.imu.display(),
+                s.t,
+                k + 1
+            );
+        }
         prev_t = s.t;
         if (k + 1) % every == 0 {
             rows.push(row(&nav.state));

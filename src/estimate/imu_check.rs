@@ -130,6 +130,16 @@ pub fn check(
             s.last().map(|x| x.t).unwrap_or(0.0)
         ));
     } else if !is_static {
+        // no vehicle averages 0.5 g or 2 g of specific force over seconds: a unit error shows
+        // even while moving
+        if !(0.5..2.0).contains(&gravity_ratio) {
+            problems.push(format!(
+                "mean specific force |f| = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
+                 while moving too: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong",
+                crate::estimate::explain::sig3(f.norm()),
+                crate::estimate::explain::sig3(gravity_ratio)
+            ));
+        }
         notes.push(format!(
             "the window {w0:.1}–{w1:.1} s is not static (specific force varies by {spread:.2} m/s² RMS): \
              the gravity, Earth-rate and attitude checks need a static stretch (--skip, --seconds)"

@@ -15,6 +15,14 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts writing `target` (through `target` + `.partial`), creating its directory.
     pub fn create(target: &Path) -> Result<AtomicFile> {
+        if let Ok(m) = std::fs::symlink_metadata(target) {
+            if !m.is_file() && !std::fs::metadata(target).is_ok_and(|m| m.is_file()) {
+                anyhow::bail!(
+                    "{}: exists and is not a regular file (a directory, device or pipe); choose another output path",
+                    target.display()
+                );
+            }
+        }
         if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
             std::fs::create_dir_all(parent)
                 .with_context(|| format!("cannot create {}", parent.display()))?;
@@ -99,6 +107,28 @@ impl OutputDir {
                     target.display()
                 );
             }
+            if !empty {
+                // the marker lists the run's files (one per line after the first): anything
+                // else was put there since, and replacing the directory would lose it
+                let marker = std::fs::read_to_string(target.join(RUN_MARKER)).unwrap_or_default();
+                let listed: Vec<&str> = marker.lines().skip(1).collect();
+                if !listed.is_empty() {
+                    let mut foreign: Vec<String> = std::fs::read_dir(target)
+                        .with_context(|| format!("cannot read {}", target.display()))?
+                        .filter_map(|e| e.ok())
+                        .map(|e| e.file_name().to_string_lossy().into_owned())
+                        .filter(|n| n != RUN_MARKER && !listed.contains(&n.as_str()))
+                        .collect();
+                    if !foreign.is_empty() {
+                        foreign.sort();
+                        anyhow::bail!(
+                            "--out {}: holds files the earlier sinsmodel run did not write ({}); move them or choose another --out (nothing is overwritten)",
+                            target.display(),
+                            foreign.join(", ")
+                        );
+                    }
+                }
+            }
             let canon = target.canonicalize()?;
             for inp in inputs {
                 if let Ok(c) = inp.canonicalize() {
@@ -140,7 +170,16 @@ impl OutputDir {
 
     /// Marks the run complete and moves it into place (replacing the previous run, if any).
     pub fn commit(mut self) -> Result<()> {
-        write_text(&self.staging.join(RUN_MARKER), "written by sinsmodel\n")?;
+        let mut names: Vec<String> = std::fs::read_dir(&self.staging)
+            .with_context(|| format!("cannot read {}", self.staging.display()))?
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        write_text(
+            &self.staging.join(RUN_MARKER),
+            &format!("written by sinsmodel; its files:\n{}\n", names.join("\n")),
+        )?;
         if self.target.exists() {
             std::fs::remove_dir_all(&self.target)
                 .with_context(|| format!("cannot replace {}", self.target.display()))?;
@@ -163,4 +202,29 @@ impl Drop for OutputDir {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// Refuses an output file `path` (named by `option` in the message) that is one of `inputs`
+/// (also through a link) or exists as something other than a regular file; call it before the
+/// computation.
+pub fn check_output_file(option: &str, path: &Path, inputs: &[&Path]) -> Result<()> {
+    if let Ok(m) = std::fs::metadata(path) {
+        if !m.is_file() {
+            anyhow::bail!(
+                "{option} {}: exists and is not a regular file (a directory, device or pipe); choose another output path",
+                path.display()
+            );
+        }
+        let canon = path.canonicalize().ok();
+        for inp in inputs {
+            if canon.is_some() && inp.canonicalize().ok() == canon {
+                anyhow::bail!(
+                    "{option} {}: is an input of this run ({}); choose another output path",
+                    path.display(),
+                    inp.display()
+                );
+            }
+        }
+    }
+    Ok(())
 }

@@ -127,6 +127,18 @@ struct RawAxes {
     rotation: Option<Spanned<Vec<Vec<f64>>>>,
 }
 
+fn column_words(c: &ColumnRef) -> String {
+    match c {
+        ColumnRef::Name(n) => format!("`{}`", n.escape_debug()),
+        ColumnRef::Index(i) => format!("{i}"),
+    }
+}
+
+/// Physical bounds on what an IMU measures: rate [rad/s], specific force [m/s²], interval [s].
+const MAX_RATE: f64 = 100.0;
+const MAX_FORCE: f64 = 2000.0 * crate::io::units::STANDARD_GRAVITY;
+const INTERVAL_RANGE: (f64, f64) = (1e-5, 10.0);
+
 /// The FRD body unit vector a direction word names.
 fn direction(word: &str) -> Option<Vector3<f64>> {
     Some(match word.trim().to_ascii_lowercase().as_str() {
@@ -144,7 +156,11 @@ fn direction(word: &str) -> Option<Vector3<f64>> {
 /// checked against the dimension of `si_unit`.
 fn unit_scale(text: &str, si_unit: &str) -> Result<f64, String> {
     let t = text.trim();
-    let q = if t.starts_with(|c: char| c.is_ascii_digit() || c == '.' || c == '-' || c == '+') {
+    let first_is_number = t
+        .split_whitespace()
+        .next()
+        .is_some_and(|w| w.parse::<f64>().is_ok());
+    let q = if first_is_number {
         parse_quantity(t).map_err(|e| e.0)?
     } else {
         parse_quantity(&format!("1 {t}")).map_err(|e| e.0)?
@@ -166,6 +182,12 @@ fn unit_scale(text: &str, si_unit: &str) -> Result<f64, String> {
 impl ImuFormat {
     /// Reads and checks a description file.
     pub fn load(path: &Path) -> Result<ImuFormat> {
+        if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+            bail!(
+                "IMU format {}: not a regular file (missing, a directory, a dangling link, a device or a pipe)",
+                path.display()
+            );
+        }
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("--imu-format {}: cannot read the file", path.display()))?;
         ImuFormat::parse(&text, &path.display().to_string())
@@ -179,7 +201,13 @@ impl ImuFormat {
         };
         let raw: RawFormat = toml::from_str(text).map_err(|e| {
             let l = e.span().map(|s| line(s.start + 1)).unwrap_or(0);
-            anyhow!("{origin}:{l}: {}", e.message().trim())
+            let msg = e.message().trim();
+            let msg = if msg.contains("untagged enum ColumnRef") {
+                "a column is a header name (a string) or a 1-based index (a whole number)"
+            } else {
+                msg
+            };
+            anyhow!("{origin}:{l}: {msg}")
         })?;
         let file = raw.file.unwrap_or(RawFile {
             delimiter: None,
@@ -319,7 +347,8 @@ impl ImuFormat {
         for (i, a) in all.iter().enumerate() {
             if all[..i].contains(a) {
                 return Err(anyhow!(
-                    "{origin}: column {a:?} is used twice among time, gyro and accel"
+                    "{origin}: column {} is used twice among time, gyro and accel",
+                    column_words(a)
                 ));
             }
         }
@@ -410,11 +439,18 @@ impl ImuFormat {
     /// Reads a data file described by this format into FRD increments; errors name the data
     /// file and line (or the description's line for a column name it lacks).
     pub fn read(&self, path: &Path) -> Result<ImuData> {
+        if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+            bail!(
+                "{}: not a regular file (missing, a directory, a device or a pipe)",
+                path.display()
+            );
+        }
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read IMU file {}", path.display()))?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let file = path.display().to_string();
         let mut cols: Option<[usize; 7]> = None;
+        let mut width: Option<usize> = None;
         let mut prev: Option<(f64, Vector3<f64>, Vector3<f64>)> = None;
         let mut samples = Vec::new();
         let resolve = |names: &[&str], c: &ColumnRef, lineno: usize| -> Result<usize> {
@@ -442,6 +478,33 @@ impl ImuFormat {
                 } else {
                     Vec::new()
                 };
+                if self.header {
+                    if names.len() == 1 {
+                        if let Some(d) = [',', ';', '\t', '|', ' ']
+                            .iter()
+                            .find(|d| names[0].contains(**d))
+                        {
+                            bail!(
+                                "{file}:{lineno}: the header is one field with `{}` in it: is [file] delimiter right in {}? (it reads `{}`)",
+                                d.escape_debug(),
+                                self.origin,
+                                match self.delimiter {
+                                    Delimiter::Whitespace => "whitespace".to_string(),
+                                    Delimiter::Char(c) => c.escape_debug().to_string(),
+                                }
+                            );
+                        }
+                    }
+                    for (k, n) in names.iter().enumerate() {
+                        if names[..k].contains(n) {
+                            bail!(
+                                "{file}:{lineno}: the header names `{}` twice: name the column by its 1-based index in {}",
+                                n.escape_debug(),
+                                self.origin
+                            );
+                        }
+                    }
+                }
                 let mut c = [0usize; 7];
                 let all = [
                     &self.time,
@@ -455,12 +518,40 @@ impl ImuFormat {
                 for (k, r) in all.iter().enumerate() {
                     c[k] = resolve(&names, r, lineno)?;
                 }
+                for k in 0..7 {
+                    if c[..k].contains(&c[k]) {
+                        bail!(
+                            "{}: column {} is used twice among time, gyro and accel (by name and by index)",
+                            self.origin,
+                            c[k] + 1
+                        );
+                    }
+                }
                 cols = Some(c);
                 if self.header {
+                    width = Some(fields.len());
                     continue;
                 }
             }
             let c = cols.unwrap_or([0; 7]);
+            match width {
+                None => width = Some(fields.len()),
+                Some(w) if w != fields.len() => bail!(
+                    "{file}:{lineno}: {} fields where {} has {w}{}",
+                    fields.len(),
+                    if self.header {
+                        "the header"
+                    } else {
+                        "the first row"
+                    },
+                    if fields.len() > w {
+                        " (a decimal comma, or a delimiter inside a value?)"
+                    } else {
+                        ""
+                    }
+                ),
+                Some(_) => {}
+            }
             let mut v = [0.0f64; 7];
             for k in 0..7 {
                 let f = fields.get(c[k]).ok_or_else(|| {
@@ -470,25 +561,61 @@ impl ImuFormat {
                         c[k] + 1
                     )
                 })?;
+                let shown = || {
+                    f.chars()
+                        .take(40)
+                        .collect::<String>()
+                        .escape_debug()
+                        .to_string()
+                };
                 let x: f64 = f.parse().map_err(|_| {
                     anyhow!(
                         "{file}:{lineno}: column {}: `{}` is not a number",
                         c[k] + 1,
-                        f.chars().take(40).collect::<String>()
+                        shown()
                     )
                 })?;
                 if !x.is_finite() {
-                    bail!("{file}:{lineno}: column {}: `{f}` is not finite", c[k] + 1);
+                    bail!(
+                        "{file}:{lineno}: column {}: `{}` is not finite",
+                        c[k] + 1,
+                        shown()
+                    );
                 }
                 v[k] = x;
             }
             let t = v[0] * self.time_to_s;
             let g = self.axes * Vector3::new(v[1], v[2], v[3]) * self.gyro_to_si;
             let a = self.axes * Vector3::new(v[4], v[5], v[6]) * self.accel_to_si;
+            if !t.is_finite() {
+                bail!(
+                    "{file}:{lineno}: the time is not finite after [time] unit in {}",
+                    self.origin
+                );
+            }
             if let Some((tp, _, _)) = prev {
                 if t <= tp {
                     bail!("{file}:{lineno}: time {t} s does not increase (previous {tp} s)");
                 }
+            }
+            // what any IMU measures: the rate (or increment over the interval) in range
+            let dt_here = prev.map(|p| t - p.0);
+            let (w_rate, f_rate) = match (self.kind, dt_here) {
+                (Kind::Rate, _) => (g.norm(), a.norm()),
+                (Kind::Increment, Some(d)) => (g.norm() / d, a.norm() / d),
+                (Kind::Increment, None) => (0.0, 0.0),
+            };
+            if w_rate.is_nan() || w_rate > MAX_RATE {
+                bail!(
+                    "{file}:{lineno}: angular rate {w_rate:.3e} rad/s is beyond any IMU (<= {MAX_RATE} rad/s): check the value, gyro_unit and [time] unit in {}",
+                    self.origin
+                );
+            }
+            if f_rate.is_nan() || f_rate > MAX_FORCE {
+                bail!(
+                    "{file}:{lineno}: specific force {f_rate:.3e} m/s^2 is beyond any IMU (<= 2000 g): check the value, accel_unit and [time] unit in {}",
+                    self.origin
+                );
             }
             match self.kind {
                 Kind::Increment => samples.push(ImuSample {
@@ -515,7 +642,18 @@ impl ImuFormat {
                 self.origin
             );
         }
-        Ok(ImuData { samples })
+        let data = ImuData { samples };
+        let dt = data.interval();
+        if !(INTERVAL_RANGE.0..=INTERVAL_RANGE.1).contains(&dt) {
+            bail!(
+                "{file}: median sample interval {dt:.3e} s ({:.3e} Hz) is not an IMU's ({} .. {} s): check [time] unit in {}",
+                1.0 / dt,
+                INTERVAL_RANGE.0,
+                INTERVAL_RANGE.1,
+                self.origin
+            );
+        }
+        Ok(data)
     }
 }
 
@@ -524,5 +662,6 @@ pub fn beside(data: &Path) -> Option<std::path::PathBuf> {
     let mut name = data.file_name()?.to_os_string();
     name.push(".format.toml");
     let p = data.with_file_name(name);
-    p.is_file().then_some(p)
+    // anything at that path counts: a directory or a dangling link is reported when loaded
+    std::fs::symlink_metadata(&p).is_ok().then_some(p)
 }

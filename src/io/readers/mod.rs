@@ -23,6 +23,12 @@ pub fn read_any_imu(path: &Path) -> Result<ImuData> {
 /// it (`FILE.format.toml`), else by extension; also returns the words saying which was used.
 pub fn read_imu(path: &Path, format: Option<&Path>) -> Result<(ImuData, String)> {
     use crate::io::imu_format::{beside, ImuFormat};
+    if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+        anyhow::bail!(
+            "--imu {}: cannot read IMU file (missing, or not a regular file: a directory, device or pipe)",
+            path.display()
+        );
+    }
     if let Some(f) = format {
         let fmt = ImuFormat::load(f)?;
         return Ok((fmt.read(path)?, format!("as described by {}", f.display())));
