@@ -14,7 +14,8 @@
 //!   (`NOT_RUN`).
 //!
 //! A command the test does not know (not `sinsmodel …` and not in a list) fails the test, as
-//! does any command exiting non-zero or printing a panic.
+//! does any command exiting non-zero or printing a panic. The `reproduce` commands, which read
+//! nothing the others write, run in order on a second thread in their own scratch directory.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -181,36 +182,26 @@ fn readme_commands_run_verbatim_in_order() {
         std::env::var("PATH").unwrap_or_default()
     );
 
+    // Plan every command first; `sinsmodel reproduce` simulates its own data and reads nothing
+    // the other commands write, so those run in order on a second thread in a scratch
+    // directory of their own, beside the main sequence (the suite has two cores).
     let mut used = vec![false; QUICK.len()];
-    let mut ran = 0;
+    let mut main_seq: Vec<(usize, String)> = Vec::new();
+    let mut side_seq: Vec<(usize, String)> = Vec::new();
     for (line, cmd) in &commands {
-        let shell = match plan(cmd, &mut used) {
-            Ok(s) => s,
-            Err(why) => {
-                eprintln!("README.md:{line}: not run: {cmd}  ({why})");
-                continue;
-            }
-        };
-        let t0 = std::time::Instant::now();
-        let out = Command::new("bash")
-            .args(["-c", &format!("set -euo pipefail; {shell}")])
-            .current_dir(&work)
-            .env("PATH", &path)
-            .output()
-            .expect("bash");
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        eprintln!(
-            "README.md:{line}: {shell}  ({:.1} s)",
-            t0.elapsed().as_secs_f64()
-        );
-        assert!(
-            out.status.success() && !stderr.contains("panicked"),
-            "README.md:{line}: `{shell}` failed ({}):\n{}\n{stderr}",
-            out.status,
-            String::from_utf8_lossy(&out.stdout)
-        );
-        ran += 1;
+        match plan(cmd, &mut used) {
+            Ok(shell) if shell.starts_with("sinsmodel reproduce ") => side_seq.push((*line, shell)),
+            Ok(shell) => main_seq.push((*line, shell)),
+            Err(why) => eprintln!("README.md:{line}: not run: {cmd}  ({why})"),
+        }
     }
+    let side_work = tmp.path().join("side");
+    std::fs::create_dir(&side_work).unwrap();
+    let side = {
+        let path = path.clone();
+        std::thread::spawn(move || run_all(&side_seq, &side_work, &path))
+    };
+    let ran = run_all(&main_seq, &work, &path) + side.join().expect("reproduce commands");
     for (k, (from, _, why)) in QUICK.iter().enumerate() {
         assert!(
             used[k],
@@ -227,6 +218,32 @@ fn readme_commands_run_verbatim_in_order() {
         "{ran} README commands ran, {} not run",
         commands.len() - ran
     );
+}
+
+/// Runs shell lines in order in `dir` with `path`, failing on the first that fails; returns
+/// how many ran.
+fn run_all(seq: &[(usize, String)], dir: &Path, path: &str) -> usize {
+    for (line, shell) in seq {
+        let t0 = std::time::Instant::now();
+        let out = Command::new("bash")
+            .args(["-c", &format!("set -euo pipefail; {shell}")])
+            .current_dir(dir)
+            .env("PATH", path)
+            .output()
+            .expect("bash");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        eprintln!(
+            "README.md:{line}: {shell}  ({:.1} s)",
+            t0.elapsed().as_secs_f64()
+        );
+        assert!(
+            out.status.success() && !stderr.contains("panicked"),
+            "README.md:{line}: `{shell}` failed ({}):\n{}\n{stderr}",
+            out.status,
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
+    seq.len()
 }
 
 #[test]
