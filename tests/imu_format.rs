@@ -766,3 +766,64 @@ fn a_closed_pipe_ends_the_output_quietly() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn scenarios_that_would_hang_or_exhaust_memory_are_refused_before_simulating() {
+    let tmp = tempfile::tempdir().unwrap();
+    let base = "name = \"x\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\nh_m = 0.0\neuler_deg = [0.0, 0.0, 0.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 10.0\n[[vibration]]\nkind = \"sine\"\naxis = \"n\"\namplitude = \"1 g\"\nfreq_hz = 20.0\n";
+    let cases: &[(&str, &str, &str)] = &[
+        ("freq_hz = 20.0", "freq_hz = inf", "freq_hz"),
+        ("freq_hz = 20.0", "freq_hz = 1e9", "freq_hz"),
+        ("imu_rate_hz = 100.0", "imu_rate_hz = 1e9", "imu_rate_hz"),
+        ("lat_deg = 30.0", "lat_deg = nan", "lat_deg"),
+        (
+            "amplitude = \"1 g\"",
+            "amplitude = \"1e308 g\"",
+            "amplitude",
+        ),
+        ("duration_s = 10.0", "duration_s = 1e15", "duration_s"),
+        ("duration_s = 10.0", "duration_s = 1e7", "--force"),
+    ];
+    for (from, to, want) in cases {
+        let f = tmp.path().join("s.toml");
+        std::fs::write(&f, base.replace(from, to)).unwrap();
+        let out = tmp.path().join("o");
+        let t0 = std::time::Instant::now();
+        let (ok, _, err) = sinsmodel(&[
+            "simulate",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            !ok && err.contains(want) && !err.contains("panicked"),
+            "{to}: {err}"
+        );
+        assert!(t0.elapsed().as_secs() < 10, "{to}: took {:?}", t0.elapsed());
+        assert!(!out.exists(), "{to}: an output directory was left");
+    }
+    // a vibration above Nyquist is simulated, with a warning
+    let f = tmp.path().join("s.toml");
+    std::fs::write(&f, base.replace("freq_hz = 20.0", "freq_hz = 80.0")).unwrap();
+    let out = tmp.path().join("o");
+    let (ok, _, err) = sinsmodel(&[
+        "simulate",
+        f.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok && err.contains("Nyquist"), "{err}");
+    // re-running into it replaces the run; a file the user added there stops it
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let (ok, _, err) = sinsmodel(&[
+        "simulate",
+        f.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("notes.txt"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+}

@@ -1,8 +1,9 @@
-//! `sinsmodel simulate SCENARIO.toml --out DIR`.
+//! `sinsmodel simulate SCENARIO.toml --out DIR [--force]`.
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
-use sinsmodel::io::{aiding, atomic_file, imu, truth};
+use sinsmodel::io::atomic_file::{self, OutputDir};
+use sinsmodel::io::{aiding, imu, truth};
 use sinsmodel::report::progress;
 use sinsmodel::sim::scenario::Scenario;
 use sinsmodel::sim::simulator::simulate;
@@ -13,31 +14,59 @@ use std::path::PathBuf;
 pub struct SimulateArgs {
     /// Scenario file (TOML; see scenarios/).
     scenario: PathBuf,
-    /// Output directory: imu.txt, gnss.txt, truth.txt and a copy of the scenario.
+    /// Output directory: imu.txt, gnss.txt (with [gnss]), truth.txt and a copy of the scenario;
+    /// written complete or not at all, replacing only an earlier sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
+    /// Simulate even when the run would exceed the size limit (memory or output size).
+    #[arg(long)]
+    force: bool,
 }
+
+/// Bytes of memory per IMU sample while simulating, and of text per sample in imu.txt
+/// (measured: ~55 B and ~150 B).
+const MEM_PER_SAMPLE: f64 = 60.0;
+const TEXT_PER_SAMPLE: f64 = 160.0;
+/// Above this many bytes of memory or output, `--force` is needed.
+const LIMIT_BYTES: f64 = 4e9;
 
 /// Runs the command.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     let sc = Scenario::load(&args.scenario)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    for w in &sc.warnings {
+        eprintln!("warning: {w}");
+    }
+    let samples = sc.duration() * sc.imu_rate_hz;
+    let (mem, text) = (samples * MEM_PER_SAMPLE, samples * TEXT_PER_SAMPLE);
+    if (mem > LIMIT_BYTES || text > LIMIT_BYTES) && !args.force {
+        bail!(
+            "{}: {:.3e} IMU samples ({:.0} s at {} Hz) need about {:.1} GB of memory and write about {:.1} GB of text; \
+             shorten the scenario or pass --force",
+            args.scenario.display(),
+            samples,
+            sc.duration(),
+            sc.imu_rate_hz,
+            mem / 1e9,
+            text / 1e9
+        );
+    }
+    let out = OutputDir::create(&args.out, &[args.scenario.as_path()])?;
     let pb = progress::bar(1000, "simulate");
     let sim = simulate(&sc, |f| pb.set_position((f * 1000.0) as u64));
     pb.finish_and_clear();
     let header = format!(
-        "sinsmodel simulate {} (scenario `{}`, seed {})",
-        args.scenario.display(),
+        "{} (scenario `{}`, seed {})",
+        super::command_line(),
         sc.name,
         sc.seed
     );
-    imu::write_text(&args.out.join("imu.txt"), &sim.imu, &header)?;
-    truth::write(&args.out.join("truth.txt"), &sim.truth, &header)?;
+    imu::write_text(&out.file("imu.txt"), &sim.imu, &header)?;
+    truth::write(&out.file("truth.txt"), &sim.truth, &header)?;
     if !sim.gnss.is_empty() {
-        aiding::write(&args.out.join("gnss.txt"), &sim.gnss, &header)?;
+        aiding::write(&out.file("gnss.txt"), &sim.gnss, &header)?;
     }
-    atomic_file::write_text(&args.out.join("scenario.toml"), &sc.text)?;
+    atomic_file::write_text(&out.file("scenario.toml"), &sc.text)?;
+    out.commit()?;
     eprintln!(
         "simulated {} IMU samples ({:.1} s at {} Hz), {} truth rows, {} GNSS fixes into {}",
         sim.imu.samples.len(),

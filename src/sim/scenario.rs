@@ -168,6 +168,8 @@ pub struct Scenario {
     pub noise: NoiseSi,
     /// GNSS aiding (rate [Hz], σ_ne [m], σ_d [m], noisy).
     pub gnss: Option<(f64, f64, f64, bool)>,
+    /// Remarks that are not errors (vibration above the IMU's Nyquist frequency).
+    pub warnings: Vec<String>,
     /// The scenario text, for provenance.
     pub text: String,
 }
@@ -188,6 +190,15 @@ pub struct NoiseSi {
     /// Accelerometer quantum [m/s] (0 = none).
     pub accel_quantum: f64,
 }
+
+/// Bounds on scenario quantities (a simulation must end and fit in memory).
+const MAX_RATE_HZ: f64 = 1e5;
+/// Longest segment [s].
+const MAX_DURATION_S: f64 = 1e7;
+/// Highest vibration frequency [Hz].
+const MAX_VIB_HZ: f64 = 1e5;
+/// Most sinusoids in a random vibration.
+const MAX_COMPONENTS: usize = 10_000;
 
 fn line_of(text: &str, needle: &str) -> usize {
     text.lines()
@@ -227,8 +238,11 @@ impl Scenario {
             2000.0
         });
 
-        if !(imu_rate_hz > 0.0 && imu_rate_hz.is_finite()) {
-            bail!("{}: imu_rate_hz must be positive", at("imu_rate_hz"));
+        if !(imu_rate_hz > 0.0 && imu_rate_hz <= MAX_RATE_HZ) {
+            bail!(
+                "{}: imu_rate_hz = {imu_rate_hz} must be in (0, {MAX_RATE_HZ}] Hz",
+                at("imu_rate_hz")
+            );
         }
         if !(raw.truth_rate_hz > 0.0 && raw.truth_rate_hz <= imu_rate_hz) {
             bail!(
@@ -236,17 +250,60 @@ impl Scenario {
                 at("truth_rate_hz")
             );
         }
-        if raw.start.lat_deg.abs() >= 89.0 {
-            bail!("{}: lat_deg must be within ±89°", at("lat_deg"));
+        let st = &raw.start;
+        if st.lat_deg.is_nan() || st.lat_deg.abs() >= 89.0 {
+            bail!(
+                "{}: lat_deg = {} must be within ±89°",
+                at("lat_deg"),
+                st.lat_deg
+            );
+        }
+        if !(-180.0..=360.0).contains(&st.lon_deg) {
+            bail!(
+                "{}: lon_deg = {} must be within -180 .. 360",
+                at("lon_deg"),
+                st.lon_deg
+            );
+        }
+        if st.h_m.is_nan() || st.h_m.abs() > 1e5 {
+            bail!("{}: h_m = {} must be within ±1e5 m", at("h_m"), st.h_m);
+        }
+        if !(st.euler_deg[0].abs() <= 180.0
+            && st.euler_deg[1].abs() <= 90.0
+            && st.euler_deg[2].abs() <= 360.0)
+        {
+            bail!(
+                "{}: euler_deg = {:?}: roll within ±180, pitch within ±90, yaw within ±360 degrees",
+                at("euler_deg"),
+                st.euler_deg
+            );
+        }
+        if !(0.0..=1e4).contains(&st.speed_mps) {
+            bail!(
+                "{}: speed_mps = {} must be in 0 .. 1e4 m/s",
+                at("speed_mps"),
+                st.speed_mps
+            );
         }
         if raw.segment.is_empty() {
             bail!("{origin}: at least one [[segment]] is needed");
         }
+        let mut warnings = Vec::new();
         let mut speed = raw.start.speed_mps;
         for (k, s) in raw.segment.iter().enumerate() {
             let where_ = format!("{origin}: segment {} (`{}`)", k + 1, s.kind);
-            if !(s.duration_s > 0.0 && s.duration_s.is_finite()) {
-                bail!("{where_}: duration_s must be positive");
+            if !(s.duration_s > 0.0 && s.duration_s <= MAX_DURATION_S) {
+                bail!(
+                    "{where_}: duration_s = {} must be in (0, {MAX_DURATION_S}] s",
+                    s.duration_s
+                );
+            }
+            if !(s.accel_mps2.abs() <= 1e3 && s.yaw_rate_deg_s.abs() <= 1e4) {
+                bail!(
+                    "{where_}: accel_mps2 = {} (|a| <= 1000 m/s^2) or yaw_rate_deg_s = {} (|r| <= 1e4 deg/s) out of range",
+                    s.accel_mps2,
+                    s.yaw_rate_deg_s
+                );
             }
             match s.kind.as_str() {
                 "rest" if speed != 0.0 => {
@@ -258,6 +315,9 @@ impl Scenario {
             }
             if speed < 0.0 {
                 bail!("{where_}: speed would become negative");
+            }
+            if speed > 1e4 {
+                bail!("{where_}: speed would exceed 1e4 m/s");
             }
         }
         for v in &raw.vibration {
@@ -284,38 +344,73 @@ impl Scenario {
                         .amplitude
                         .as_deref()
                         .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
-                    units::parse_quantity_as(a, "m/s^2")
+                    let a = units::parse_quantity_as(a, "m/s^2")
                         .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
+                    if a.is_nan() || a.abs() > 1000.0 * units::STANDARD_GRAVITY {
+                        bail!("{where_}: amplitude must be within ±1000 g");
+                    }
                 }
                 "angular" => {
                     let a = v
                         .amplitude
                         .as_deref()
                         .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
-                    units::parse_quantity_as(a, "rad")
+                    let a = units::parse_quantity_as(a, "rad")
                         .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
+                    if a.is_nan() || a.abs() > std::f64::consts::PI {
+                        bail!("{where_}: amplitude must be within ±180 deg");
+                    }
                 }
                 _ => {
                     let p = v
                         .psd
                         .as_deref()
                         .ok_or_else(|| anyhow!("{where_}: psd missing"))?;
-                    units::parse_quantity_as(p, "m^2/s^4/Hz")
+                    let p = units::parse_quantity_as(p, "m^2/s^4/Hz")
                         .map_err(|e| anyhow!("{where_}: psd: {e}"))?;
+                    let g2 = units::STANDARD_GRAVITY.powi(2);
+                    if !(0.0..=100.0 * g2).contains(&p) {
+                        bail!("{where_}: psd must be in 0 .. 100 g^2/Hz");
+                    }
                     let b = v
                         .band_hz
                         .ok_or_else(|| anyhow!("{where_}: band_hz missing"))?;
-                    if !(b[0] > 0.0 && b[1] > b[0]) {
-                        bail!("{where_}: band_hz must be [low, high] with 0 < low < high");
+                    if !(b[0] > 0.0 && b[1] > b[0] && b[1] <= MAX_VIB_HZ) {
+                        bail!("{where_}: band_hz must be [low, high] with 0 < low < high <= {MAX_VIB_HZ} Hz");
+                    }
+                    if b[1] > 0.5 * imu_rate_hz {
+                        warnings.push(format!(
+                            "{where_}: band_hz reaches {} Hz, above the Nyquist frequency of the {imu_rate_hz} Hz IMU: the increments average it away",
+                            b[1]
+                        ));
+                    }
+                    if let Some(c) = v.components {
+                        if !(1..=MAX_COMPONENTS).contains(&c) {
+                            bail!("{where_}: components = {c} must be in 1 ..= {MAX_COMPONENTS}");
+                        }
                     }
                 }
             }
-            if v.kind != "random" && (v.freq_hz.is_nan() || v.freq_hz <= 0.0) {
-                bail!("{where_}: freq_hz must be positive");
+            if v.kind != "random" {
+                if !(v.freq_hz > 0.0 && v.freq_hz <= MAX_VIB_HZ) {
+                    bail!(
+                        "{where_}: freq_hz = {} must be in (0, {MAX_VIB_HZ}] Hz",
+                        v.freq_hz
+                    );
+                }
+                if v.freq_hz > 0.5 * imu_rate_hz {
+                    warnings.push(format!(
+                        "{where_}: freq_hz = {} is above the Nyquist frequency of the {imu_rate_hz} Hz IMU: the increments average it away",
+                        v.freq_hz
+                    ));
+                }
+            }
+            if !v.phase_deg.is_finite() {
+                bail!("{where_}: phase_deg must be finite");
             }
             for w in v.schedule.iter().flatten() {
-                if w[1].is_nan() || w[0].is_nan() || w[1] <= w[0] {
-                    bail!("{where_}: schedule window {w:?} must have end > start");
+                if !(w.iter().all(|x| x.is_finite()) && w[1] > w[0] && w[2].abs() <= 1e3) {
+                    bail!("{where_}: schedule window {w:?} must be finite with end > start and |scale| <= 1000");
                 }
             }
         }
@@ -334,12 +429,21 @@ impl Scenario {
                     common::TERMS[k].unit
                 )
             })?;
+            if !si.is_finite() {
+                bail!("{at_e}: [errors] {name} = {value} is not finite in SI units");
+            }
             errors.push((k, si));
         }
         let q = |v: &Option<String>, unit: &str, key: &str| -> Result<f64> {
             match v {
-                Some(s) => units::parse_quantity_as(s, unit)
-                    .map_err(|e| anyhow!("{}: [noise] {key}: {e}", at(key))),
+                Some(s) => {
+                    let x = units::parse_quantity_as(s, unit)
+                        .map_err(|e| anyhow!("{}: [noise] {key}: {e}", at(key)))?;
+                    if !(x.is_finite() && x >= 0.0) {
+                        bail!("{}: [noise] {key} = {s} must be finite and >= 0", at(key));
+                    }
+                    Ok(x)
+                }
                 None => Ok(0.0),
             }
         };
@@ -364,6 +468,12 @@ impl Scenario {
                     .map_err(|e| anyhow!("{}: [gnss] sigma_ne: {e}", at("sigma_ne")))?;
                 let sd = units::parse_quantity_as(&g.sigma_d, "m")
                     .map_err(|e| anyhow!("{}: [gnss] sigma_d: {e}", at("sigma_d")))?;
+                if !(sne > 0.0 && sne <= 1e4 && sd > 0.0 && sd <= 1e4) {
+                    bail!(
+                        "{}: [gnss] sigma_ne and sigma_d must be in (0, 1e4] m",
+                        at("sigma_ne")
+                    );
+                }
                 Some((g.rate_hz, sne, sd, g.noisy))
             }
             None => None,
@@ -380,6 +490,7 @@ impl Scenario {
             noise,
             gnss,
             text: text.to_string(),
+            warnings,
         })
     }
 }
