@@ -172,3 +172,95 @@ fn simulate_then_navigate_round_trip_through_text() {
         "navigated through the text files to the truth"
     );
 }
+
+#[test]
+fn out_of_range_edges_are_refused_by_option_or_file_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    // a short static IMU log and good aiding
+    let mut imu = String::from("# t dth dv\n");
+    for k in 1..=300 {
+        imu.push_str(&format!("{} 0 0 0 0 0 -0.0979\n", k as f64 * 0.01));
+    }
+    std::fs::write(p("imu.txt"), imu).unwrap();
+    let aid_ok = "1 30 110 0 1 1 1\n2 30 110 0 1 1 1\n";
+    std::fs::write(p("aid.txt"), aid_ok).unwrap();
+    let filter = |extra: &[&str]| {
+        let mut a = vec![
+            "filter".to_string(),
+            "--model".into(),
+            "P13".into(),
+            "--imu".into(),
+            p("imu.txt"),
+            "--out".into(),
+            p("out"),
+        ];
+        a.extend(extra.iter().map(|s| s.to_string()));
+        let refs: Vec<&str> = a.iter().map(|s| s.as_str()).collect();
+        run(&refs)
+    };
+    let aid = p("aid.txt");
+    let (ok, err) = filter(&["--aid", &aid, "--init", "90,110,0,0,0,0"]);
+    assert!(
+        !ok && err.contains("--init") && err.contains("pole"),
+        "{err}"
+    );
+    std::fs::write(p("empty.txt"), "").unwrap();
+    let empty = p("empty.txt");
+    let (ok, err) = filter(&["--aid", &aid, "--init", "30,110,0,0,0,0", "--truth", &empty]);
+    assert!(
+        !ok && err.contains("empty.txt") && err.contains("no data rows"),
+        "{err}"
+    );
+    for (name, text, want) in [
+        ("lat.txt", "1 200 110 0 1 1 1\n", "aid_lat.txt:1: latitude"),
+        ("sig.txt", "1 30 110 0 0 1 1\n", "aid_sig.txt:1: sigma"),
+        ("lon.txt", "1 30 1e9 0 1 1 1\n", "aid_lon.txt:1: longitude"),
+    ] {
+        let f = p(&format!("aid_{name}"));
+        std::fs::write(&f, text).unwrap();
+        let (ok, err) = filter(&["--aid", &f, "--init", "30,110,0,0,0,0"]);
+        assert!(!ok && err.contains(want), "{name}: {err}");
+    }
+    let head = "% GPST latitude(deg) longitude(deg) height(m) Q ns sdn(m) sde(m) sdu(m) sdne(m) sdeu(m) sdun(m) age(s) ratio\n";
+    for (name, row, want) in [
+        (
+            "lat.pos",
+            "2025/07/08 00:00:01.000 200.0 110.0 0.0 1 20 0.01 0.01 0.01 0 0 0 0 0\n",
+            ":2: latitude",
+        ),
+        (
+            "month.pos",
+            "2025/13/08 00:00:01.000 30.0 110.0 0.0 1 20 0.01 0.01 0.01 0 0 0 0 0\n",
+            ":2: bad GPST",
+        ),
+        (
+            "sig.pos",
+            "2025/07/08 00:00:01.000 30.0 110.0 0.0 1 20 -1 0.01 0.01 0 0 0 0 0\n",
+            ":2: a position sigma",
+        ),
+    ] {
+        let f = p(name);
+        std::fs::write(&f, format!("{head}{row}")).unwrap();
+        let (ok, err) = filter(&["--aid", &f, "--init", "30,110,0,0,0,0"]);
+        assert!(!ok && err.contains(want), "{name}: {err}");
+    }
+    let truth = p("truth.txt");
+    std::fs::write(&truth, "0 200 110 0 0 0 0 0 0 0\n").unwrap();
+    let (ok, err) = filter(&["--aid", &aid, "--truth", &truth]);
+    assert!(!ok && err.contains("truth.txt:1: latitude"), "{err}");
+    let imu_p = p("imu.txt");
+    for (opt, val) in [
+        ("--gyro-bias-sigma", "nan"),
+        ("--lon", "nan"),
+        ("--h", "inf"),
+        ("--lat", "nan"),
+    ] {
+        let (ok, err) = run(&["align", "--imu", &imu_p, opt, val]);
+        assert!(!ok && err.contains(opt), "{opt} {val}: {err}");
+    }
+    assert!(
+        !Path::new(&p("out")).exists(),
+        "a refused run left its output directory"
+    );
+}

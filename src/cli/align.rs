@@ -34,8 +34,31 @@ pub struct AlignArgs {
 /// Runs the command.
 pub fn run(args: &AlignArgs) -> Result<()> {
     if let Some(l) = args.lat {
-        if !(-89.0..=89.0).contains(&l) {
+        if !(l.is_finite() && (-89.0..=89.0).contains(&l)) {
             anyhow::bail!("--lat {l} must be within ±89°");
+        }
+    }
+    if !(args.lon.is_finite() && (-180.0..=360.0).contains(&args.lon)) {
+        anyhow::bail!(
+            "--lon {}: expected a longitude in degrees within -180 .. 360",
+            args.lon
+        );
+    }
+    if !(args.h.is_finite() && args.h.abs() <= 1e5) {
+        anyhow::bail!("--h {}: expected a height in metres within ±1e5", args.h);
+    }
+    if !(args.gyro_bias_sigma.is_finite()
+        && args.gyro_bias_sigma > 0.0
+        && args.gyro_bias_sigma <= 3.6e6)
+    {
+        anyhow::bail!(
+            "--gyro-bias-sigma {}: expected a positive gyro-bias sigma in deg/h (at most 3.6e6, i.e. 1000 deg/s)",
+            args.gyro_bias_sigma
+        );
+    }
+    if let Some(s) = args.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            anyhow::bail!("--seconds {s}: expected a positive number of seconds");
         }
     }
     if let Some(j) = &args.json {

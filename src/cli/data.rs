@@ -320,6 +320,12 @@ impl DataArgs {
                         bail!("--init: {} = {x} is outside [{lo}, {hi}] {unit}", names[k]);
                     }
                 }
+                if v[0].abs() >= 89.9 {
+                    bail!(
+                        "--init: lat = {} is at a pole (|lat| < 89.9 deg): the navigation frame is not defined there",
+                        v[0]
+                    );
+                }
                 let c = dcm_from_euler(v[3] * d, v[4] * d, v[5] * d);
                 NavState {
                     t: t0,

@@ -51,11 +51,31 @@ pub fn read(path: &Path) -> Result<Vec<PositionFix>> {
     read_table(path, 7, "aiding file")?
         .into_iter()
         .map(|(line, v)| {
-            if v[4] <= 0.0 || v[5] <= 0.0 || v[6] <= 0.0 {
-                bail!("{}:{line}: sigma must be positive", path.display());
+            if v[4..7].iter().any(|s| !(*s > 0.0 && *s <= 1e5)) {
+                bail!(
+                    "{}:{line}: sigma must be in (0, 1e5] m (got {}, {}, {})",
+                    path.display(),
+                    v[4],
+                    v[5],
+                    v[6]
+                );
             }
-            if v[1].abs() > 90.0 {
-                bail!("{}:{line}: latitude {} outside ±90°", path.display(), v[1]);
+            if v[1].abs() >= 90.0 {
+                bail!(
+                    "{}:{line}: latitude {} outside (-90, 90) deg",
+                    path.display(),
+                    v[1]
+                );
+            }
+            if !(-180.0..=360.0).contains(&v[2]) {
+                bail!(
+                    "{}:{line}: longitude {} outside -180 .. 360 deg",
+                    path.display(),
+                    v[2]
+                );
+            }
+            if v[3].abs() > 1e5 {
+                bail!("{}:{line}: height {} beyond ±1e5 m", path.display(), v[3]);
             }
             Ok(PositionFix {
                 t: v[0],

@@ -68,7 +68,29 @@ pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
 
 /// Reads a truth file (errors name file and line; time must increase).
 pub fn read(path: &Path) -> Result<Vec<TruthRow>> {
-    Ok(read_table(path, 10, "truth file")?
+    let rows = read_table(path, 10, "truth file")?;
+    if rows.is_empty() {
+        anyhow::bail!("{}: the truth file has no data rows", path.display());
+    }
+    for (line, v) in &rows {
+        let what = if v[1].abs() >= 90.0 {
+            Some("latitude outside (-90, 90) deg")
+        } else if !(-180.0..=360.0).contains(&v[2]) {
+            Some("longitude outside -180 .. 360 deg")
+        } else if v[3].abs() > 1e5 {
+            Some("height beyond ±1e5 m")
+        } else if v[4..7].iter().any(|x| x.abs() > 1e4) {
+            Some("velocity beyond ±1e4 m/s")
+        } else if v[7].abs() > 180.0 || v[8].abs() > 90.0 || v[9].abs() > 360.0 {
+            Some("attitude outside roll ±180, pitch ±90, yaw ±360 deg")
+        } else {
+            None
+        };
+        if let Some(w) = what {
+            anyhow::bail!("{}:{line}: {w}", path.display());
+        }
+    }
+    Ok(rows
         .into_iter()
         .map(|(_, v)| TruthRow {
             t: v[0],

@@ -50,8 +50,20 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         }
         let date: Vec<i64> = f[0].split('/').filter_map(|x| x.parse().ok()).collect();
         let time: Vec<f64> = f[1].split(':').filter_map(|x| x.parse().ok()).collect();
-        if date.len() != 3 || time.len() != 3 {
-            bail!("{}: bad GPST date/time `{} {}`", at(), f[0], f[1]);
+        if date.len() != 3
+            || time.len() != 3
+            || !(1..=12).contains(&date[1])
+            || !(1..=31).contains(&date[2])
+            || !(0.0..24.0).contains(&time[0])
+            || !(0.0..60.0).contains(&time[1])
+            || !(0.0..61.0).contains(&time[2])
+        {
+            bail!(
+                "{}: bad GPST date/time `{} {}` (expected YYYY/MM/DD HH:MM:SS.SSS)",
+                at(),
+                f[0].escape_debug(),
+                f[1].escape_debug()
+            );
         }
         let num = |k: usize| -> Result<f64> {
             f[k].parse::<f64>()
@@ -75,7 +87,7 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         } else {
             None
         };
-        out.push(PosEpoch {
+        let e = PosEpoch {
             t,
             lat_deg: num(2)?,
             lon_deg: num(3)?,
@@ -83,7 +95,24 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
             q: num(5)? as u8,
             sigma_neu: [num(7)?, num(8)?, num(9)?],
             v_ned,
-        });
+        };
+        let bad = if e.lat_deg.abs() >= 90.0 {
+            Some("latitude outside (-90, 90) deg")
+        } else if !(-180.0..=360.0).contains(&e.lon_deg) {
+            Some("longitude outside -180 .. 360 deg")
+        } else if e.h.abs() > 1e5 {
+            Some("height beyond ±1e5 m")
+        } else if e.sigma_neu.iter().any(|s| !(0.0..=1e5).contains(s)) {
+            Some("a position sigma outside 0 .. 1e5 m")
+        } else if e.v_ned.is_some_and(|v| v.iter().any(|x| x.abs() > 1e4)) {
+            Some("a velocity beyond ±1e4 m/s")
+        } else {
+            None
+        };
+        if let Some(b) = bad {
+            bail!("{}: {b}", at());
+        }
+        out.push(e);
     }
     if out.is_empty() {
         bail!("{}: no solution epochs", path.display());
