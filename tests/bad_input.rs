@@ -264,3 +264,44 @@ fn out_of_range_edges_are_refused_by_option_or_file_line() {
         "a refused run left its output directory"
     );
 }
+
+#[test]
+fn scenario_keys_are_found_by_whole_name_and_slow_data_does_not_panic_align() {
+    let dir = tempfile::tempdir().unwrap();
+    let scen = "name = \"x\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\nh_m = 0.0\neuler_deg = [0.0, 0.0, 0.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 10.0\n[errors]\nd_xq=\"5e-5 s^2/m\"\n[gnss]\nrate_hz = 1000.0\n";
+    let f = dir.path().join("g.toml");
+    std::fs::write(&f, scen).unwrap();
+    let out = dir.path().join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        f.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("g.toml:12:") && err.contains("d_xq"),
+        "{err}"
+    );
+    std::fs::write(&f, scen.replace("d_xq", "d_x")).unwrap();
+    let (ok, err) = run(&[
+        "simulate",
+        f.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("g.toml:14:") && err.contains("rate_hz"),
+        "{err}"
+    );
+    let slow = dir.path().join("slow.txt");
+    std::fs::write(
+        &slow,
+        "100 0 0 0 0 0 -980\n200 0 0 0 0 0 -980\n300 0 0 0 0 0 -980\n",
+    )
+    .unwrap();
+    let (ok, err) = run(&["align", "--imu", slow.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("1 Hz") && !err.contains("panicked"),
+        "{err}"
+    );
+}

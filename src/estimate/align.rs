@@ -123,6 +123,12 @@ pub fn align(
     gyro_bias_sigma: f64,
 ) -> anyhow::Result<Alignment> {
     let dt = data.interval();
+    // the quiet-window logic works on 10 s windows of samples: at least 1 Hz data
+    if !(dt > 0.0 && dt <= 1.0) {
+        anyhow::bail!(
+            "the IMU interval is {dt} s: alignment needs data at 1 Hz or faster (10 s windows of samples)"
+        );
+    }
     let q0 = quiet_start(data, 10.0);
     let mut used: Vec<ImuSample> = data.samples[q0..].to_vec();
     if let Some(s) = seconds {

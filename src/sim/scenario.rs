@@ -200,9 +200,17 @@ const MAX_VIB_HZ: f64 = 1e5;
 /// Most sinusoids in a random vibration.
 const MAX_COMPONENTS: usize = 10_000;
 
+/// Line (1-based) of the first line that starts with `needle` as a whole key (`rate_hz` does not
+/// match `imu_rate_hz`, `d_x` not `d_xy`); 0 when none does.
 fn line_of(text: &str, needle: &str) -> usize {
+    let needle = needle.trim_end();
+    let ident = |c: char| c.is_alphanumeric() || c == '_';
     text.lines()
-        .position(|l| l.contains(needle))
+        .position(|l| {
+            let l = l.trim_start();
+            l.starts_with(needle)
+                && (needle.ends_with(|c: char| !ident(c)) || !l[needle.len()..].starts_with(ident))
+        })
         .map(|i| i + 1)
         .unwrap_or(0)
 }
