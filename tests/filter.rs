@@ -234,3 +234,48 @@ fn position_update_at(lat_deg: &str) {
         "lat {lat_deg}: dlat {e_lat:.2e}, dlon {e_lon:.2e}"
     );
 }
+
+#[test]
+fn a_nan_or_negative_variance_stops_the_run_instead_of_printing_sigma_zero() {
+    use nalgebra::{UnitQuaternion, Vector3};
+    use sinsmodel::estimate::filter::{FilterRun, Innovation, Record};
+    use sinsmodel::nav::strapdown::NavState;
+    let nav = NavState {
+        t: 1.0,
+        lat: 0.5,
+        lon: 2.0,
+        h: 0.0,
+        v: Vector3::zeros(),
+        q: UnitQuaternion::identity(),
+    };
+    let rec = |sigma: f64| Record {
+        t: 1.0,
+        x: vec![0.0; 2],
+        sigma: vec![1.0, sigma],
+        phi_true: None,
+        phi_est: Vector3::zeros(),
+        pos_err_ne: None,
+        nav,
+        cov: None,
+    };
+    let run = |sigma: f64| FilterRun {
+        names: vec!["a", "b"],
+        records: vec![rec(sigma)],
+        innovations: vec![Innovation {
+            t: 1.0,
+            meas: "pos_ne",
+            component: 0,
+            nu: 0.1,
+            s: 1.0,
+        }],
+        final_state: nav,
+        nonfinite_updates: 0,
+        first_nonfinite_t: None,
+    };
+    assert!(run(0.5).check().is_ok());
+    let err = run(f64::NAN).check().unwrap_err();
+    assert!(
+        err.contains("diverged") && err.contains("t = 1.000"),
+        "{err}"
+    );
+}

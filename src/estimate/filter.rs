@@ -208,7 +208,7 @@ impl FilterRun {
             .find(|r| r.x.iter().chain(&r.sigma).any(|v| !v.is_finite()))
         {
             return Err(format!(
-                "the filter diverged: non-finite state estimates at t = {:.3} s; check --init, --prior, --noise and the IMU values",
+                "the filter diverged: non-finite state estimates or a negative variance at t = {:.3} s; check --init, --prior, --noise and the IMU values",
                 r.t
             ));
         }
@@ -541,7 +541,19 @@ impl<'a> Engine<'a> {
         self.records.push(Record {
             t: ep.t,
             x: xr,
-            sigma: (0..n).map(|i| self.p[i * n + i].max(0.0).sqrt()).collect(),
+            // a NaN variance, or one negative beyond round-off, is kept as NaN (never shown as
+            // σ = 0): `FilterRun::check` then stops the run with the time it happened
+            sigma: (0..n)
+                .map(|i| {
+                    let v = self.p[i * n + i];
+                    let tol = 1e-9 * self.cfg.prior_sigma[i].powi(2);
+                    if v.is_nan() || v < -tol {
+                        f64::NAN
+                    } else {
+                        v.max(0.0).sqrt()
+                    }
+                })
+                .collect(),
             phi_true,
             phi_est,
             pos_err_ne,
