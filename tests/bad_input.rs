@@ -81,7 +81,12 @@ fn imu_text_errors_name_file_line_and_problem() {
     let (ok, err) = navigate(&p, &out);
     assert!(ok, "{err}");
     assert!(out.exists());
-    assert!(!dir.path().join("nav.txt.partial").exists());
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 
 #[test]

@@ -13,7 +13,8 @@ pub struct AtomicFile {
 }
 
 impl AtomicFile {
-    /// Starts writing `target` (through `target` + `.partial`), creating its directory.
+    /// Starts writing `target` (through `target.partial-PID-N`, unique per process and file),
+    /// creating its directory.
     pub fn create(target: &Path) -> Result<AtomicFile> {
         if let Ok(m) = std::fs::symlink_metadata(target) {
             if !m.is_file() && !std::fs::metadata(target).is_ok_and(|m| m.is_file()) {
@@ -27,8 +28,11 @@ impl AtomicFile {
             std::fs::create_dir_all(parent)
                 .with_context(|| format!("cannot create {}", parent.display()))?;
         }
+        // unique per process and file: concurrent runs never share a temporary
+        static SERIAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let mut tmp = target.as_os_str().to_owned();
-        tmp.push(".partial");
+        tmp.push(format!(".partial-{}-{k}", std::process::id()));
         let tmp = PathBuf::from(tmp);
         let f = std::fs::File::create(&tmp)
             .with_context(|| format!("cannot create {}", tmp.display()))?;
@@ -47,8 +51,15 @@ impl AtomicFile {
     /// Flushes and renames into place.
     pub fn commit(mut self) -> Result<()> {
         let mut w = self.out.take().expect("not committed");
-        w.flush()
-            .with_context(|| format!("cannot write {}", self.tmp.display()))?;
+        if let Err(e) = w.flush().and_then(|_| w.get_ref().sync_all()) {
+            drop(w);
+            let _ = std::fs::remove_file(&self.tmp);
+            anyhow::bail!(
+                "cannot write {} (for {}): {e}",
+                self.tmp.display(),
+                self.target.display()
+            );
+        }
         drop(w);
         std::fs::rename(&self.tmp, &self.target).map_err(|e| {
             let _ = std::fs::remove_file(&self.tmp);
@@ -208,6 +219,22 @@ impl Drop for OutputDir {
 /// (also through a link) or exists as something other than a regular file; call it before the
 /// computation.
 pub fn check_output_file(option: &str, path: &Path, inputs: &[&Path]) -> Result<()> {
+    // writable before minutes of work: create the directory and a probe file in it
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| {
+            format!(
+                "{option} {}: cannot create {}",
+                path.display(),
+                parent.display()
+            )
+        })?;
+    }
+    let mut probe = path.as_os_str().to_owned();
+    probe.push(format!(".probe-{}", std::process::id()));
+    let probe = PathBuf::from(probe);
+    std::fs::File::create(&probe)
+        .with_context(|| format!("{option} {}: cannot write there", path.display()))?;
+    let _ = std::fs::remove_file(&probe);
     if let Ok(m) = std::fs::metadata(path) {
         if !m.is_file() {
             anyhow::bail!(
