@@ -3,7 +3,7 @@
 //! deviation on the static start.
 
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::estimate::allan::{fit, oadev};
+use sinsmodel::estimate::allan::{fit, oadev, uniform_rates};
 use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
 use sinsmodel::io::readers::{gnss_imu, rtklib};
 use sinsmodel::model::Model;
@@ -30,18 +30,15 @@ fn mems_drive_mounting_and_noise_identification() {
     let dt = log.imu.interval();
     let t0 = log.imu.samples[0].t;
     let stat: Vec<_> = log.imu.samples.iter().filter(|s| s.t < t0 + 30.0).collect();
+    // the clock jitters (8–11 ms): increments resampled in time, as `sinsmodel allan` does
+    let times: Vec<f64> = stat.iter().map(|s| s.t).collect();
     let dens = |c: usize| {
-        let y: Vec<f64> = stat
+        let inc: Vec<f64> = stat
             .iter()
-            .map(|s| {
-                if c < 3 {
-                    s.dtheta[c] / dt
-                } else {
-                    s.dv[c - 3] / dt
-                }
-            })
+            .map(|s| if c < 3 { s.dtheta[c] } else { s.dv[c - 3] })
             .collect();
-        fit(&oadev(&y, dt)).white
+        let (y, t) = uniform_rates(&times, &inc);
+        fit(&oadev(&y, t)).white
     };
     let arw = ((0..3).map(|c| dens(c).powi(2)).sum::<f64>() / 3.0).sqrt();
     let vrw = ((3..6).map(|c| dens(c).powi(2)).sum::<f64>() / 3.0).sqrt();

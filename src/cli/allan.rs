@@ -71,19 +71,37 @@ pub fn run(args: &AllanArgs) -> Result<()> {
             args.src.imu.display()
         );
     }
+    // a jittered clock: each increment keeps its own interval (cumulative integral resampled
+    // to a uniform grid); dividing by one interval would turn the jitter times the mean (gravity
+    // on an accelerometer) into noise
+    let times: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    let jitter = {
+        let d: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+        (d.iter().map(|x| (x - dt).powi(2)).sum::<f64>() / d.len().max(1) as f64).sqrt() / dt
+    };
+    let resample = jitter > 1e-6;
+    if resample {
+        eprintln!(
+            "note: the clock jitters ({:.2} % RMS of the {dt:.6} s interval): the increments are integrated in time and resampled to a uniform {dt:.6} s grid",
+            100.0 * jitter
+        );
+    }
+    let channel = |c: usize| -> Vec<f64> {
+        samples
+            .iter()
+            .map(|s| if c < 3 { s.dtheta[c] } else { s.dv[c - 3] })
+            .collect()
+    };
     let curves: Vec<AllanCurve> = (0..6)
         .map(|c| {
-            let y: Vec<f64> = samples
-                .iter()
-                .map(|s| {
-                    if c < 3 {
-                        s.dtheta[c] / dt
-                    } else {
-                        s.dv[c - 3] / dt
-                    }
-                })
-                .collect();
-            oadev(&y, dt)
+            let inc = channel(c);
+            if resample {
+                let (y, t) = sinsmodel::estimate::allan::uniform_rates(&times, &inc);
+                oadev(&y, t)
+            } else {
+                let y: Vec<f64> = inc.iter().map(|v| v / dt).collect();
+                oadev(&y, dt)
+            }
         })
         .collect();
     let mut out = Out {

@@ -60,6 +60,45 @@ pub fn oadev(y: &[f64], dt: f64) -> AllanCurve {
     }
 }
 
+/// Rates on a uniform grid from increments on any clock: the increments `inc[k]` over
+/// (t[k−1], t[k]] are summed into their cumulative integral, which is interpolated linearly at
+/// t[0] + m·T (T = the median interval) and differenced: y_m = (Θ(t_{m+1}) − Θ(t_m)) / T. On a
+/// uniform clock this returns inc[k]/T exactly; on a jittered one each increment keeps its own
+/// interval. Returns (rates, T).
+pub fn uniform_rates(t: &[f64], inc: &[f64]) -> (Vec<f64>, f64) {
+    let n = t.len().min(inc.len());
+    if n < 3 {
+        return (Vec::new(), 0.0);
+    }
+    let mut d: Vec<f64> = t[..n].windows(2).map(|w| w[1] - w[0]).collect();
+    d.sort_by(f64::total_cmp);
+    let dt = d[d.len() / 2];
+    // cumulative integral at the sample times, starting at t[0] (the first increment, whose
+    // interval start is unknown, is not used)
+    let mut cum = Vec::with_capacity(n);
+    cum.push(0.0);
+    for k in 1..n {
+        cum.push(cum[k - 1] + inc[k]);
+    }
+    let span = t[n - 1] - t[0];
+    let m_max = (span / dt).floor() as usize;
+    let mut out = Vec::with_capacity(m_max);
+    let mut j = 0usize;
+    let mut prev = 0.0;
+    for m in 1..=m_max {
+        let tm = t[0] + m as f64 * dt;
+        while j + 1 < n - 1 && t[j + 1] < tm {
+            j += 1;
+        }
+        let (ta, tb) = (t[j], t[j + 1]);
+        let f = ((tm - ta) / (tb - ta)).clamp(0.0, 1.0);
+        let v = cum[j] + f * (cum[j + 1] - cum[j]);
+        out.push((v - prev) / dt);
+        prev = v;
+    }
+    (out, dt)
+}
+
 /// Classic noise terms read off an Allan curve.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct NoiseFit {
@@ -215,5 +254,62 @@ mod tests {
         assert!(rising, "the test needs a +1/2 segment on the bump: {c:?}");
         let f = fit(&c);
         assert!(f.random_walk.is_nan(), "{f:?}");
+    }
+
+    #[test]
+    fn a_jittered_clock_gives_the_uniform_clock_answer() {
+        // one white rate process riding on a large mean (gravity on an accelerometer) on a 1 ms
+        // grid, integrated over (a) uniform 10 ms intervals and (b) intervals jittering between
+        // 6 and 14 ms; ADEV of both agree within 2 %
+        let mut rng = Rng::new(21);
+        let fine_dt: f64 = 1e-3;
+        let dens = 3e-3;
+        let n_fine = 2_000_000;
+        let fine: Vec<f64> = (0..n_fine)
+            .map(|_| (9.8 + dens / fine_dt.sqrt() * rng.normal()) * fine_dt)
+            .collect();
+        let sample = |steps: &mut dyn FnMut() -> usize| {
+            let (mut t, mut inc) = (vec![0.0], vec![0.0]);
+            let mut k = 0;
+            loop {
+                let s = steps();
+                if k + s > n_fine {
+                    break;
+                }
+                inc.push(fine[k..k + s].iter().sum::<f64>());
+                k += s;
+                t.push(k as f64 * fine_dt);
+            }
+            (t, inc)
+        };
+        let (tu, iu) = sample(&mut || 10);
+        let mut jr = Rng::new(5);
+        let (tj, ij) =
+            sample(&mut || (10.0 + (jr.normal() * 2.5).round()).clamp(6.0, 14.0) as usize);
+        let (yu, dtu) = uniform_rates(&tu, &iu);
+        let (yj, dtj) = uniform_rates(&tj, &ij);
+        let (cu, cj) = (oadev(&yu, dtu), oadev(&yj, dtj));
+        let mut compared = 0;
+        for (k, tau) in cu.tau_s.iter().enumerate() {
+            if *tau < 0.1 || *tau > 100.0 {
+                continue;
+            }
+            let kj = cj
+                .tau_s
+                .iter()
+                .position(|x| (x / tau - 1.0).abs() < 0.2)
+                .expect("matching tau");
+            let r = cj.adev[kj] * cj.tau_s[kj].sqrt() / (cu.adev[k] * tau.sqrt());
+            assert!((r - 1.0).abs() < 0.02, "tau {tau}: jittered/uniform {r}");
+            compared += 1;
+        }
+        assert!(compared >= 5);
+        // dividing by the median interval instead (the old way) is off by more than 2 %
+        let naive: Vec<f64> = ij[1..].iter().map(|v| v / dtj).collect();
+        let cn = oadev(&naive, dtj);
+        let k = cn.tau_s.iter().position(|t| *t >= 1.0).unwrap();
+        let ku = cu.tau_s.iter().position(|t| *t >= 1.0).unwrap();
+        let r = cn.adev[k] * cn.tau_s[k].sqrt() / (cu.adev[ku] * cu.tau_s[ku].sqrt());
+        assert!((r - 1.0).abs() > 0.02, "naive ratio {r}");
     }
 }
