@@ -118,6 +118,27 @@ fn navigate_names_its_inputs_and_reports_the_drift() {
         p(&out),
     ]);
     assert!(!ok && err.contains("--att"), "{err}");
+    for (opt, bad) in [("--att", "0,95,0"), ("--lon", "nan"), ("--h", "inf")] {
+        let mut a = vec![
+            "navigate",
+            "--imu",
+            p(&imu),
+            "--lat",
+            "28.22",
+            "--lon",
+            "112.99",
+            "--att",
+            "0,0,0",
+            "--out",
+            p(&out),
+        ];
+        match a.iter().position(|x| *x == opt) {
+            Some(k) => a[k + 1] = bad,
+            None => a.extend([opt, bad]),
+        }
+        let (ok, _, err) = sinsmodel(&a);
+        assert!(!ok && err.contains(opt), "{opt} {bad}: {err}");
+    }
     let (ok, _, err) = sinsmodel(&[
         "navigate",
         "--imu",

@@ -38,14 +38,12 @@ pub fn run(args: &AlignArgs) -> Result<()> {
             anyhow::bail!("--lat {l} must be within ±89°");
         }
     }
-    if !(args.lon.is_finite() && (-180.0..=360.0).contains(&args.lon)) {
-        anyhow::bail!(
-            "--lon {}: expected a longitude in degrees within -180 .. 360",
-            args.lon
-        );
+    use sinsmodel::io::bounds;
+    if let Some(p) = bounds::lon_deg(args.lon) {
+        anyhow::bail!("--lon: {p}");
     }
-    if !(args.h.is_finite() && args.h.abs() <= 1e5) {
-        anyhow::bail!("--h {}: expected a height in metres within ±1e5", args.h);
+    if let Some(p) = bounds::height_m(args.h) {
+        anyhow::bail!("--h: {p}");
     }
     if !(args.gyro_bias_sigma.is_finite()
         && args.gyro_bias_sigma > 0.0

@@ -7,6 +7,7 @@ use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::allan::{fit, oadev, AllanCurve, NoiseFit};
 use sinsmodel::io::atomic_file;
+use sinsmodel::io::imu::ImuData;
 use sinsmodel::report::plot::{line_plot, Scale, Series};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -60,11 +61,15 @@ pub fn run(args: &AllanArgs) -> Result<()> {
     let dt = data.interval();
     let t0 = data.samples[0].t + args.skip;
     let t1 = args.seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);
-    let samples: Vec<_> = data
-        .samples
-        .iter()
-        .filter(|s| s.t >= t0 && s.t < t1)
-        .collect();
+    let span = ImuData {
+        samples: data
+            .samples
+            .iter()
+            .filter(|s| s.t >= t0 && s.t < t1)
+            .copied()
+            .collect(),
+    };
+    let samples = &span.samples;
     if samples.len() < 16 {
         anyhow::bail!(
             "{}: fewer than 16 samples in the chosen span",
@@ -75,10 +80,7 @@ pub fn run(args: &AllanArgs) -> Result<()> {
     // to a uniform grid); dividing by one interval would turn the jitter times the mean (gravity
     // on an accelerometer) into noise
     let times: Vec<f64> = samples.iter().map(|s| s.t).collect();
-    let jitter = {
-        let d: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-        (d.iter().map(|x| (x - dt).powi(2)).sum::<f64>() / d.len().max(1) as f64).sqrt() / dt
-    };
+    let jitter = span.jitter_rms() / dt;
     let resample = jitter > 1e-6;
     if resample {
         eprintln!(

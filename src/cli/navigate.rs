@@ -51,11 +51,9 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.lat.abs() >= 89.0 || !args.lat.is_finite() {
         bail!("--lat {} must be within ±89°", args.lat);
     }
+    use sinsmodel::io::bounds;
     if args.att.len() != 3
-        || args.att.iter().any(|a| !a.is_finite())
-        || args.att[0].abs() > 180.0
-        || args.att[1].abs() > 90.0
-        || args.att[2].abs() > 360.0
+        || bounds::attitude_deg([args.att[0], args.att[1], args.att[2]]).is_some()
     {
         bail!(
             "--att {}: expected roll,pitch,yaw in degrees (roll within ±180, pitch within ±90, yaw within ±360)",
@@ -69,14 +67,11 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     {
         bail!("--vel: expected N,E,D in m/s (three finite comma-separated numbers within ±1e4)");
     }
-    if !args.lon.is_finite() || args.lon.abs() > 360.0 {
-        bail!(
-            "--lon {}: expected a longitude in degrees within ±360",
-            args.lon
-        );
+    if let Some(p) = bounds::lon_deg(args.lon) {
+        bail!("--lon: {p}");
     }
-    if !args.h.is_finite() || args.h.abs() > 1e5 {
-        bail!("--h {}: expected a height in metres within ±1e5", args.h);
+    if let Some(p) = bounds::height_m(args.h) {
+        bail!("--h: {p}");
     }
     if args.out_rate.is_nan() || args.out_rate <= 0.0 {
         bail!("--out-rate must be positive");

@@ -69,12 +69,7 @@ pub fn check(
     let s = &imu.samples;
     let mut intervals: Vec<f64> = s.windows(2).map(|w| w[1].t - w[0].t).collect();
     let median = imu.interval();
-    let jitter = if intervals.is_empty() {
-        0.0
-    } else {
-        (intervals.iter().map(|d| (d - median).powi(2)).sum::<f64>() / intervals.len() as f64)
-            .sqrt()
-    };
+    let jitter = imu.jitter_rms();
     let gaps = intervals.iter().filter(|d| **d > 2.0 * median).count();
     intervals.sort_by(f64::total_cmp);
     let t_first = s.first().map(|x| x.t).unwrap_or(0.0);

@@ -60,22 +60,12 @@ pub fn read(path: &Path) -> Result<Vec<PositionFix>> {
                     v[6]
                 );
             }
-            if v[1].abs() >= 90.0 {
-                bail!(
-                    "{}:{line}: latitude {} outside (-90, 90) deg",
-                    path.display(),
-                    v[1]
-                );
-            }
-            if !(-180.0..=360.0).contains(&v[2]) {
-                bail!(
-                    "{}:{line}: longitude {} outside -180 .. 360 deg",
-                    path.display(),
-                    v[2]
-                );
-            }
-            if v[3].abs() > 1e5 {
-                bail!("{}:{line}: height {} beyond ±1e5 m", path.display(), v[3]);
+            use crate::io::bounds;
+            if let Some(p) = bounds::lat_deg(v[1])
+                .or_else(|| bounds::lon_deg(v[2]))
+                .or_else(|| bounds::height_m(v[3]))
+            {
+                bail!("{}:{line}: {p}", path.display());
             }
             Ok(PositionFix {
                 t: v[0],

@@ -37,6 +37,21 @@ impl ImuData {
         d[d.len() / 2]
     }
 
+    /// RMS deviation of the sample intervals from their median [s] (0 on a uniform clock).
+    pub fn jitter_rms(&self) -> f64 {
+        let median = self.interval();
+        let n = self.samples.len().saturating_sub(1);
+        if n == 0 {
+            return 0.0;
+        }
+        let ss: f64 = self
+            .samples
+            .windows(2)
+            .map(|w| (w[1].t - w[0].t - median).powi(2))
+            .sum();
+        (ss / n as f64).sqrt()
+    }
+
     /// Sample rate [Hz] from the median interval.
     pub fn rate_hz(&self) -> f64 {
         1.0 / self.interval()

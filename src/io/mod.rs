@@ -3,6 +3,7 @@
 
 pub mod aiding;
 pub mod atomic_file;
+pub mod bounds;
 pub mod fixed;
 pub mod imu;
 pub mod imu_format;

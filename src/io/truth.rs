@@ -73,19 +73,17 @@ pub fn read(path: &Path) -> Result<Vec<TruthRow>> {
         anyhow::bail!("{}: the truth file has no data rows", path.display());
     }
     for (line, v) in &rows {
-        let what = if v[1].abs() >= 90.0 {
-            Some("latitude outside (-90, 90) deg")
-        } else if !(-180.0..=360.0).contains(&v[2]) {
-            Some("longitude outside -180 .. 360 deg")
-        } else if v[3].abs() > 1e5 {
-            Some("height beyond ±1e5 m")
-        } else if v[4..7].iter().any(|x| x.abs() > 1e4) {
-            Some("velocity beyond ±1e4 m/s")
-        } else if v[7].abs() > 180.0 || v[8].abs() > 90.0 || v[9].abs() > 360.0 {
-            Some("attitude outside roll ±180, pitch ±90, yaw ±360 deg")
-        } else {
-            None
-        };
+        use crate::io::bounds;
+        let what = bounds::lat_deg(v[1])
+            .or_else(|| bounds::lon_deg(v[2]))
+            .or_else(|| bounds::height_m(v[3]))
+            .or_else(|| {
+                v[4..7]
+                    .iter()
+                    .any(|x| x.abs() > 1e4)
+                    .then(|| "velocity beyond ±1e4 m/s".to_string())
+            })
+            .or_else(|| bounds::attitude_deg([v[7], v[8], v[9]]));
         if let Some(w) = what {
             anyhow::bail!("{}:{line}: {w}", path.display());
         }

@@ -266,25 +266,15 @@ impl Scenario {
                 st.lat_deg
             );
         }
-        if !(-180.0..=360.0).contains(&st.lon_deg) {
-            bail!(
-                "{}: lon_deg = {} must be within -180 .. 360",
-                at("lon_deg"),
-                st.lon_deg
-            );
+        use crate::io::bounds;
+        if let Some(p) = bounds::lon_deg(st.lon_deg) {
+            bail!("{}: lon_deg: {p}", at("lon_deg"));
         }
-        if st.h_m.is_nan() || st.h_m.abs() > 1e5 {
-            bail!("{}: h_m = {} must be within ±1e5 m", at("h_m"), st.h_m);
+        if let Some(p) = bounds::height_m(st.h_m) {
+            bail!("{}: h_m: {p}", at("h_m"));
         }
-        if !(st.euler_deg[0].abs() <= 180.0
-            && st.euler_deg[1].abs() <= 90.0
-            && st.euler_deg[2].abs() <= 360.0)
-        {
-            bail!(
-                "{}: euler_deg = {:?}: roll within ±180, pitch within ±90, yaw within ±360 degrees",
-                at("euler_deg"),
-                st.euler_deg
-            );
+        if let Some(p) = bounds::attitude_deg(st.euler_deg) {
+            bail!("{}: euler_deg: {p}", at("euler_deg"));
         }
         if !(0.0..=1e4).contains(&st.speed_mps) {
             bail!(

@@ -96,19 +96,21 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
             sigma_neu: [num(7)?, num(8)?, num(9)?],
             v_ned,
         };
-        let bad = if e.lat_deg.abs() >= 90.0 {
-            Some("latitude outside (-90, 90) deg")
-        } else if !(-180.0..=360.0).contains(&e.lon_deg) {
-            Some("longitude outside -180 .. 360 deg")
-        } else if e.h.abs() > 1e5 {
-            Some("height beyond ±1e5 m")
-        } else if e.sigma_neu.iter().any(|s| !(0.0..=1e5).contains(s)) {
-            Some("a position sigma outside 0 .. 1e5 m")
-        } else if e.v_ned.is_some_and(|v| v.iter().any(|x| x.abs() > 1e4)) {
-            Some("a velocity beyond ±1e4 m/s")
-        } else {
-            None
-        };
+        use crate::io::bounds;
+        let bad = bounds::lat_deg(e.lat_deg)
+            .or_else(|| bounds::lon_deg(e.lon_deg))
+            .or_else(|| bounds::height_m(e.h))
+            .or_else(|| {
+                e.sigma_neu
+                    .iter()
+                    .any(|s| !(0.0..=1e5).contains(s))
+                    .then(|| "a position sigma outside 0 .. 1e5 m".to_string())
+            })
+            .or_else(|| {
+                e.v_ned
+                    .is_some_and(|v| v.iter().any(|x| x.abs() > 1e4))
+                    .then(|| "a velocity beyond ±1e4 m/s".to_string())
+            });
         if let Some(b) = bad {
             bail!("{}: {b}", at());
         }

@@ -1,0 +1,43 @@
+//! Physical ranges of the quantities that enter from outside (options and file rows), in one
+//! place: each function returns the problem in words, or None when the value is plausible.
+//! Degrees at the edge, as the files and options write them.
+
+/// Latitude [deg]: finite and inside (−90, 90) (the navigation frame is undefined at a pole).
+pub fn lat_deg(v: f64) -> Option<String> {
+    (v.is_nan() || v.abs() >= 90.0).then(|| format!("latitude {v} outside (-90, 90) deg"))
+}
+
+/// Longitude [deg]: finite, −180 ..= 360.
+pub fn lon_deg(v: f64) -> Option<String> {
+    (!(-180.0..=360.0).contains(&v)).then(|| format!("longitude {v} outside -180 .. 360 deg"))
+}
+
+/// Height [m]: finite, within ±1e5.
+pub fn height_m(v: f64) -> Option<String> {
+    (v.is_nan() || v.abs() > 1e5).then(|| format!("height {v} beyond ±1e5 m"))
+}
+
+/// Roll, pitch, yaw [deg]: roll ±180, pitch ±90, yaw ±360.
+pub fn attitude_deg(rpy: [f64; 3]) -> Option<String> {
+    let ok = rpy[0].abs() <= 180.0 && rpy[1].abs() <= 90.0 && rpy[2].abs() <= 360.0;
+    (!ok).then(|| format!("attitude {rpy:?} outside roll ±180, pitch ±90, yaw ±360 deg"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edges_and_non_finite_values() {
+        assert!(lat_deg(89.9).is_none() && lat_deg(90.0).is_some() && lat_deg(f64::NAN).is_some());
+        assert!(
+            lon_deg(360.0).is_none() && lon_deg(-181.0).is_some() && lon_deg(f64::NAN).is_some()
+        );
+        assert!(height_m(-1e5).is_none() && height_m(f64::INFINITY).is_some());
+        assert!(attitude_deg([180.0, -90.0, 360.0]).is_none());
+        assert!(
+            attitude_deg([0.0, 95.0, 0.0]).is_some()
+                && attitude_deg([f64::NAN, 0.0, 0.0]).is_some()
+        );
+    }
+}
