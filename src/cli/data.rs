@@ -6,7 +6,7 @@ use clap::Args;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use sinsmodel::estimate::filter::{AidingEpoch, FilterConfig, Mode};
 use sinsmodel::io::imu::ImuData;
-use sinsmodel::io::truth::TruthRow;
+use sinsmodel::io::truth::{TruthLookup, TruthRow};
 use sinsmodel::io::{aiding, readers, truth};
 use sinsmodel::model::Model;
 use sinsmodel::nav::attitude::dcm_from_euler;
@@ -31,6 +31,14 @@ impl ImuSource {
         let (data, how) = readers::read_imu(&self.imu, self.imu_format.as_deref())?;
         eprintln!("reading {} {how}", self.imu.display());
         Ok(data)
+    }
+
+    /// Opens the IMU file as a stream of validated samples; says on stderr which format was used.
+    pub fn open(&self) -> Result<sinsmodel::io::imu_stream::ImuStream> {
+        let (stream, how) =
+            sinsmodel::io::imu_stream::ImuStream::open(&self.imu, self.imu_format.as_deref())?;
+        eprintln!("reading {} {how}", self.imu.display());
+        Ok(stream)
     }
 
     /// The input files (so outputs never land on them).
@@ -102,6 +110,78 @@ pub struct Inputs {
     pub truth: Option<Vec<TruthRow>>,
     /// Initial navigation state.
     pub start: NavState,
+}
+
+/// The data options opened for one streamed pass.
+pub struct Opened {
+    /// IMU samples, validated as they are read.
+    pub imu: sinsmodel::io::imu_stream::ImuStream,
+    /// Aiding epochs after the start.
+    pub aid: AidPlan,
+    /// Truth, read as the run advances.
+    pub truth: Option<truth::TruthReader>,
+    /// Initial navigation state.
+    pub start: NavState,
+}
+
+/// Where the aiding epochs come from.
+pub enum AidPlan {
+    /// Fixes from a file, with the ZUPT σ [m/s] to add to each.
+    Fixes(Vec<aiding::PositionFix>, Option<f64>),
+    /// A static vehicle: this fix every whole second from `first_s`, with a ZUPT σ [m/s].
+    Static {
+        /// The position (its `t` unused).
+        fix: aiding::PositionFix,
+        /// Time of the first epoch [s].
+        first_s: f64,
+        /// Zero-velocity σ [m/s].
+        zupt: Option<f64>,
+    },
+}
+
+impl AidPlan {
+    /// Only the epochs after `t0`.
+    fn after(self, t0: f64) -> AidPlan {
+        match self {
+            AidPlan::Fixes(f, z) => AidPlan::Fixes(f.into_iter().filter(|f| f.t > t0).collect(), z),
+            s => s,
+        }
+    }
+
+    /// Number of epochs from a file (0 for the endless static plan).
+    pub fn len(&self) -> usize {
+        match self {
+            AidPlan::Fixes(f, _) => f.len(),
+            AidPlan::Static { .. } => 0,
+        }
+    }
+
+    /// The epochs in time order (endless for a static vehicle: the run ends with the IMU data).
+    pub fn epochs(&self) -> Box<dyn Iterator<Item = AidingEpoch> + '_> {
+        let epoch = |f: &aiding::PositionFix, t: f64, zupt: Option<f64>| AidingEpoch {
+            t,
+            vel: zupt.map(|s| (Vector3::zeros(), s)),
+            pos: Some((f.lat, f.lon, f.h, f.sigma)),
+        };
+        match self {
+            AidPlan::Fixes(f, zupt) => Box::new(f.iter().map(move |f| epoch(f, f.t, *zupt))),
+            AidPlan::Static { fix, first_s, zupt } => {
+                Box::new((0u64..).map(move |k| epoch(fix, first_s + k as f64, *zupt)))
+            }
+        }
+    }
+}
+
+/// At least 10 aiding epochs must have fallen inside the IMU data (t0, t_last]: `used` of
+/// `total` (0: a static plan) did.
+pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<()> {
+    if used < 10 {
+        bail!(
+            "only {used}{} aiding epochs fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (the filter works on innovations)",
+            if total > 0 { format!(" of {total}") } else { String::new() }
+        );
+    }
+    Ok(())
 }
 
 impl DataArgs {
@@ -214,18 +294,55 @@ impl DataArgs {
         Ok(())
     }
 
-    /// Reads the IMU, aiding and truth files and builds the initial state.
+    /// Reads the IMU, aiding and truth files whole and builds the initial state (for the
+    /// commands that pass over the data more than once).
     pub fn load(&self) -> Result<Inputs> {
+        let opened = self.open()?;
+        let truth = match &self.truth {
+            Some(p) => Some(truth::read(p)?),
+            None => None,
+        };
+        let start = opened.start;
+        let imu = opened.imu.collect()?;
+        let t_last = imu.samples[imu.samples.len() - 1].t;
+        let aid: Vec<AidingEpoch> = opened
+            .aid
+            .epochs()
+            .take_while(|e| e.t <= t_last + 1e-9)
+            .collect();
+        check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
+        Ok(Inputs {
+            imu,
+            aid,
+            truth,
+            start,
+        })
+    }
+
+    /// Opens the IMU, aiding and truth files for one streamed pass and builds the initial
+    /// state; everything that can be checked before the run is (the aiding epochs that fall
+    /// inside the IMU data are counted after it: [`check_inside`]).
+    pub fn open(&self) -> Result<Opened> {
         let args = self;
         if !(args.step.is_finite() && args.step > 0.0 && args.step <= 10.0) {
             bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
         let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
-        let (imu, how) = readers::read_imu(imu_path, args.imu_format.as_deref())?;
+        let (imu, how) =
+            sinsmodel::io::imu_stream::ImuStream::open(imu_path, args.imu_format.as_deref())?;
         eprintln!("reading {} {how}", imu_path.display());
-        imu.check_time(&imu_path.display().to_string(), 5.0)?;
-        let fixes = match (&args.aid, &args.static_aid) {
-            (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {
+        if let Some(z) = args.zupt {
+            if !(z.is_finite() && z > 0.0 && z < 100.0) {
+                bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");
+            }
+        }
+        let zupt = args.zupt.or(args
+            .static_aid
+            .as_ref()
+            .map(|_| sinsmodel::model::measurement_sigma("vel_ne").unwrap_or(0.01)));
+        let t0 = imu.first_t() - imu.interval();
+        let fixes: AidPlan = match (&args.aid, &args.static_aid) {
+            (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => AidPlan::Fixes(
                 sinsmodel::io::readers::rtklib::read(p)?
                     .iter()
                     .map(|e| aiding::PositionFix {
@@ -239,29 +356,29 @@ impl DataArgs {
                             e.sigma_neu[2].max(0.05),
                         ],
                     })
-                    .collect()
-            }
-            (Some(p), None) => aiding::read(p)?,
+                    .collect(),
+                zupt,
+            ),
+            (Some(p), None) => AidPlan::Fixes(aiding::read(p)?, zupt),
             (None, Some(v)) if v.len() == 3 => {
-                if !v.iter().all(|x| x.is_finite())
-                    || v[0].abs() > 90.0
-                    || v[1].abs() > 360.0
-                    || !(-1000.0..=20_000.0).contains(&v[2])
+                use sinsmodel::io::bounds;
+                if let Some(p) = bounds::lat_deg(v[0])
+                    .or_else(|| bounds::lon_deg(v[1]))
+                    .or_else(|| bounds::height_m(v[2]))
                 {
-                    bail!("--static-aid {v:?}: expected LAT in [-90, 90] deg, LON in [-360, 360] deg, H in [-1000, 20000] m");
+                    bail!("--static-aid: {p}");
                 }
-                let (t_first, t_last) = (imu.samples[0].t, imu.samples[imu.samples.len() - 1].t);
-                (1..)
-                    .map(|k| t_first.floor() + k as f64)
-                    .take_while(|t| *t <= t_last)
-                    .map(|t| aiding::PositionFix {
-                        t,
+                AidPlan::Static {
+                    fix: aiding::PositionFix {
+                        t: 0.0,
                         lat: v[0].to_radians(),
                         lon: v[1].to_radians(),
                         h: v[2],
                         sigma: [0.1, 0.1, 0.1],
-                    })
-                    .collect()
+                    },
+                    first_s: imu.first_t().floor() + 1.0,
+                    zupt,
+                }
             }
             (Some(_), Some(_)) => bail!("give --aid FILE or --static-aid LAT,LON,H, not both"),
             (None, Some(v)) => bail!(
@@ -272,17 +389,8 @@ impl DataArgs {
                 "no aiding: give --aid FILE or --static-aid LAT,LON,H (the filter works on innovations)"
             ),
         };
-        if let Some(z) = args.zupt {
-            if !(z.is_finite() && z > 0.0 && z < 100.0) {
-                bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");
-            }
-        }
-        let zupt = args.zupt.or(args
-            .static_aid
-            .as_ref()
-            .map(|_| sinsmodel::model::measurement_sigma("vel_ne").unwrap_or(0.01)));
-        let truth_rows = match &args.truth {
-            Some(p) => Some(truth::read(p)?),
+        let mut truth_reader = match &args.truth {
+            Some(p) => Some(truth::TruthReader::open(p)?),
             None => None,
         };
         if args.step < 0.999 * imu.interval() {
@@ -292,9 +400,8 @@ impl DataArgs {
                 imu.interval()
             );
         }
-        let t0 = imu.samples[0].t - imu.interval();
         let d = std::f64::consts::PI / 180.0;
-        let start = match (&args.init, &truth_rows) {
+        let start = match (&args.init, &mut truth_reader) {
             (Some(v), _) => {
                 if v.len() != 6 && v.len() != 9 {
                     bail!(
@@ -342,8 +449,7 @@ impl DataArgs {
             }
             (None, Some(tr)) => {
                 let r = tr
-                    .iter()
-                    .find(|r| (r.t - t0).abs() < 1e-6)
+                    .at(t0, 1e-6)?
                     .context("no truth row at the IMU start time; give --init")?;
                 let c = dcm_from_euler(r.euler.x, r.euler.y, r.euler.z);
                 NavState {
@@ -357,40 +463,42 @@ impl DataArgs {
             }
             (None, None) => bail!("give --init or --truth for the initial state"),
         };
-        let t_last = imu.samples[imu.samples.len() - 1].t;
-        let inside = fixes.iter().filter(|f| f.t > t0 && f.t <= t_last).count();
-        if inside < 10 {
-            bail!(
-                "only {inside} of {} aiding epochs fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (the filter works on innovations)",
-                fixes.len()
-            );
-        }
-        // the initial position and the first aiding fix must describe the same place
-        if let Some(f) = fixes.iter().find(|f| f.t > t0) {
-            let dn = (f.lat - start.lat) * 6.371e6;
-            let de = (f.lon - start.lon) * 6.371e6 * start.lat.cos();
-            let dist = dn.hypot(de);
-            if dist > 20_000.0 {
+        if let AidPlan::Fixes(fixes, _) = &fixes {
+            let after = fixes.iter().filter(|f| f.t > t0).count();
+            if after < 10 {
                 bail!(
-                    "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
-                    dist / 1000.0,
-                    f.t
+                    "only {after} of {} aiding epochs come after the IMU start ({t0:.3} s); at least 10 are needed (the filter works on innovations)",
+                    fixes.len()
+                );
+            }
+            // the initial position and the first aiding fix must describe the same place
+            if let Some(f) = fixes.iter().find(|f| f.t > t0) {
+                let dn = (f.lat - start.lat) * 6.371e6;
+                let de = (f.lon - start.lon) * 6.371e6 * start.lat.cos();
+                let dist = dn.hypot(de);
+                if dist > 20_000.0 {
+                    bail!(
+                        "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
+                        dist / 1000.0,
+                        f.t
+                    );
+                }
+            }
+        }
+        if let AidPlan::Static { fix, .. } = &fixes {
+            let dn = (fix.lat - start.lat) * 6.371e6;
+            let de = (fix.lon - start.lon) * 6.371e6 * start.lat.cos();
+            if dn.hypot(de) > 20_000.0 {
+                bail!(
+                    "the initial position is {:.1} km from --static-aid: check --init / --static-aid",
+                    dn.hypot(de) / 1000.0
                 );
             }
         }
-        let aid: Vec<AidingEpoch> = fixes
-            .iter()
-            .filter(|f| f.t > t0)
-            .map(|f| AidingEpoch {
-                t: f.t,
-                vel: zupt.map(|s| (Vector3::zeros(), s)),
-                pos: Some((f.lat, f.lon, f.h, f.sigma)),
-            })
-            .collect();
-        Ok(Inputs {
+        Ok(Opened {
             imu,
-            aid,
-            truth: truth_rows,
+            aid: fixes.after(t0),
+            truth: truth_reader,
             start,
         })
     }

@@ -24,24 +24,21 @@ pub struct FilterArgs {
     out: PathBuf,
 }
 
-/// Runs the command.
+/// Runs the command: one streamed pass (memory does not grow with the IMU or truth file);
+/// states.txt and model_error.txt are written as the epochs come, innovations.txt at the end,
+/// and the directory appears only when the run succeeded.
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
     let cfg = args.data.config(&model, false)?;
     let out = OutputDir::create(&args.out, &args.data.input_paths())?;
     args.data.print_noise()?;
-    let inputs = args.data.load()?;
-    let (imu, aid, truth_rows, start) = (&inputs.imu, &inputs.aid, &inputs.truth, inputs.start);
-    let pb = progress::bar(1000, "filter");
-    let run = filter::run(&model, &cfg, imu, start, aid, truth_rows.as_deref(), |f| {
-        pb.set_position((f * 1000.0) as u64)
-    });
-    pb.finish_and_clear();
-    run.check().map_err(anyhow::Error::msg)?;
-
-    let mut f = AtomicFile::create(&out.file("states.txt"))?;
-    let w = f.writer();
+    let mut inputs = args.data.open()?;
+    let start = inputs.start;
     let provenance = super::command_line();
+    let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
+
+    let mut states = AtomicFile::create(&out.file("states.txt"))?;
+    let w = states.writer();
     writeln!(w, "# {provenance}")?;
     writeln!(
         w,
@@ -58,14 +55,78 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         write!(w, " sigma_{n}")?;
     }
     writeln!(w)?;
-    for r in &run.records {
+    let with_truth = inputs.truth.is_some();
+    let mut model_error = match with_truth {
+        true => {
+            let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
+            let w = f.writer();
+            writeln!(w, "# {provenance}")?;
+            writeln!(
+                w,
+                "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
+            )?;
+            Some(f)
+        }
+        false => None,
+    };
+    // what the summary needs of each epoch: t and the model error e = φ̂ − φ (north, east)
+    let mut errors: Vec<(f64, Option<[f64; 2]>)> = Vec::new();
+    let mut on_record = |r: &filter::Record| -> Result<()> {
+        let w = states.writer();
         write!(w, "{:.4}", r.t)?;
         for v in r.x.iter().chain(&r.sigma) {
             write!(w, " {v:.6e}")?;
         }
         writeln!(w)?;
-    }
-    f.commit()?;
+        let mut e_ne = None;
+        if let (Some(f), Some(p)) = (model_error.as_mut(), r.phi_true) {
+            let e = r.phi_est - p;
+            e_ne = Some([e.x, e.y]);
+            writeln!(
+                f.writer(),
+                "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
+                r.t,
+                p.x * arcsec,
+                p.y * arcsec,
+                p.z * arcsec,
+                r.phi_est.x * arcsec,
+                r.phi_est.y * arcsec,
+                r.phi_est.z * arcsec,
+                e.x * arcsec,
+                e.y * arcsec
+            )?;
+        }
+        errors.push((r.t, e_ne));
+        Ok(())
+    };
+    let pb = progress::bar(1000, "filter");
+    let mut epochs = inputs.aid.epochs();
+    let mut io = filter::StreamIo {
+        samples: &mut inputs.imu,
+        aiding: &mut epochs,
+        truth: inputs
+            .truth
+            .as_mut()
+            .map(|t| t as &mut dyn sinsmodel::io::truth::TruthLookup),
+    };
+    let run = filter::run_stream(
+        &model,
+        &cfg,
+        start,
+        &mut io,
+        |f| pb.set_position((f * 1000.0) as u64),
+        &mut |_| {},
+        &mut filter::NoObserver,
+        &mut on_record,
+        false,
+    )?;
+    drop(io);
+    drop(epochs);
+    pb.finish_and_clear();
+    run.check().map_err(anyhow::Error::msg)?;
+    let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
+    super::data::check_inside(errors.len(), inputs.aid.len(), start.t, t_last)?;
+    states.commit()?;
 
     let mut f = AtomicFile::create(&out.file("innovations.txt"))?;
     let w = f.writer();
@@ -79,58 +140,41 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         )?;
     }
     f.commit()?;
-
-    if truth_rows.is_some() {
-        let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
-        let w = f.writer();
-        let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
-        writeln!(w, "# {provenance}")?;
-        writeln!(
-            w,
-            "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
-        )?;
-        for r in &run.records {
-            if let Some(p) = r.phi_true {
-                let e = r.phi_est - p;
-                writeln!(
-                    w,
-                    "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
-                    r.t,
-                    p.x * arcsec,
-                    p.y * arcsec,
-                    p.z * arcsec,
-                    r.phi_est.x * arcsec,
-                    r.phi_est.y * arcsec,
-                    r.phi_est.z * arcsec,
-                    e.x * arcsec,
-                    e.y * arcsec
-                )?;
-            }
-        }
+    if let Some(f) = model_error {
         f.commit()?;
     }
     out.commit()?;
     eprintln!(
         "filtered {} samples ({:.1} s) with {} ({} states, {} loop): {} scalar updates",
-        imu.samples.len(),
-        imu.duration(),
+        inputs.imu.count(),
+        t_last - t_first,
         model.name,
         model.n(),
         cfg.mode.word(),
         run.innovations.len(),
     );
     eprint!("{}", nis_table(&run));
-    if let (Some(first), Some(last)) = (run.records.first(), run.records.last()) {
-        let mid = 0.5 * (first.t + last.t);
-        if let Some([n, e]) = filter::model_error_rms_arcsec(&run, mid, last.t) {
+    if let (Some(first), Some(last)) = (errors.first(), errors.last()) {
+        let mid = 0.5 * (first.0 + last.0);
+        let half: Vec<[f64; 2]> = errors
+            .iter()
+            .filter(|e| e.0 >= mid)
+            .map_while(|e| e.1)
+            .collect();
+        if !half.is_empty() && errors.iter().filter(|e| e.0 >= mid).all(|e| e.1.is_some()) {
+            let rms = |c: usize| {
+                (half.iter().map(|e| e[c] * e[c]).sum::<f64>() / half.len() as f64).sqrt() * arcsec
+            };
             eprintln!(
-                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s): north {n:.2} arcsec, east {e:.2} arcsec",
-                last.t
+                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s): north {:.2} arcsec, east {:.2} arcsec",
+                last.0,
+                rms(0),
+                rms(1)
             );
         }
     }
     let mut files = vec!["states.txt", "innovations.txt"];
-    if truth_rows.is_some() {
+    if with_truth {
         files.push("model_error.txt");
     }
     eprintln!("wrote {} in {}", files.join(", "), args.out.display());
