@@ -490,7 +490,7 @@ impl DataArgs {
             let de = (fix.lon - start.lon) * 6.371e6 * start.lat.cos();
             if dn.hypot(de) > 20_000.0 {
                 bail!(
-                    "the initial position is {:.1} km from --static-aid: check --init / --static-aid",
+                    "the initial position is {:.1} km from the first aiding fix (--static-aid): check --init / --static-aid",
                     dn.hypot(de) / 1000.0
                 );
             }

@@ -22,6 +22,10 @@ pub struct FilterArgs {
     /// complete or not at all, replacing only an earlier sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
+    /// Read the whole IMU file before filtering (the pre-streaming path, kept as the baseline
+    /// `sinsmodel bench` measures the stream against).
+    #[arg(long, hide = true)]
+    in_memory: bool,
 }
 
 /// Runs the command: one streamed pass (memory does not grow with the IMU or truth file);
@@ -33,6 +37,9 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     let out = OutputDir::create(&args.out, &args.data.input_paths())?;
     args.data.print_noise()?;
     let mut inputs = args.data.open()?;
+    if args.in_memory {
+        inputs.imu = inputs.imu.into_memory()?;
+    }
     let start = inputs.start;
     let provenance = super::command_line();
     let arcsec = 180.0 / std::f64::consts::PI * 3600.0;

@@ -44,6 +44,10 @@ pub struct NavigateArgs {
     /// Output file (truth layout of DESIGN §9).
     #[arg(long)]
     out: PathBuf,
+    /// Read the whole IMU file before navigating (the pre-streaming path, kept as the baseline
+    /// `sinsmodel bench` measures the stream against).
+    #[arg(long, hide = true)]
+    in_memory: bool,
 }
 
 /// Runs the command.
@@ -80,6 +84,9 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     // streamed: memory does not grow with the file; the output is written as it goes and
     // appears only when complete
     let mut data = args.src.open()?;
+    if args.in_memory {
+        data = data.into_memory()?;
+    }
     // the same plausibility imu-check applies, on the first 10 s: warn, do not stop (a start
     // that moves or a tilted mounting are legitimate here)
     let head = sinsmodel::io::imu::ImuData {

@@ -48,8 +48,11 @@ pub fn write(path: &Path, rows: &[PositionFix], header: &str) -> Result<()> {
 
 /// Reads a position aiding file; σ must be positive, time increasing.
 pub fn read(path: &Path) -> Result<Vec<PositionFix>> {
-    read_table(path, 7, "aiding file")?
-        .into_iter()
+    let rows = read_table(path, 7, "aiding file")?;
+    if rows.is_empty() {
+        bail!("{}: the aiding file has no data rows", path.display());
+    }
+    rows.into_iter()
         .map(|(line, v)| {
             if v[4..7].iter().any(|s| !(*s > 0.0 && *s <= 1e5)) {
                 bail!(

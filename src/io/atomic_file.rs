@@ -9,7 +9,35 @@ use std::path::{Path, PathBuf};
 pub struct AtomicFile {
     tmp: PathBuf,
     target: PathBuf,
-    out: Option<BufWriter<std::fs::File>>,
+    out: Option<NamedWriter>,
+}
+
+/// A buffered file writer whose errors name the file they happened in (a full disk while
+/// writing says which output it was).
+pub struct NamedWriter {
+    inner: BufWriter<std::fs::File>,
+    target: PathBuf,
+}
+
+impl NamedWriter {
+    fn named(&self, e: std::io::Error) -> std::io::Error {
+        std::io::Error::new(
+            e.kind(),
+            format!("cannot write {}: {e}", self.target.display()),
+        )
+    }
+}
+
+impl Write for NamedWriter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.inner.write(buf).map_err(|e| self.named(e))
+    }
+    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
+        self.inner.write_all(buf).map_err(|e| self.named(e))
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush().map_err(|e| self.named(e))
+    }
 }
 
 impl AtomicFile {
@@ -39,19 +67,22 @@ impl AtomicFile {
         Ok(AtomicFile {
             tmp,
             target: target.to_path_buf(),
-            out: Some(BufWriter::with_capacity(1 << 20, f)),
+            out: Some(NamedWriter {
+                inner: BufWriter::with_capacity(1 << 20, f),
+                target: target.to_path_buf(),
+            }),
         })
     }
 
     /// The writer.
-    pub fn writer(&mut self) -> &mut BufWriter<std::fs::File> {
+    pub fn writer(&mut self) -> &mut NamedWriter {
         self.out.as_mut().expect("not committed")
     }
 
     /// Flushes and renames into place.
     pub fn commit(mut self) -> Result<()> {
         let mut w = self.out.take().expect("not committed");
-        if let Err(e) = w.flush().and_then(|_| w.get_ref().sync_all()) {
+        if let Err(e) = w.inner.flush().and_then(|_| w.inner.get_ref().sync_all()) {
             drop(w);
             let _ = std::fs::remove_file(&self.tmp);
             anyhow::bail!(

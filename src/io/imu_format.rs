@@ -192,12 +192,12 @@ impl ImuFormat {
 
     /// Parses and checks description text; `origin` names it in messages (`origin:line: …`).
     pub fn parse(text: &str, origin: &str) -> Result<ImuFormat> {
-        let line = |start: usize| text[..start.min(text.len())].lines().count().max(1);
+        let line = |start: usize| crate::io::lines::line_at(text, start);
         let at = |span: std::ops::Range<usize>, msg: String| {
-            anyhow!("{origin}:{}: {msg}", line(span.start + 1))
+            anyhow!("{origin}:{}: {msg}", line(span.start))
         };
         let raw: RawFormat = toml::from_str(text).map_err(|e| {
-            let l = e.span().map(|s| line(s.start + 1)).unwrap_or(0);
+            let l = e.span().map(|s| line(s.start)).unwrap_or(0);
             let msg = e.message().trim();
             let msg = if msg.contains("untagged enum ColumnRef") {
                 "a column is a header name (a string) or a 1-based index (a whole number)"
@@ -436,7 +436,16 @@ impl ImuFormat {
     /// Reads a data file described by this format into FRD increments; errors name the data
     /// file and line (or the description's line for a column name it lacks).
     pub fn read(&self, path: &Path) -> Result<ImuData> {
-        ImuStream::new(self.source(path)?, &path.display().to_string())?.collect()
+        self.stream(path)?.collect()
+    }
+
+    /// A stream of the validated samples of a data file described by this format.
+    pub fn stream(&self, path: &Path) -> Result<ImuStream> {
+        ImuStream::with_hint(
+            self.source(path)?,
+            &path.display().to_string(),
+            &format!("[time] unit in {}", self.origin),
+        )
     }
 
     /// The samples of a data file described by this format, read one at a time.

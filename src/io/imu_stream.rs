@@ -93,7 +93,17 @@ pub struct ImuStream {
 impl ImuStream {
     /// A stream over `src`; `name` is the file's name in messages. Reads the head ahead and
     /// checks it: at least two samples and a plausible median interval.
-    pub fn new(mut src: Box<dyn SampleSource>, name: &str) -> Result<ImuStream> {
+    pub fn new(src: Box<dyn SampleSource>, name: &str) -> Result<ImuStream> {
+        ImuStream::with_hint(src, name, "the time column and its unit")
+    }
+
+    /// [`ImuStream::new`], with the words that say where the clock's unit is set (for a wrong
+    /// median interval).
+    pub fn with_hint(
+        mut src: Box<dyn SampleSource>,
+        name: &str,
+        clock_hint: &str,
+    ) -> Result<ImuStream> {
         let mut head: VecDeque<(ImuSample, usize)> = VecDeque::new();
         while head.len() < HEAD_MAX_SAMPLES {
             let Some((s, line)) = src.next_sample()? else {
@@ -131,7 +141,7 @@ impl ImuStream {
         let interval = d[d.len() / 2];
         if !(INTERVAL_RANGE.0..=INTERVAL_RANGE.1).contains(&interval) {
             bail!(
-                "{name}: median sample interval {interval:.3e} s ({:.3e} Hz) is not an IMU's ({} .. {} s): check the time column and its unit",
+                "{name}: median sample interval {interval:.3e} s ({:.3e} Hz) is not an IMU's ({} .. {} s): check {clock_hint}",
                 1.0 / interval,
                 INTERVAL_RANGE.0,
                 INTERVAL_RANGE.1
@@ -173,18 +183,15 @@ impl ImuStream {
         }
         if let Some(f) = format {
             let fmt = ImuFormat::load(f)?;
-            let src = fmt.source(path)?;
             return Ok((
-                ImuStream::new(src, &name)
-                    .with_context(|| format!("as described by {}", f.display()))?,
+                fmt.stream(path)?,
                 format!("as described by {}", f.display()),
             ));
         }
         if let Some(f) = beside(path) {
             let fmt = ImuFormat::load(&f)?;
-            let src = fmt.source(path)?;
             return Ok((
-                ImuStream::new(src, &name)?,
+                fmt.stream(path)?,
                 format!("as described by {} (found beside it)", f.display()),
             ));
         }
@@ -330,6 +337,13 @@ impl ImuStream {
         &self.name
     }
 
+    /// The same samples, all read into memory first (the pre-streaming path: a baseline for
+    /// `sinsmodel bench`).
+    pub fn into_memory(self) -> Result<ImuStream> {
+        let name = self.name.clone();
+        ImuStream::from_data(self.collect()?, &name)
+    }
+
     /// Reads every remaining sample into memory.
     pub fn collect(mut self) -> Result<ImuData> {
         let mut samples = Vec::new();
@@ -391,7 +405,7 @@ mod tests {
             .to_string();
         assert!(e.contains("beyond any IMU"), "{e}");
         // a clock in ms read as s
-        let ms: Vec<f64> = (1..50).map(|k| k as f64 * 10.0).collect();
+        let ms: Vec<f64> = (1..50).map(|k| k as f64 * 20.0).collect();
         let e = ImuStream::from_data(data(&ms, 0.0), "mem")
             .err()
             .unwrap()

@@ -37,6 +37,17 @@ pub struct Line<'a> {
     pub file: &'a str,
 }
 
+/// The 1-based line of byte offset `start` in `text` (an offset at column 0 is on its own line,
+/// not the one before).
+pub fn line_at(text: &str, start: usize) -> usize {
+    let end = start.min(text.len());
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
 /// A file's lines, numbered from 1, with the number of bytes read so far (for progress).
 pub struct Lines<R> {
     reader: R,
@@ -181,6 +192,15 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("f.txt:1: not UTF-8"), "{e}");
+    }
+
+    #[test]
+    fn line_of_an_offset() {
+        let t = "a = 1\nb = 2\nc = 3\n";
+        assert_eq!(line_at(t, 0), 1);
+        assert_eq!(line_at(t, 6), 2); // column 0 of line 2
+        assert_eq!(line_at(t, 13), 3);
+        assert_eq!(line_at(t, 999), 4);
     }
 
     #[test]

@@ -233,7 +233,7 @@ impl Scenario {
         let raw: RawScenario = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start].lines().count().max(1))
+                .map(|s| crate::io::lines::line_at(text, s.start))
                 .unwrap_or(0);
             anyhow!("{origin}:{line}: {}", e.message().trim())
         })?;
