@@ -71,7 +71,7 @@ fn explain_job(seconds: f64) -> Result<()> {
     let plain = filter::run(&model, &cfg, &sim.imu, sim.start, &aid, None, |_| {});
     let t_plain = t.elapsed().as_secs_f64();
     let data = ExplainData {
-        imu: &sim.imu,
+        imu: sinsmodel::estimate::explain::ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: None,
         start: sim.start,

@@ -100,10 +100,13 @@ pub struct DataArgs {
     zupt: Option<f64>,
 }
 
-/// What the data options load: IMU samples, aiding epochs, truth, the initial state.
+/// What the data options load for a command that passes over the data more than once: the IMU
+/// file (read again on every pass), aiding epochs, truth, the initial state.
 pub struct Inputs {
-    /// IMU increments (FRD body frame).
-    pub imu: ImuData,
+    /// The IMU file.
+    pub imu: PathBuf,
+    /// Its format description, when given.
+    pub imu_format: Option<PathBuf>,
     /// Aiding epochs after the start.
     pub aid: Vec<AidingEpoch>,
     /// Truth rows, when given.
@@ -294,17 +297,19 @@ impl DataArgs {
         Ok(())
     }
 
-    /// Reads the IMU, aiding and truth files whole and builds the initial state (for the
-    /// commands that pass over the data more than once).
-    pub fn load(&self) -> Result<Inputs> {
-        let opened = self.open()?;
+    /// For a command that passes over the IMU file more than once (explain): reads the file
+    /// through once (every sample validated, its end found; memory does not grow with it), then
+    /// the aiding epochs inside it, the truth and the initial state. Each pass reads the file
+    /// again ([`sinsmodel::estimate::explain::ImuInput::File`]).
+    pub fn load_for_passes(&self) -> Result<Inputs> {
+        let mut opened = self.open()?;
+        while opened.imu.next()?.is_some() {}
+        let t_last = opened.imu.last_t();
         let truth = match &self.truth {
             Some(p) => Some(truth::read(p)?),
             None => None,
         };
         let start = opened.start;
-        let imu = opened.imu.collect()?;
-        let t_last = imu.samples[imu.samples.len() - 1].t;
         let aid: Vec<AidingEpoch> = opened
             .aid
             .epochs()
@@ -312,7 +317,8 @@ impl DataArgs {
             .collect();
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
         Ok(Inputs {
-            imu,
+            imu: self.imu.clone().context("--imu FILE is required")?,
+            imu_format: self.imu_format.clone(),
             aid,
             truth,
             start,

@@ -86,9 +86,12 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         opts.candidate_sigma = args.data.term_priors()?;
         let out = OutputDir::create(&args.out, &args.data.input_paths())?;
         args.data.print_noise()?;
-        let inputs = args.data.load()?;
+        let inputs = args.data.load_for_passes()?;
         let data = ExplainData {
-            imu: &inputs.imu,
+            imu: sinsmodel::estimate::explain::ImuInput::File {
+                path: &inputs.imu,
+                format: inputs.imu_format.as_deref(),
+            },
             aid: &inputs.aid,
             truth: inputs.truth.as_deref(),
             start: inputs.start,
@@ -163,7 +166,7 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let priors = reproduce::Priors::default();
     let aid = reproduce::aiding_from_truth(&sim, &priors, case.velocity_updates, seed)?;
     let data = ExplainData {
-        imu: &sim.imu,
+        imu: sinsmodel::estimate::explain::ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,

@@ -713,9 +713,17 @@ pub trait Samples {
     fn fraction(&self) -> f64;
 }
 
-struct SliceSamples<'a> {
+/// Samples in memory handed out one at a time.
+pub struct SliceSamples<'a> {
     samples: &'a [ImuSample],
     next: usize,
+}
+
+impl<'a> SliceSamples<'a> {
+    /// From the first sample.
+    pub fn new(samples: &'a [ImuSample]) -> Self {
+        SliceSamples { samples, next: 0 }
+    }
 }
 
 impl Samples for SliceSamples<'_> {
