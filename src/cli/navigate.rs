@@ -137,7 +137,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         nav.step(&s.dtheta, &s.dv, s.t - prev_t);
         nav.state.t = s.t;
         let st = &nav.state;
-        if ![st.lat, st.lon, st.h, st.v.x, st.v.y, st.v.z]
+        if ![st.lat, st.lon, st.h, st.v.x, st.v.y, st.v.z, st.q.w, st.q.i]
             .iter()
             .all(|v| v.is_finite())
             || st.h.abs() > 1e7

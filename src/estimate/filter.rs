@@ -563,6 +563,34 @@ impl<'a> Engine<'a> {
         })
     }
 
+    /// Why the filter cannot go on after the propagation step ending at `t`, if it cannot: a
+    /// non-finite estimate or variance, or a variance negative beyond round-off (checked every
+    /// step, so the time named is the step where it happened).
+    fn step_divergence(&self, t: f64) -> Option<String> {
+        let n = self.n;
+        let bad = (0..n).find(|&i| {
+            let v = self.p[i * n + i];
+            !self.x[i].is_finite() || !v.is_finite() || v < -1e-9 * self.cfg.prior_sigma[i].powi(2)
+        })?;
+        let s = &self.nav.state;
+        let nav_finite = [s.lat, s.lon, s.h, s.v.x, s.v.y, s.v.z]
+            .iter()
+            .all(|v| v.is_finite());
+        Some(format!(
+            "the filter diverged at t = {t:.3} s (propagation): the estimate or variance of state {} is not finite or negative beyond round-off (navigation state lat {:.6} deg, lon {:.6} deg, h {:.1} m, speed {:.3} m/s); likely cause: {}; check --init, --prior, --noise and the IMU values",
+            self.model.names[bad],
+            s.lat.to_degrees(),
+            s.lon.to_degrees(),
+            s.h,
+            s.v.norm(),
+            if nav_finite {
+                "A(t) or the process noise out of scale (IMU values beyond the model's range, priors or --noise far too large)"
+            } else {
+                "the navigation itself diverged: IMU values, units or the initial state are not physical"
+            }
+        ))
+    }
+
     /// Why the filter cannot go on after this epoch's updates, if it cannot: a scalar update
     /// whose innovation or variance S was not finite or S ≤ 0, or a non-finite estimate or
     /// variance (or one negative beyond round-off) in the record. Names the time, the navigation
@@ -794,6 +822,10 @@ pub fn run_stream(
             continue;
         }
         e.propagate(smp.t, obs);
+        diverged = e.step_divergence(smp.t);
+        if diverged.is_some() {
+            break;
+        }
         while let Some(ep) = aiding.next_if(|a| a.t <= smp.t + 1e-9) {
             e.update(&ep, obs);
             let rec = e.record(&ep, io.truth.as_deref_mut())?;
