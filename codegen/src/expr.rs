@@ -127,9 +127,12 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
         syn::Expr::Path(p) => Err(format!("no dimension for `{}`", p.to_token_stream())),
         syn::Expr::Binary(b) => {
             let (l, r) = (dimension(&b.left)?, dimension(&b.right)?);
+            let in_range = |d: Result<crate::units::Dim, String>| {
+                d.map_err(|m| format!("`{}`: {m}", b.to_token_stream()))
+            };
             match b.op {
-                syn::BinOp::Mul(_) => Ok(l.times(r)),
-                syn::BinOp::Div(_) => Ok(l.per(r)),
+                syn::BinOp::Mul(_) => in_range(l.times(r)),
+                syn::BinOp::Div(_) => in_range(l.per(r)),
                 _ if l == r => Ok(l),
                 _ => Err(format!(
                     "`{}` adds or subtracts unlike dimensions [{l}] and [{r}]",
@@ -154,7 +157,8 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
                         })) => i.base10_parse::<i32>().map_err(|e| e.to_string())?,
                         _ => return Err("`powi` takes one integer literal".into()),
                     };
-                    Ok(d.powi(k))
+                    d.powi(k)
+                        .map_err(|e| format!("`{}`: {e}", m.to_token_stream()))
                 }
                 name if d.is_dimensionless_or_angle() => {
                     let _ = name;
@@ -305,7 +309,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                     })) => i.base10_parse::<i32>().ok(),
                     _ => None,
                 };
-                if k.is_none_or(|k| k.abs() > crate::units::MAX_POWER) {
+                if k.is_none_or(|k| k.unsigned_abs() > crate::units::MAX_POWER.unsigned_abs()) {
                     return Err(format!(
                         "`powi` exponent out of range (|n| <= {})",
                         crate::units::MAX_POWER
@@ -363,5 +367,21 @@ mod tests {
         let e = parse("lat.powi(h)", ExprKind::Navigation).unwrap_err();
         assert!(e.contains("powi"), "{e}");
         assert!(parse("vn % 2", ExprKind::Navigation).is_err());
+    }
+
+    #[test]
+    fn regressor_dimensions_are_bounded_not_wrapped() {
+        // each powi is in range; nested, their dimension (s^-4 to the 12^9) used to wrap i32
+        let nested = format!("w.x{}", ".powi(12)".repeat(9));
+        let r = parse(&nested, ExprKind::Regressor).unwrap();
+        let e = r.dimension().unwrap_err();
+        assert!(e.contains("is out of range (|exponent| <= 24"), "{e}");
+        let e = parse("f.x.powi(12) * f.y", ExprKind::Regressor)
+            .unwrap()
+            .dimension()
+            .unwrap_err();
+        assert!(e.contains("dimension s^-26"), "{e}");
+        let r = parse("f.x.powi(6) * f.y.powi(6)", ExprKind::Regressor).unwrap();
+        assert_eq!(r.dimension().unwrap().0, [24, -48, 0]);
     }
 }

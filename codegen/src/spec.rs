@@ -772,7 +772,9 @@ fn check_term_dimension(
     let want = units::parse_unit(sensor_unit)
         .expect("sensor unit parses")
         .dim;
-    let got = unit.times(reg_dim);
+    let got = unit
+        .times(reg_dim)
+        .map_err(|m| src.error(t.unit.span(), item, format!("unit times regressor: {m}")))?;
     if got.0[0] != want.0[0] || got.0[1] != want.0[1] {
         return Err(src.error(
             t.unit.span(),
@@ -783,7 +785,7 @@ fn check_term_dimension(
                 t.regressor.get_ref(),
                 reg_dim,
                 got,
-                want.per(reg_dim)
+                want.per(reg_dim).map_or_else(|e| format!("(none: {e})"), |d| d.to_string())
             )
             .trim_end()
             .to_string(),
