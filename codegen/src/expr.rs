@@ -83,6 +83,13 @@ impl Expr {
         dimension(&self.ast)
     }
 
+    /// Values of the numeric literals, in source order (`powi`'s exponent included).
+    pub fn literals(&self) -> Vec<f64> {
+        let mut out = Vec::new();
+        literals(&self.ast, &mut out);
+        out
+    }
+
     /// True when the expression is the literal `1` or `1.0`.
     pub fn is_one(&self) -> bool {
         matches!(self.source.as_str(), "1" | "1.0")
@@ -109,6 +116,29 @@ fn collect(e: &syn::Expr, out: &mut BTreeSet<String>) {
             collect(&m.receiver, out);
             for a in &m.args {
                 collect(a, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+fn literals(e: &syn::Expr, out: &mut Vec<f64>) {
+    match e {
+        syn::Expr::Lit(l) => match &l.lit {
+            syn::Lit::Float(f) => out.extend(f.base10_parse::<f64>().ok()),
+            syn::Lit::Int(i) => out.extend(i.base10_parse::<f64>().ok()),
+            _ => {}
+        },
+        syn::Expr::Binary(b) => {
+            literals(&b.left, out);
+            literals(&b.right, out);
+        }
+        syn::Expr::Unary(u) => literals(&u.expr, out),
+        syn::Expr::Paren(p) => literals(&p.expr, out),
+        syn::Expr::MethodCall(m) => {
+            literals(&m.receiver, out);
+            for a in &m.args {
+                literals(a, out);
             }
         }
         _ => {}
@@ -218,6 +248,15 @@ fn floatify(e: &mut syn::Expr) {
 fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
     match e {
         syn::Expr::Lit(l) => match &l.lit {
+            // a suffix (`1.5f32`, `2u8`) would change the generated code's types
+            syn::Lit::Float(f) if !f.suffix().is_empty() => Err(format!(
+                "literal `{}` has a type suffix (write plain numbers)",
+                f.token()
+            )),
+            syn::Lit::Int(i) if !i.suffix().is_empty() => Err(format!(
+                "literal `{}` has a type suffix (write plain numbers)",
+                i.token()
+            )),
             syn::Lit::Float(_) | syn::Lit::Int(_) => Ok(()),
             _ => Err("only numeric literals are allowed".into()),
         },
@@ -302,6 +341,9 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 if !ok {
                     return Err("`powi` takes one integer literal".into());
                 }
+                for a in &m.args {
+                    check(a, kind)?;
+                }
                 let k = match m.args.first() {
                     Some(syn::Expr::Lit(syn::ExprLit {
                         lit: syn::Lit::Int(i),
@@ -367,6 +409,16 @@ mod tests {
         let e = parse("lat.powi(h)", ExprKind::Navigation).unwrap_err();
         assert!(e.contains("powi"), "{e}");
         assert!(parse("vn % 2", ExprKind::Navigation).is_err());
+        let e = parse("vn * 1.5f32", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("literal `1.5f32` has a type suffix"), "{e}");
+        let e = parse("w.x.powi(2u8)", ExprKind::Regressor).unwrap_err();
+        assert!(e.contains("literal `2u8` has a type suffix"), "{e}");
+        assert_eq!(
+            parse("2 * vn.powi(3) / 0.5", ExprKind::Navigation)
+                .unwrap()
+                .literals(),
+            [2.0, 3.0, 0.5]
+        );
     }
 
     #[test]

@@ -42,6 +42,30 @@ pub struct JacobianOut {
     pub h: BTreeMap<&'static str, Vec<Vec<f64>>>,
 }
 
+/// The points of a POINT.json text, as `sinsmodel jacobian --at` reads it.
+#[derive(Debug, Clone)]
+pub enum Points {
+    /// A single JSON object: one point (the output is one object).
+    One(PointSpec),
+    /// A JSON array of objects (the output is an array).
+    Many(Vec<PointSpec>),
+}
+
+/// Reads POINT.json text: one point object, or an array of them; errors name the point.
+pub fn parse_points(text: &str) -> Result<Points> {
+    let value: serde_json::Value = serde_json::from_str(text).context("not valid JSON")?;
+    Ok(match value {
+        serde_json::Value::Array(items) => Points::Many(
+            items
+                .into_iter()
+                .enumerate()
+                .map(|(k, v)| serde_json::from_value(v).with_context(|| format!("point {k}")))
+                .collect::<Result<_>>()?,
+        ),
+        v => Points::One(serde_json::from_value(v)?),
+    })
+}
+
 impl PointSpec {
     /// Checks that every number is finite and the latitude is inside ±90°.
     pub fn validate(&self) -> Result<()> {
