@@ -257,6 +257,14 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 "literal `{}` has a type suffix (write plain numbers)",
                 i.token()
             )),
+            // the generated code writes the value as an f64 literal: it must be one
+            syn::Lit::Float(f) if !f.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(
+                format!("literal `{}` is beyond the range of f64", f.token()),
+            ),
+            syn::Lit::Int(i) if !i.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(format!(
+                "literal `{}` is beyond the range of f64",
+                i.token()
+            )),
             syn::Lit::Float(_) | syn::Lit::Int(_) => Ok(()),
             _ => Err("only numeric literals are allowed".into()),
         },
@@ -411,6 +419,16 @@ mod tests {
         assert!(parse("vn % 2", ExprKind::Navigation).is_err());
         let e = parse("vn * 1.5f32", ExprKind::Navigation).unwrap_err();
         assert!(e.contains("literal `1.5f32` has a type suffix"), "{e}");
+        // found by fuzzing: `1.01e999` was accepted and would have been written as `inf`
+        let e = parse("vn * 1.01e999", ExprKind::Navigation).unwrap_err();
+        assert!(
+            e.contains("literal `1.01e999` is beyond the range of f64"),
+            "{e}"
+        );
+        let big = format!("1{}", "0".repeat(400));
+        let e = parse(&format!("vn * {big}"), ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("is beyond the range of f64"), "{e}");
+        assert!(parse("vn * 1e308", ExprKind::Navigation).is_ok());
         let e = parse("w.x.powi(2u8)", ExprKind::Regressor).unwrap_err();
         assert!(e.contains("literal `2u8` has a type suffix"), "{e}");
         assert_eq!(

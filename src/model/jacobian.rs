@@ -67,7 +67,9 @@ pub fn parse_points(text: &str) -> Result<Points> {
 }
 
 impl PointSpec {
-    /// Checks that every number is finite and the latitude is inside ±90°.
+    /// Checks that every number is finite and within the physical ranges of [`crate::io::bounds`]
+    /// (latitude inside ±90°, height ±1e5 m, attitude, velocity ±1e4 m/s, specific force
+    /// ±1e4 m/s², angular rate ±1e3 rad/s), so that A and H are finite.
     pub fn validate(&self) -> Result<()> {
         let all = [self.lat_deg, self.h_m]
             .into_iter()
@@ -80,6 +82,17 @@ impl PointSpec {
         }
         if self.lat_deg.abs() >= 90.0 {
             bail!("lat_deg = {} is outside (-90, 90)", self.lat_deg);
+        }
+        use crate::io::bounds;
+        let problems = [
+            bounds::height_m(self.h_m).map(|p| format!("h_m: {p}")),
+            bounds::attitude_deg(self.euler_deg).map(|p| format!("euler_deg: {p}")),
+            bounds::velocity_mps(self.v_ned).map(|p| format!("v_ned: {p}")),
+            bounds::specific_force_mps2(self.f_b).map(|p| format!("f_b: {p}")),
+            bounds::angular_rate_rps(self.w_b).map(|p| format!("w_b: {p}")),
+        ];
+        if let Some(p) = problems.into_iter().flatten().next() {
+            bail!("point: {p}");
         }
         Ok(())
     }
