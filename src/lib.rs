@@ -12,8 +12,10 @@
 //! - [`io`]: IMU, aiding and truth files, readers of other formats, units at the edges,
 //!   atomic output files.
 //! - [`report`]: the paper's reproduction and its analysis, plots and progress bars.
+//! - [`fuzzing`]: fuzz target bodies, shared by cargo-fuzz and the stable corpus test.
 
 pub mod estimate;
+pub mod fuzzing;
 pub mod io;
 pub mod model;
 pub mod nav;

@@ -83,6 +83,13 @@ impl Expr {
         dimension(&self.ast)
     }
 
+    /// Values of the numeric literals, in source order (`powi`'s exponent included).
+    pub fn literals(&self) -> Vec<f64> {
+        let mut out = Vec::new();
+        literals(&self.ast, &mut out);
+        out
+    }
+
     /// True when the expression is the literal `1` or `1.0`.
     pub fn is_one(&self) -> bool {
         matches!(self.source.as_str(), "1" | "1.0")
@@ -115,6 +122,29 @@ fn collect(e: &syn::Expr, out: &mut BTreeSet<String>) {
     }
 }
 
+fn literals(e: &syn::Expr, out: &mut Vec<f64>) {
+    match e {
+        syn::Expr::Lit(l) => match &l.lit {
+            syn::Lit::Float(f) => out.extend(f.base10_parse::<f64>().ok()),
+            syn::Lit::Int(i) => out.extend(i.base10_parse::<f64>().ok()),
+            _ => {}
+        },
+        syn::Expr::Binary(b) => {
+            literals(&b.left, out);
+            literals(&b.right, out);
+        }
+        syn::Expr::Unary(u) => literals(&u.expr, out),
+        syn::Expr::Paren(p) => literals(&p.expr, out),
+        syn::Expr::MethodCall(m) => {
+            literals(&m.receiver, out);
+            for a in &m.args {
+                literals(a, out);
+            }
+        }
+        _ => {}
+    }
+}
+
 fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
     use crate::units::{DIM_ACCEL, DIM_ONE, DIM_RATE};
     match e {
@@ -127,9 +157,12 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
         syn::Expr::Path(p) => Err(format!("no dimension for `{}`", p.to_token_stream())),
         syn::Expr::Binary(b) => {
             let (l, r) = (dimension(&b.left)?, dimension(&b.right)?);
+            let in_range = |d: Result<crate::units::Dim, String>| {
+                d.map_err(|m| format!("`{}`: {m}", b.to_token_stream()))
+            };
             match b.op {
-                syn::BinOp::Mul(_) => Ok(l.times(r)),
-                syn::BinOp::Div(_) => Ok(l.per(r)),
+                syn::BinOp::Mul(_) => in_range(l.times(r)),
+                syn::BinOp::Div(_) => in_range(l.per(r)),
                 _ if l == r => Ok(l),
                 _ => Err(format!(
                     "`{}` adds or subtracts unlike dimensions [{l}] and [{r}]",
@@ -154,7 +187,8 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
                         })) => i.base10_parse::<i32>().map_err(|e| e.to_string())?,
                         _ => return Err("`powi` takes one integer literal".into()),
                     };
-                    Ok(d.powi(k))
+                    d.powi(k)
+                        .map_err(|e| format!("`{}`: {e}", m.to_token_stream()))
                 }
                 name if d.is_dimensionless_or_angle() => {
                     let _ = name;
@@ -214,6 +248,23 @@ fn floatify(e: &mut syn::Expr) {
 fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
     match e {
         syn::Expr::Lit(l) => match &l.lit {
+            // a suffix (`1.5f32`, `2u8`) would change the generated code's types
+            syn::Lit::Float(f) if !f.suffix().is_empty() => Err(format!(
+                "literal `{}` has a type suffix (write plain numbers)",
+                f.token()
+            )),
+            syn::Lit::Int(i) if !i.suffix().is_empty() => Err(format!(
+                "literal `{}` has a type suffix (write plain numbers)",
+                i.token()
+            )),
+            // the generated code writes the value as an f64 literal: it must be one
+            syn::Lit::Float(f) if !f.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(
+                format!("literal `{}` is beyond the range of f64", f.token()),
+            ),
+            syn::Lit::Int(i) if !i.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(format!(
+                "literal `{}` is beyond the range of f64",
+                i.token()
+            )),
             syn::Lit::Float(_) | syn::Lit::Int(_) => Ok(()),
             _ => Err("only numeric literals are allowed".into()),
         },
@@ -298,6 +349,9 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 if !ok {
                     return Err("`powi` takes one integer literal".into());
                 }
+                for a in &m.args {
+                    check(a, kind)?;
+                }
                 let k = match m.args.first() {
                     Some(syn::Expr::Lit(syn::ExprLit {
                         lit: syn::Lit::Int(i),
@@ -305,7 +359,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                     })) => i.base10_parse::<i32>().ok(),
                     _ => None,
                 };
-                if k.is_none_or(|k| k.abs() > crate::units::MAX_POWER) {
+                if k.is_none_or(|k| k.unsigned_abs() > crate::units::MAX_POWER.unsigned_abs()) {
                     return Err(format!(
                         "`powi` exponent out of range (|n| <= {})",
                         crate::units::MAX_POWER
@@ -363,5 +417,41 @@ mod tests {
         let e = parse("lat.powi(h)", ExprKind::Navigation).unwrap_err();
         assert!(e.contains("powi"), "{e}");
         assert!(parse("vn % 2", ExprKind::Navigation).is_err());
+        let e = parse("vn * 1.5f32", ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("literal `1.5f32` has a type suffix"), "{e}");
+        // found by fuzzing: `1.01e999` was accepted and would have been written as `inf`
+        let e = parse("vn * 1.01e999", ExprKind::Navigation).unwrap_err();
+        assert!(
+            e.contains("literal `1.01e999` is beyond the range of f64"),
+            "{e}"
+        );
+        let big = format!("1{}", "0".repeat(400));
+        let e = parse(&format!("vn * {big}"), ExprKind::Navigation).unwrap_err();
+        assert!(e.contains("is beyond the range of f64"), "{e}");
+        assert!(parse("vn * 1e308", ExprKind::Navigation).is_ok());
+        let e = parse("w.x.powi(2u8)", ExprKind::Regressor).unwrap_err();
+        assert!(e.contains("literal `2u8` has a type suffix"), "{e}");
+        assert_eq!(
+            parse("2 * vn.powi(3) / 0.5", ExprKind::Navigation)
+                .unwrap()
+                .literals(),
+            [2.0, 3.0, 0.5]
+        );
+    }
+
+    #[test]
+    fn regressor_dimensions_are_bounded_not_wrapped() {
+        // each powi is in range; nested, their dimension (s^-4 to the 12^9) used to wrap i32
+        let nested = format!("w.x{}", ".powi(12)".repeat(9));
+        let r = parse(&nested, ExprKind::Regressor).unwrap();
+        let e = r.dimension().unwrap_err();
+        assert!(e.contains("is out of range (|exponent| <= 24"), "{e}");
+        let e = parse("f.x.powi(12) * f.y", ExprKind::Regressor)
+            .unwrap()
+            .dimension()
+            .unwrap_err();
+        assert!(e.contains("dimension s^-26"), "{e}");
+        let r = parse("f.x.powi(6) * f.y.powi(6)", ExprKind::Regressor).unwrap();
+        assert_eq!(r.dimension().unwrap().0, [24, -48, 0]);
     }
 }

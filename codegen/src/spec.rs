@@ -369,6 +369,13 @@ impl Source {
         Ok(Source { path, text })
     }
 
+    fn new(dir: &Path, name: &str, text: &str) -> Source {
+        Source {
+            path: dir.join(name),
+            text: text.to_string(),
+        }
+    }
+
     fn line_of(&self, offset: usize) -> usize {
         let end = offset.min(self.text.len());
         self.text[..end].bytes().filter(|&b| b == b'\n').count() + 1
@@ -433,10 +440,35 @@ impl Spec {
     /// Reads and validates the spec in `dir` (the four files of [`SPEC_FILES`]), one file and
     /// one kind of item at a time; the first problem found is returned.
     pub fn load(dir: &Path) -> Result<Spec, SpecError> {
-        let nav_src = Source::read(dir, SPEC_FILES[0])?;
-        let terms_src = Source::read(dir, SPEC_FILES[1])?;
-        let meas_src = Source::read(dir, SPEC_FILES[2])?;
-        let preset_src = Source::read(dir, SPEC_FILES[3])?;
+        let [nav_src, terms_src, meas_src, preset_src] = [
+            Source::read(dir, SPEC_FILES[0])?,
+            Source::read(dir, SPEC_FILES[1])?,
+            Source::read(dir, SPEC_FILES[2])?,
+            Source::read(dir, SPEC_FILES[3])?,
+        ];
+        Spec::from_sources(dir, nav_src, terms_src, meas_src, preset_src)
+    }
+
+    /// Validates a spec given as the texts of its four files, in [`SPEC_FILES`] order, as
+    /// [`Spec::load`] does once it has read them; `dir` only names the files in messages.
+    pub fn from_texts(dir: &Path, texts: [&str; 4]) -> Result<Spec, SpecError> {
+        let [nav, terms, meas, presets] = texts;
+        Spec::from_sources(
+            dir,
+            Source::new(dir, SPEC_FILES[0], nav),
+            Source::new(dir, SPEC_FILES[1], terms),
+            Source::new(dir, SPEC_FILES[2], meas),
+            Source::new(dir, SPEC_FILES[3], presets),
+        )
+    }
+
+    fn from_sources(
+        dir: &Path,
+        nav_src: Source,
+        terms_src: Source,
+        meas_src: Source,
+        preset_src: Source,
+    ) -> Result<Spec, SpecError> {
         let raw_nav: RawNavigation = nav_src.parse()?;
         let raw_terms: RawTerms = terms_src.parse()?;
         let raw_meas: RawMeasurements = meas_src.parse()?;
@@ -772,7 +804,9 @@ fn check_term_dimension(
     let want = units::parse_unit(sensor_unit)
         .expect("sensor unit parses")
         .dim;
-    let got = unit.times(reg_dim);
+    let got = unit
+        .times(reg_dim)
+        .map_err(|m| src.error(t.unit.span(), item, format!("unit times regressor: {m}")))?;
     if got.0[0] != want.0[0] || got.0[1] != want.0[1] {
         return Err(src.error(
             t.unit.span(),
@@ -783,7 +817,7 @@ fn check_term_dimension(
                 t.regressor.get_ref(),
                 reg_dim,
                 got,
-                want.per(reg_dim)
+                want.per(reg_dim).map_or_else(|e| format!("(none: {e})"), |d| d.to_string())
             )
             .trim_end()
             .to_string(),

@@ -16,26 +16,51 @@ pub const STANDARD_GRAVITY: f64 = 9.806_65;
 pub struct Dim(pub [i32; 3]);
 
 impl Dim {
-    fn add(self, o: Dim, sign: i32) -> Dim {
-        Dim([
-            self.0[0] + sign * o.0[0],
-            self.0[1] + sign * o.0[1],
-            self.0[2] + sign * o.0[2],
-        ])
+    /// `self + sign·o`, exponent by exponent, in i64 (no wrap) and then bounded.
+    fn add(self, o: Dim, sign: i32) -> Result<Dim, String> {
+        let e = |i: usize| i64::from(self.0[i]) + i64::from(sign) * i64::from(o.0[i]);
+        Dim::bounded([e(0), e(1), e(2)])
     }
-    fn scale(self, k: i32) -> Dim {
-        Dim([self.0[0] * k, self.0[1] * k, self.0[2] * k])
+    /// Every exponent times `k`, in i64 (no wrap) and then bounded.
+    fn scale(self, k: i32) -> Result<Dim, String> {
+        let e = |i: usize| i64::from(self.0[i]) * i64::from(k);
+        Dim::bounded([e(0), e(1), e(2)])
     }
-    /// Dimension of a product.
-    pub fn times(self, o: Dim) -> Dim {
+    /// Doubled exponents computed in i64 back to a `Dim`, or the one that is beyond
+    /// [`MAX_DIM_EXPONENT`] named.
+    fn bounded(e: [i64; 3]) -> Result<Dim, String> {
+        let limit = 2 * i64::from(MAX_DIM_EXPONENT);
+        for (name, &x) in ["m", "s", "rad"].iter().zip(e.iter()) {
+            if x.abs() > limit {
+                let power = if x % 2 == 0 {
+                    format!("{}", x / 2)
+                } else {
+                    format!("({x}/2)")
+                };
+                return Err(format!(
+                    "dimension {name}^{power} is out of range (|exponent| <= {MAX_DIM_EXPONENT} for each of m, s, rad)"
+                ));
+            }
+        }
+        // in range: each doubled exponent fits an i32 by far
+        Ok(Dim(e.map(|x| x as i32)))
+    }
+    /// Dimension of a product; an error when an exponent would leave ±[`MAX_DIM_EXPONENT`].
+    pub fn times(self, o: Dim) -> Result<Dim, String> {
         self.add(o, 1)
     }
-    /// Dimension of a quotient.
-    pub fn per(self, o: Dim) -> Dim {
+    /// Dimension of a quotient; an error when an exponent would leave ±[`MAX_DIM_EXPONENT`].
+    pub fn per(self, o: Dim) -> Result<Dim, String> {
         self.add(o, -1)
     }
-    /// Dimension raised to an integer power (|k| ≤ [`MAX_POWER`]).
-    pub fn powi(self, k: i32) -> Dim {
+    /// Dimension raised to an integer power; an error when |k| > [`MAX_POWER`] or an exponent
+    /// would leave ±[`MAX_DIM_EXPONENT`].
+    pub fn powi(self, k: i32) -> Result<Dim, String> {
+        if k.unsigned_abs() > MAX_POWER.unsigned_abs() {
+            return Err(format!(
+                "power {k} is out of range (|power| <= {MAX_POWER})"
+            ));
+        }
         self.scale(k)
     }
     /// Square root; None when an exponent would become fractional beyond halves.
@@ -53,6 +78,14 @@ impl Dim {
 
 /// Largest power a unit factor or a regressor's `powi` may use.
 pub const MAX_POWER: i32 = 12;
+
+/// Largest |exponent| of metre, second or radian in any dimension that a unit, a quantity or a
+/// regressor reaches (an acceleration to the twelfth power, s^-24, is the largest a single
+/// `powi` can make). Bounding it keeps the exponent arithmetic far from i32 overflow.
+pub const MAX_DIM_EXPONENT: i32 = 24;
+
+/// Deepest nesting of `sqrt(...)` in a unit (`ug/sqrt(Hz)` is depth 1).
+pub const MAX_SQRT_DEPTH: usize = 4;
 
 /// Dimension of a specific force, m/s².
 pub const DIM_ACCEL: Dim = Dim([2, -4, 0]);
@@ -108,7 +141,7 @@ const RAD: Dim = Dim([0, 0, 2]);
 const ONE: Dim = Dim([0, 0, 0]);
 
 fn base(name: &str) -> Option<Unit> {
-    let acc = M.add(S, -2);
+    let acc = DIM_ACCEL;
     let deg = std::f64::consts::PI / 180.0;
     let (to_si, dim) = match name {
         "1" => (1.0, ONE),
@@ -124,7 +157,7 @@ fn base(name: &str) -> Option<Unit> {
         "ns" => (1e-9, S),
         "min" => (60.0, S),
         "h" => (3600.0, S),
-        "Hz" => (1.0, S.scale(-1)),
+        "Hz" => (1.0, Dim([0, -2, 0])),
         "rad" => (1.0, RAD),
         "mrad" => (1e-3, RAD),
         "urad" => (1e-6, RAD),
@@ -141,7 +174,16 @@ fn base(name: &str) -> Option<Unit> {
 }
 
 /// Parses a unit expression such as `deg/h`, `s^2/m`, `ug/sqrt(Hz)`, `rad*s/m`.
+///
+/// Refused with a message: unknown names, a power beyond ±[`MAX_POWER`], a dimension exponent
+/// beyond ±[`MAX_DIM_EXPONENT`], `sqrt` nested deeper than [`MAX_SQRT_DEPTH`], and a conversion
+/// factor to SI that is not a normal f64 (it overflowed to infinity or underflowed to zero).
 pub fn parse_unit(text: &str) -> Result<Unit, UnitError> {
+    parse_unit_at(text, 0)
+}
+
+/// [`parse_unit`] inside `depth` enclosing `sqrt(...)`.
+fn parse_unit_at(text: &str, depth: usize) -> Result<Unit, UnitError> {
     let t = text.trim();
     if t.is_empty() {
         return Err(UnitError("empty unit".into()));
@@ -155,13 +197,21 @@ pub fn parse_unit(text: &str) -> Result<Unit, UnitError> {
     loop {
         let end = next_operator(rest);
         let factor = rest[..end].trim();
-        let f = parse_factor(factor).map_err(|e| UnitError(format!("unit `{t}`: {e}")))?;
+        let f = parse_factor(factor, depth).map_err(|e| UnitError(format!("unit `{t}`: {e}")))?;
         unit.to_si = if sign > 0 {
             unit.to_si * f.to_si
         } else {
             unit.to_si / f.to_si
         };
-        unit.dim = unit.dim.add(f.dim, sign);
+        if !unit.to_si.is_normal() {
+            return Err(UnitError(format!(
+                "unit `{t}`: its factor to SI is out of the range of f64 (overflows or underflows)"
+            )));
+        }
+        unit.dim = unit
+            .dim
+            .add(f.dim, sign)
+            .map_err(|e| UnitError(format!("unit `{t}`: {e}")))?;
         if end == rest.len() {
             break;
         }
@@ -185,29 +235,35 @@ fn next_operator(s: &str) -> usize {
     s.len()
 }
 
-fn parse_factor(f: &str) -> Result<Unit, String> {
+/// One factor: `name`, `name^n` or `sqrt(unit)`, inside `depth` enclosing `sqrt`.
+fn parse_factor(f: &str, depth: usize) -> Result<Unit, String> {
     if let Some(inner) = f.strip_prefix("sqrt(").and_then(|x| x.strip_suffix(')')) {
-        let u = parse_unit(inner).map_err(|e| e.0)?;
-        if u.dim.0.iter().any(|e| e % 2 != 0) {
-            return Err(format!("sqrt of `{inner}` would give a quarter power"));
+        if depth >= MAX_SQRT_DEPTH {
+            return Err(format!("`sqrt` nested deeper than {MAX_SQRT_DEPTH} levels"));
         }
+        let u = parse_unit_at(inner, depth + 1).map_err(|e| e.0)?;
+        let dim = u
+            .dim
+            .sqrt()
+            .ok_or_else(|| format!("sqrt of `{inner}` would give a quarter power"))?;
         return Ok(Unit {
             to_si: u.to_si.sqrt(),
-            dim: Dim([u.dim.0[0] / 2, u.dim.0[1] / 2, u.dim.0[2] / 2]),
+            dim,
         });
     }
     let (name, power) = match f.split_once('^') {
         Some((n, p)) => {
-            let p: i32 = p
+            // parsed wide, so that no written power can wrap before the range check
+            let p: i64 = p
                 .trim()
                 .parse()
                 .map_err(|_| format!("power `{p}` is not an integer"))?;
-            if p.abs() > MAX_POWER {
+            if p.abs() > i64::from(MAX_POWER) {
                 return Err(format!(
                     "power `{p}` is out of range (|power| <= {MAX_POWER})"
                 ));
             }
-            (n.trim(), p)
+            (n.trim(), p as i32)
         }
         None => (f, 1),
     };
@@ -219,7 +275,7 @@ fn parse_factor(f: &str) -> Result<Unit, String> {
     })?;
     Ok(Unit {
         to_si: u.to_si.powi(power),
-        dim: u.dim.scale(power),
+        dim: u.dim.powi(power)?,
     })
 }
 
@@ -232,7 +288,27 @@ pub struct Quantity {
     pub dim: Dim,
 }
 
+/// Checks a value converted to SI: finite, and not a non-zero value that underflowed (to zero
+/// or to a subnormal, where f64 has lost its precision). `what` is the quantity as written.
+fn check_si(si: f64, written_nonzero: bool, what: &str) -> Result<f64, UnitError> {
+    if !si.is_finite() {
+        return Err(UnitError(format!(
+            "`{what}` is too large: it overflows f64 in SI units"
+        )));
+    }
+    if written_nonzero && !si.is_normal() {
+        return Err(UnitError(format!(
+            "`{what}` is too small: it underflows f64 in SI units (|value| < {:e})",
+            f64::MIN_POSITIVE
+        )));
+    }
+    Ok(si)
+}
+
 /// Parses `"<number> <unit>"` (a bare number is dimensionless) into SI.
+///
+/// Refused with a message: a number that is not finite, a unit [`parse_unit`] refuses, and a
+/// value that overflows f64 in SI or, when not written as zero, underflows (`1e-320 m`).
 pub fn parse_quantity(text: &str) -> Result<Quantity, UnitError> {
     let t = text.trim();
     let split = t.find(|c: char| c.is_whitespace()).unwrap_or(t.len());
@@ -252,12 +328,13 @@ pub fn parse_quantity(text: &str) -> Result<Quantity, UnitError> {
         parse_unit(unit)?
     };
     Ok(Quantity {
-        si: value * unit.to_si,
+        si: check_si(value * unit.to_si, value != 0.0, t)?,
         dim: unit.dim,
     })
 }
 
-/// Parses a quantity and checks that its dimension is that of `expected_unit`; returns SI.
+/// Parses a quantity and checks that its dimension is that of `expected_unit`; returns the value
+/// in `expected_unit` (SI when that unit is SI), finite, and normal unless written as zero.
 pub fn parse_quantity_as(text: &str, expected_unit: &str) -> Result<f64, UnitError> {
     let q = parse_quantity(text)?;
     let u = parse_unit(expected_unit)?;
@@ -267,7 +344,7 @@ pub fn parse_quantity_as(text: &str, expected_unit: &str) -> Result<f64, UnitErr
             q.dim, u.dim
         )));
     }
-    Ok(q.si / u.to_si)
+    check_si(q.si / u.to_si, q.si != 0.0, text.trim())
 }
 
 #[cfg(test)]
@@ -318,5 +395,94 @@ mod tests {
         assert!(parse_quantity_as("abc deg", "rad").is_err());
         assert!(parse_quantity_as("NaN deg", "rad").is_err());
         assert!(parse_quantity_as("1 s^x", "s").is_err());
+    }
+
+    #[test]
+    fn exponents_are_bounded_not_wrapped() {
+        // i32::MIN as a power: its absolute value used to wrap, and s^-2147483648 times the
+        // doubled exponent of s wrapped to 0, so `rad*s^-2147483648` read as plain rad
+        for text in [
+            "1 rad*s^2147483647",
+            "1 rad*s^-2147483648",
+            "1 s^99999999999",
+        ] {
+            let e = parse_quantity_as(text, "rad").unwrap_err();
+            assert!(
+                e.0.contains("power") && e.0.contains("out of range"),
+                "{text}: {e}"
+            );
+        }
+        let e = parse_unit("s^13").unwrap_err();
+        assert!(e.0.contains("power `13` is out of range"), "{e}");
+        // each written power is in range, their product is not
+        let e = parse_unit("s^12*s^12*s").unwrap_err();
+        assert!(
+            e.0.contains("dimension s^25 is out of range (|exponent| <= 24"),
+            "{e}"
+        );
+        assert_eq!(parse_unit("s^12*s^12").unwrap().dim, Dim([0, 48, 0]));
+        let e = parse_unit("1/s^12/s^12/s").unwrap_err();
+        assert!(e.0.contains("dimension s^-25"), "{e}");
+        // the same bound for regressor dimensions and powers
+        assert!(DIM_ACCEL.powi(12).is_ok());
+        assert!(DIM_ACCEL.powi(13).unwrap_err().contains("power 13"));
+        assert!(DIM_ACCEL.powi(i32::MIN).is_err());
+        let e = DIM_ACCEL.powi(12).unwrap().times(DIM_RATE).unwrap_err();
+        assert!(e.contains("dimension s^-25"), "{e}");
+    }
+
+    #[test]
+    fn sqrt_nesting_is_bounded() {
+        assert!(parse_unit("sqrt(sqrt(sqrt(sqrt(1))))").is_ok());
+        let e = parse_unit("sqrt(sqrt(sqrt(sqrt(sqrt(1)))))").unwrap_err();
+        assert!(e.0.contains("`sqrt` nested deeper than 4 levels"), "{e}");
+        let deep = format!("{}1{}", "sqrt(".repeat(100_000), ")".repeat(100_000));
+        assert!(parse_unit(&deep).is_err());
+    }
+
+    #[test]
+    fn non_finite_and_underflowing_values_are_refused() {
+        let e = parse_quantity("1e308 g").unwrap_err();
+        assert!(
+            e.0.contains("`1e308 g` is too large: it overflows f64"),
+            "{e}"
+        );
+        let e = parse_quantity_as("1e308 km", "m").unwrap_err();
+        assert!(e.0.contains("too large"), "{e}");
+        let e = parse_quantity("1e-320 m").unwrap_err();
+        assert!(
+            e.0.contains("`1e-320 m` is too small: it underflows f64"),
+            "{e}"
+        );
+        let e = parse_quantity("1e-300 ppb").unwrap_err();
+        assert!(e.0.contains("too small"), "{e}");
+        // a value in range whose expected unit moves it out of range
+        let e = parse_quantity_as("1e300 m", "ppb*mm^12").unwrap_err();
+        assert!(
+            e.0.contains("dimension") || e.0.contains("too large"),
+            "{e}"
+        );
+        assert!(parse_quantity("1e999 m").is_err());
+        assert!(parse_quantity("inf m").is_err());
+        assert!(parse_quantity("-inf").is_err());
+        // zero stays zero, of either sign
+        assert_eq!(parse_quantity_as("0 deg/h", "rad/s").unwrap(), 0.0);
+        assert_eq!(parse_quantity_as("-0 ug", "m/s^2").unwrap(), 0.0);
+        // a unit whose factor to SI leaves f64 is refused whatever the value
+        let e = parse_unit("ppb^12*ppb^12*ppb^12").unwrap_err();
+        assert!(
+            e.0.contains("factor to SI is out of the range of f64"),
+            "{e}"
+        );
+        let e = parse_unit("km^12*km^12*km^12*km^12*km^12*km^12*km^12*km^12*km^12").unwrap_err();
+        assert!(
+            e.0.contains("factor to SI") || e.0.contains("dimension"),
+            "{e}"
+        );
+        let e = parse_unit("1/ppb^12/ppb^12/ppb^12").unwrap_err();
+        assert!(
+            e.0.contains("factor to SI is out of the range of f64"),
+            "{e}"
+        );
     }
 }

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use sinsmodel::model::jacobian::{jacobian, PointSpec};
+use sinsmodel::model::jacobian::{jacobian, parse_points, Points};
 use sinsmodel::model::Model;
 use std::path::PathBuf;
 
@@ -26,29 +26,21 @@ pub fn run(args: &JacobianArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
     let text = std::fs::read_to_string(&args.at)
         .with_context(|| format!("cannot read {}", args.at.display()))?;
-    let value: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not valid JSON", args.at.display()))?;
-    let out = match value {
-        serde_json::Value::Array(items) => {
-            let mut outs = Vec::with_capacity(items.len());
-            for (k, v) in items.into_iter().enumerate() {
-                let p: PointSpec = serde_json::from_value(v)
-                    .with_context(|| format!("{}: point {k}", args.at.display()))?;
+    let at = args.at.display();
+    let out = match parse_points(&text).with_context(|| format!("{at}"))? {
+        Points::Many(points) => {
+            let mut outs = Vec::with_capacity(points.len());
+            for (k, p) in points.iter().enumerate() {
                 outs.push(
-                    jacobian(&model, &p, args.runtime)
-                        .with_context(|| format!("{}: point {k}", args.at.display()))?,
+                    jacobian(&model, p, args.runtime)
+                        .with_context(|| format!("{at}: point {k}"))?,
                 );
             }
             serde_json::to_string(&outs)?
         }
-        v => {
-            let p: PointSpec =
-                serde_json::from_value(v).with_context(|| format!("{}", args.at.display()))?;
-            serde_json::to_string(
-                &jacobian(&model, &p, args.runtime)
-                    .with_context(|| format!("{}", args.at.display()))?,
-            )?
-        }
+        Points::One(p) => serde_json::to_string(
+            &jacobian(&model, &p, args.runtime).with_context(|| format!("{at}"))?,
+        )?,
     };
     println!("{out}");
     Ok(())

@@ -23,6 +23,22 @@ pub fn attitude_deg(rpy: [f64; 3]) -> Option<String> {
     (!ok).then(|| format!("attitude {rpy:?} outside roll ±180, pitch ±90, yaw ±360 deg"))
 }
 
+/// Velocity components [m/s]: finite, each within ±1e4.
+pub fn velocity_mps(v: [f64; 3]) -> Option<String> {
+    (!v.iter().all(|x| x.abs() <= 1e4)).then(|| format!("velocity {v:?} beyond ±1e4 m/s"))
+}
+
+/// Specific force components [m/s²]: finite, each within ±1e4 (about 1000 g).
+pub fn specific_force_mps2(f: [f64; 3]) -> Option<String> {
+    (!f.iter().all(|x| x.abs() <= 1e4))
+        .then(|| format!("specific force {f:?} beyond ±1e4 m/s^2 (about 1000 g)"))
+}
+
+/// Angular rate components [rad/s]: finite, each within ±1e3.
+pub fn angular_rate_rps(w: [f64; 3]) -> Option<String> {
+    (!w.iter().all(|x| x.abs() <= 1e3)).then(|| format!("angular rate {w:?} beyond ±1e3 rad/s"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -39,5 +55,11 @@ mod tests {
             attitude_deg([0.0, 95.0, 0.0]).is_some()
                 && attitude_deg([f64::NAN, 0.0, 0.0]).is_some()
         );
+        assert!(velocity_mps([1e4, -1e4, 0.0]).is_none());
+        assert!(velocity_mps([0.0, 1e308, 0.0]).is_some() && velocity_mps([f64::NAN; 3]).is_some());
+        assert!(specific_force_mps2([0.0, 0.0, -9.8]).is_none());
+        assert!(specific_force_mps2([0.0, 0.0, -1e308]).is_some());
+        assert!(angular_rate_rps([1e3, 0.0, 0.0]).is_none());
+        assert!(angular_rate_rps([0.0, f64::INFINITY, 0.0]).is_some());
     }
 }

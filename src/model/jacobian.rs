@@ -42,8 +42,34 @@ pub struct JacobianOut {
     pub h: BTreeMap<&'static str, Vec<Vec<f64>>>,
 }
 
+/// The points of a POINT.json text, as `sinsmodel jacobian --at` reads it.
+#[derive(Debug, Clone)]
+pub enum Points {
+    /// A single JSON object: one point (the output is one object).
+    One(PointSpec),
+    /// A JSON array of objects (the output is an array).
+    Many(Vec<PointSpec>),
+}
+
+/// Reads POINT.json text: one point object, or an array of them; errors name the point.
+pub fn parse_points(text: &str) -> Result<Points> {
+    let value: serde_json::Value = serde_json::from_str(text).context("not valid JSON")?;
+    Ok(match value {
+        serde_json::Value::Array(items) => Points::Many(
+            items
+                .into_iter()
+                .enumerate()
+                .map(|(k, v)| serde_json::from_value(v).with_context(|| format!("point {k}")))
+                .collect::<Result<_>>()?,
+        ),
+        v => Points::One(serde_json::from_value(v)?),
+    })
+}
+
 impl PointSpec {
-    /// Checks that every number is finite and the latitude is inside ±90°.
+    /// Checks that every number is finite and within the physical ranges of [`crate::io::bounds`]
+    /// (latitude inside ±90°, height ±1e5 m, attitude, velocity ±1e4 m/s, specific force
+    /// ±1e4 m/s², angular rate ±1e3 rad/s), so that A and H are finite.
     pub fn validate(&self) -> Result<()> {
         let all = [self.lat_deg, self.h_m]
             .into_iter()
@@ -56,6 +82,17 @@ impl PointSpec {
         }
         if self.lat_deg.abs() >= 90.0 {
             bail!("lat_deg = {} is outside (-90, 90)", self.lat_deg);
+        }
+        use crate::io::bounds;
+        let problems = [
+            bounds::height_m(self.h_m).map(|p| format!("h_m: {p}")),
+            bounds::attitude_deg(self.euler_deg).map(|p| format!("euler_deg: {p}")),
+            bounds::velocity_mps(self.v_ned).map(|p| format!("v_ned: {p}")),
+            bounds::specific_force_mps2(self.f_b).map(|p| format!("f_b: {p}")),
+            bounds::angular_rate_rps(self.w_b).map(|p| format!("w_b: {p}")),
+        ];
+        if let Some(p) = problems.into_iter().flatten().next() {
+            bail!("point: {p}");
         }
         Ok(())
     }

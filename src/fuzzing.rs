@@ -1,0 +1,254 @@
+//! Fuzz target bodies, shared by cargo-fuzz (`fuzz/`) and the stable corpus test
+//! (`tests/fuzz_corpus.rs`).
+//!
+//! Each `pub fn NAME(data: &[u8])` takes arbitrary bytes, feeds them to one parser, and panics
+//! only when a property breaks. The property is the same everywhere: no panic, no hang, and no
+//! NaN or infinity in anything a parser accepts. Refusing an input with an error is always fine.
+//! See `docs/fuzzing.md`.
+
+use crate::io::units;
+use crate::model::jacobian::{jacobian, parse_points, PointSpec, Points};
+use crate::model::Model;
+use crate::sim::scenario::Scenario;
+use sinsmodel_codegen::spec::SPEC_FILES;
+use sinsmodel_codegen::units::{Dim, MAX_DIM_EXPONENT};
+use sinsmodel_codegen::{Layout, Spec};
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Names of the targets, as `fuzz/fuzz_targets/NAME.rs` and `fuzz/corpus/NAME/` use them.
+pub const TARGETS: [&str; 4] = ["spec", "units", "scenario", "jacobian_point"];
+
+/// The target function of a name in [`TARGETS`].
+pub fn target(name: &str) -> Option<fn(&[u8])> {
+    match name {
+        "spec" => Some(spec),
+        "units" => Some(units),
+        "scenario" => Some(scenario),
+        "jacobian_point" => Some(jacobian_point),
+        _ => None,
+    }
+}
+
+/// The real spec files, in [`SPEC_FILES`] order, held fixed while one of them is fuzzed.
+const REAL_SPEC: [&str; 4] = [
+    include_str!("../model-spec/navigation.toml"),
+    include_str!("../model-spec/terms.toml"),
+    include_str!("../model-spec/measurements.toml"),
+    include_str!("../model-spec/presets.toml"),
+];
+
+/// Panics naming `what` unless `v` is finite.
+fn finite(v: f64, what: &str) {
+    assert!(v.is_finite(), "accepted {what} = {v} is not finite");
+}
+
+/// Panics unless every exponent of `d` is within the documented bound (no wrapped arithmetic).
+fn bounded(d: Dim, what: &str) {
+    assert!(
+        d.0.iter().all(|e| e.abs() <= 2 * MAX_DIM_EXPONENT),
+        "accepted {what} has dimension exponents {:?} beyond ±{MAX_DIM_EXPONENT}",
+        d.0
+    );
+}
+
+/// The model-spec compiler's front end (TOML, units, expressions, presets).
+///
+/// The first byte picks the file to replace (`byte % 4`, in [`SPEC_FILES`] order: `0`
+/// navigation, `1` terms, `2` measurements, `3` presets as ASCII digits); the rest of the input
+/// is its text, the other three files are the real ones. Property: an accepted spec has finite
+/// numbers everywhere (priors, noise densities, display factors, expression literals) and its
+/// presets lay out without panicking.
+pub fn spec(data: &[u8]) {
+    let Some((&which, text)) = data.split_first() else {
+        return;
+    };
+    let Ok(text) = std::str::from_utf8(text) else {
+        return;
+    };
+    let mut texts = REAL_SPEC;
+    texts[usize::from(which) % SPEC_FILES.len()] = text;
+    let Ok(spec) = Spec::from_texts(Path::new("model-spec"), texts) else {
+        return;
+    };
+    for s in &spec.nav_states {
+        finite(s.sigma, &format!("state `{}` sigma", s.name));
+        finite(
+            s.display_to_si,
+            &format!("state `{}` display factor", s.name),
+        );
+    }
+    for e in &spec.nav_entries {
+        for v in e.expr.literals() {
+            finite(v, &format!("literal of `{}`", e.expr.source));
+        }
+    }
+    for t in &spec.terms {
+        finite(t.sigma, &format!("term `{}` sigma", t.name));
+        finite(t.noise, &format!("term `{}` noise", t.name));
+        finite(
+            t.display_to_si,
+            &format!("term `{}` display factor", t.name),
+        );
+    }
+    for r in &spec.regressors {
+        for v in r.expr.literals() {
+            finite(v, &format!("literal of regressor `{}`", r.expr.source));
+        }
+        if let Ok(d) = r.expr.dimension() {
+            bounded(d, &format!("regressor `{}`", r.expr.source));
+        }
+    }
+    for m in &spec.measurements {
+        finite(m.sigma, &format!("measurement `{}` sigma", m.name));
+        for e in m.rows.iter().flat_map(|r| &r.h) {
+            for v in e.expr.literals() {
+                finite(v, &format!("literal of `{}`", e.expr.source));
+            }
+        }
+    }
+    finite(spec.sensor_noise.gyro_arw, "gyro_arw");
+    finite(spec.sensor_noise.accel_vrw, "accel_vrw");
+    for p in 0..spec.presets.len() {
+        for vertical in [false, true] {
+            let _ = Layout::preset(&spec, p, vertical);
+        }
+    }
+}
+
+/// The unit and quantity parser (`"0.01 deg/h"`, `"10 ug/g^2"`, `"1 deg/sqrt(h)"`).
+///
+/// Up to the first newline is a quantity, after it a unit it is expected in (none: the
+/// quantity's own text is also tried as a unit). Property: an accepted unit has a finite,
+/// positive factor to SI and bounded dimension exponents; an accepted quantity is finite in SI
+/// and in the expected unit, and has the expected unit's dimension.
+pub fn units(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let (quantity, unit) = match text.split_once('\n') {
+        Some((q, u)) => (q, u),
+        None => (text.as_ref(), text.as_ref()),
+    };
+    for u in [quantity, unit] {
+        if let Ok(parsed) = units::parse_unit(u) {
+            finite(parsed.to_si, &format!("factor to SI of `{u}`"));
+            assert!(parsed.to_si > 0.0, "unit `{u}` has factor {}", parsed.to_si);
+            bounded(parsed.dim, &format!("unit `{u}`"));
+        }
+    }
+    if let Ok(q) = units::parse_quantity(quantity) {
+        finite(q.si, &format!("quantity `{quantity}`"));
+        bounded(q.dim, &format!("quantity `{quantity}`"));
+    }
+    if let Ok(v) = units::parse_quantity_as(quantity, unit) {
+        finite(v, &format!("`{quantity}` in `{unit}`"));
+        let q = units::parse_quantity(quantity).expect("accepted as a unit, so as a quantity");
+        let u = units::parse_unit(unit).expect("accepted as expected, so as a unit");
+        assert_eq!(q.dim, u.dim, "`{quantity}` accepted as `{unit}`");
+    }
+}
+
+/// The scenario reader (`sinsmodel simulate SCENARIO`): TOML text, nothing simulated.
+/// Property: every number of an accepted scenario is finite, and so is its duration.
+pub fn scenario(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(s) = Scenario::parse(text, "fuzz.toml") else {
+        return;
+    };
+    finite(s.imu_rate_hz, "imu_rate_hz");
+    finite(s.truth_rate_hz, "truth_rate_hz");
+    let st = &s.start;
+    for (v, what) in [
+        (st.lat_deg, "lat_deg"),
+        (st.lon_deg, "lon_deg"),
+        (st.h_m, "h_m"),
+        (st.speed_mps, "speed_mps"),
+    ] {
+        finite(v, what);
+    }
+    st.euler_deg.iter().for_each(|&v| finite(v, "euler_deg"));
+    for g in &s.segments {
+        finite(g.duration_s, "duration_s");
+        finite(g.accel_mps2, "accel_mps2");
+        finite(g.yaw_rate_deg_s, "yaw_rate_deg_s");
+    }
+    for v in &s.vibration {
+        finite(v.freq_hz, "vibration freq_hz");
+        finite(v.phase_deg, "vibration phase_deg");
+        v.band_hz
+            .iter()
+            .flatten()
+            .for_each(|&b| finite(b, "vibration band_hz"));
+        v.schedule
+            .iter()
+            .flatten()
+            .flatten()
+            .for_each(|&w| finite(w, "vibration schedule"));
+        for q in [&v.amplitude, &v.psd].into_iter().flatten() {
+            if let Ok(q) = units::parse_quantity(q) {
+                finite(q.si, "vibration amplitude or psd");
+            }
+        }
+    }
+    for &(k, v) in &s.errors {
+        finite(v, &format!("error of term {k}"));
+    }
+    let n = &s.noise;
+    for v in [
+        n.arw,
+        n.vrw,
+        n.gyro_bias_rw,
+        n.accel_bias_rw,
+        n.gyro_quantum,
+        n.accel_quantum,
+    ] {
+        finite(v, "noise");
+    }
+    if let Some((rate, sne, sd, _)) = s.gnss {
+        finite(rate, "gnss rate_hz");
+        finite(sne, "gnss sigma_ne");
+        finite(sd, "gnss sigma_d");
+    }
+    finite(s.duration(), "duration");
+}
+
+/// P31, built once.
+fn p31() -> &'static Model {
+    static MODEL: OnceLock<Model> = OnceLock::new();
+    MODEL.get_or_init(|| Model::parse("P31").expect("P31 is a preset"))
+}
+
+/// The linearisation-point reader of `sinsmodel jacobian --at POINT.json` (one object or an
+/// array), then A and H of P31 at each accepted point. Property: every number of A and H at an
+/// accepted point is finite.
+pub fn jacobian_point(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let points: Vec<PointSpec> = match parse_points(text) {
+        Ok(Points::One(p)) => vec![p],
+        Ok(Points::Many(v)) => v,
+        Err(_) => return,
+    };
+    for p in &points {
+        let Ok(out) = jacobian(p31(), p, false) else {
+            continue;
+        };
+        for (i, row) in out.a.iter().enumerate() {
+            for (j, &v) in row.iter().enumerate() {
+                assert!(v.is_finite(), "A[{i}][{j}] = {v} at accepted point {p:?}");
+            }
+        }
+        for (name, h) in &out.h {
+            for (i, row) in h.iter().enumerate() {
+                for (j, &v) in row.iter().enumerate() {
+                    assert!(
+                        v.is_finite(),
+                        "H {name}[{i}][{j}] = {v} at accepted point {p:?}"
+                    );
+                }
+            }
+        }
+    }
+}
