@@ -332,8 +332,14 @@ fn check_imu(stream: crate::io::imu_stream::ImuStream) {
             }
             None => interval,
         };
-        assert!(s.dtheta.norm() / dt <= MAX_RATE * (1.0 + 1e-12), "accepted rate beyond bound");
-        assert!(s.dv.norm() / dt <= MAX_FORCE * (1.0 + 1e-12), "accepted force beyond bound");
+        assert!(
+            s.dtheta.norm() / dt <= MAX_RATE * (1.0 + 1e-12),
+            "accepted rate beyond bound"
+        );
+        assert!(
+            s.dv.norm() / dt <= MAX_FORCE * (1.0 + 1e-12),
+            "accepted force beyond bound"
+        );
         prev = Some(s.t);
     }
 }
@@ -422,7 +428,11 @@ pub fn truth(data: &[u8]) {
     let p = files(&[("truth.txt", data)]);
     if let Ok(rows) = crate::io::truth::read(&p[0]) {
         for r in &rows {
-            for v in [r.t, r.lat, r.lon, r.h].iter().chain(r.v.iter()).chain(r.euler.iter()) {
+            for v in [r.t, r.lat, r.lon, r.h]
+                .iter()
+                .chain(r.v.iter())
+                .chain(r.euler.iter())
+            {
                 finite(*v, "truth value");
             }
         }

@@ -71,6 +71,13 @@ fn main() -> ExitCode {
         Command::ImuCheck(args) => cli::imu_check::run(&args),
         Command::Align(args) => cli::align::run(&args),
     };
+    // `sinsmodel bench` measures its child processes' peak memory this way: a parent's rusage
+    // counts the parent's own pages at fork and exec, the child's VmHWM does not
+    if std::env::var_os("SINSMODEL_REPORT_PEAK_RSS").is_some() {
+        if let Some(kib) = cli::bench::peak_rss_kib() {
+            eprintln!("peak-rss-kib {kib}");
+        }
+    }
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

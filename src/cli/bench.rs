@@ -39,20 +39,21 @@ fn data(rate: f64, seconds: f64) -> Result<(SimOutput, Vec<AidingEpoch>)> {
     Ok((sim, aid))
 }
 
-fn peak_rss_mib() -> f64 {
+/// This process's peak resident memory (VmHWM) [KiB].
+pub fn peak_rss_kib() -> Option<u64> {
     std::fs::read_to_string("/proc/self/status")
+        .ok()?
+        .lines()
+        .find(|l| l.starts_with("VmHWM:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
         .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .map(|l| l.to_string())
-        })
-        .and_then(|l| {
-            l.split_whitespace()
-                .nth(1)
-                .and_then(|k| k.parse::<f64>().ok())
-        })
-        .map(|kb| kb / 1024.0)
+}
+
+fn peak_rss_mib() -> f64 {
+    peak_rss_kib()
+        .map(|k| k as f64 / 1024.0)
         .unwrap_or(f64::NAN)
 }
 
@@ -282,37 +283,29 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// A child process's wall time [s] and peak resident memory [MiB] (from wait4's rusage).
+/// A child process's wall time [s] and peak resident memory [MiB] (its own VmHWM, which it
+/// prints when `SINSMODEL_REPORT_PEAK_RSS` is set; a parent's rusage would count the parent's
+/// pages at fork).
 fn run_child(args: &[&std::ffi::OsStr]) -> Result<(f64, f64)> {
     let exe = std::env::current_exe()?;
     let t = Instant::now();
-    let child = std::process::Command::new(&exe)
+    let out = std::process::Command::new(&exe)
         .args(args)
+        .env("SINSMODEL_REPORT_PEAK_RSS", "1")
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
-        .spawn()?;
-    let pid = child.id() as libc::pid_t;
-    // the pipe is read after the exit: these commands print a few lines only
-    let mut status: libc::c_int = 0;
-    // SAFETY: rusage is plain old data, zero is a valid value; wait4 fills it for our own child
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: pid is our child, not yet waited for; the pointers are to live locals
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+        .output()?;
     let el = t.elapsed().as_secs_f64();
-    if r != pid {
-        anyhow::bail!("bench: waiting for {} failed", exe.display());
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        anyhow::bail!("bench: {:?} failed: {}", args, err.trim());
     }
-    let out = child.wait_with_output();
-    let exited_ok = libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0;
-    if !exited_ok {
-        let text = out.map(|o| String::from_utf8_lossy(&o.stderr).to_string());
-        anyhow::bail!(
-            "bench: {:?} failed: {}",
-            args,
-            text.unwrap_or_default().trim()
-        );
-    }
-    Ok((el, usage.ru_maxrss as f64 / 1024.0))
+    let kib: f64 = err
+        .lines()
+        .find_map(|l| l.strip_prefix("peak-rss-kib "))
+        .and_then(|v| v.trim().parse().ok())
+        .ok_or_else(|| anyhow::anyhow!("bench: {:?} did not report its peak memory", args))?;
+    Ok((el, kib / 1024.0))
 }
 
 /// Job 4: navigate and filter on `seconds` of 2 kHz IMU text (the sine case), each as a child
