@@ -6,8 +6,6 @@
 //! thing at a time, for every reader: IMU text, PSINS `.imu`, GNSS_IMU `.csv`, format
 //! descriptions, aiding, truth, RTKLIB `.pos`, scenarios, Jacobian points, noise files.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

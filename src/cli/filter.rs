@@ -127,7 +127,6 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         &mut on_record,
         false,
     )?;
-    drop(io);
     drop(epochs);
     pb.finish_and_clear();
     run.check().map_err(anyhow::Error::msg)?;

@@ -812,7 +812,7 @@ pub fn run_stream(
         prev_t = smp.t;
         e.navigate(&smp, dt, obs);
         on_sample(&e.nav.state);
-        if k % 2000 == 0 {
+        if k.is_multiple_of(2000) {
             progress(io.samples.fraction());
         }
         k += 1;

@@ -66,13 +66,10 @@ impl ImuData {
         }
     }
 
-    /// Mean specific force and angular rate over all samples (Σ increments / Σ intervals).
+    /// Mean specific force [m/s²] and angular rate [rad/s] over all samples: Σ increments /
+    /// Σ intervals, each sample over its own interval ([`mean_rates_of`]).
     pub fn mean_rates(&self) -> (Vector3<f64>, Vector3<f64>) {
-        let dt = self.interval();
-        let n = self.samples.len() as f64;
-        let f = self.samples.iter().map(|s| s.dv).sum::<Vector3<f64>>() / (n * dt);
-        let w = self.samples.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / (n * dt);
-        (f, w)
+        mean_rates_of(&self.samples, self.interval())
     }
 
     /// Checks time order and gaps; `what` names the source in messages.
@@ -93,6 +90,23 @@ impl ImuData {
             }
         }
         Ok(())
+    }
+}
+
+/// Mean specific force [m/s²] and angular rate [rad/s] of consecutive samples, each increment
+/// over its own interval: the increments after the first, summed, over the time from the first
+/// sample to the last (exact on a jittered clock, where dividing by a median interval is not);
+/// a single sample is divided by `dt` [s].
+pub fn mean_rates_of(samples: &[ImuSample], dt: f64) -> (Vector3<f64>, Vector3<f64>) {
+    match samples {
+        [] => (Vector3::zeros(), Vector3::zeros()),
+        [one] => (one.dv / dt, one.dtheta / dt),
+        [first, rest @ ..] => {
+            let span = rest[rest.len() - 1].t - first.t;
+            let f = rest.iter().map(|s| s.dv).sum::<Vector3<f64>>() / span;
+            let w = rest.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / span;
+            (f, w)
+        }
     }
 }
 
