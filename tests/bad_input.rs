@@ -311,3 +311,83 @@ fn scenario_keys_are_found_by_whole_name_and_slow_data_does_not_panic_align() {
         "{err}"
     );
 }
+
+/// A start attitude that contradicts gravity (a sensor upside down given roll 0) stops
+/// navigate and filter with the attitude the data measure; `--force` runs anyway.
+#[test]
+fn an_initial_attitude_against_gravity_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("flip.toml");
+    std::fs::write(
+        &sc,
+        "name = \"flip\"\nimu_rate_hz = 100.0\ntruth_rate_hz = 1.0\nseed = 2\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n\
+         euler_deg = [180.0, 0.0, 20.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 30.0\n\
+         [noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n\
+         [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let sim = dir.path().join("sim");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let imu = sim.join("imu.txt");
+    let aid = sim.join("gnss.txt");
+    let out = dir.path().join("nav.txt");
+    let (ok, err) = navigate(&imu, &out);
+    assert!(
+        !ok && err.contains("--att: the initial attitude contradicts gravity")
+            && err.contains("roll 180.00")
+            || !ok && err.contains("roll -180.00"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let nav_forced = |extra: &[&str]| {
+        let mut a = vec![
+            "navigate",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--lat",
+            "30",
+            "--lon",
+            "110",
+            "--att",
+            "0,0,0",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let (ok, err) = nav_forced(&["--force"]);
+    assert!(
+        ok && err.contains("warning: the initial attitude contradicts gravity"),
+        "{err}"
+    );
+    let od = dir.path().join("f");
+    let filter = |init: &str| {
+        run(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--aid",
+            aid.to_str().unwrap(),
+            "--init",
+            init,
+            "--out",
+            od.to_str().unwrap(),
+        ])
+    };
+    let (ok, err) = filter("30,110,0,0,0,20");
+    assert!(
+        !ok && err.contains("--init: the initial attitude contradicts gravity"),
+        "{err}"
+    );
+    let (ok, err) = filter("30,110,0,180,0,20");
+    assert!(ok, "the right attitude runs: {err}");
+}

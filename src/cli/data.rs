@@ -98,6 +98,9 @@ pub struct DataArgs {
     /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
     #[arg(long)]
     zupt: Option<f64>,
+    /// Run even when the initial roll and pitch contradict the measured gravity direction.
+    #[arg(long)]
+    force: bool,
 }
 
 /// What the data options load for a command that passes over the data more than once: the IMU
@@ -199,6 +202,7 @@ impl DataArgs {
             || self.truth.is_some()
             || self.init.is_some()
             || self.zupt.is_some()
+            || self.force
     }
 
     /// The input files named by the options (so outputs never land on them).
@@ -469,6 +473,21 @@ impl DataArgs {
             }
             (None, None) => bail!("give --init or --truth for the initial state"),
         };
+        let e = start.euler();
+        let (roll, pitch) = (e.x, e.y);
+        let head = sinsmodel::io::imu::ImuData {
+            samples: imu.head().to_vec(),
+        };
+        if let Some(p) =
+            sinsmodel::estimate::align::attitude_contradicts_gravity(&head, roll, pitch)
+        {
+            if args.force {
+                eprintln!("warning: {p} (--force given)");
+            } else {
+                bail!("{}{p}", if args.init.is_some() { "--init: " } else { "" });
+            }
+        }
+        drop(head);
         if let AidPlan::Fixes(fixes, _) = &fixes {
             let after = fixes.iter().filter(|f| f.t > t0).count();
             if after < 10 {

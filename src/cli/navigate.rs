@@ -44,6 +44,9 @@ pub struct NavigateArgs {
     /// Output file (truth layout of DESIGN §9).
     #[arg(long)]
     out: PathBuf,
+    /// Run even when --att's roll and pitch contradict the measured gravity direction.
+    #[arg(long)]
+    force: bool,
     /// Read the whole IMU file before navigating (the pre-streaming path, kept as the baseline
     /// `sinsmodel bench` measures the stream against).
     #[arg(long, hide = true)]
@@ -97,8 +100,19 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     for p in &check.problems {
         eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
     }
-    drop(head);
     let d = std::f64::consts::PI / 180.0;
+    if let Some(p) = sinsmodel::estimate::align::attitude_contradicts_gravity(
+        &head,
+        args.att[0] * d,
+        args.att[1] * d,
+    ) {
+        if args.force {
+            eprintln!("warning: {p} (--force given)");
+        } else {
+            bail!("--att: {p}");
+        }
+    }
+    drop(head);
     let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
     let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
     let t0 = data.first_t() - data.interval();

@@ -133,6 +133,52 @@ pub fn rest_evidence(data: &ImuData, win: usize, g: f64) -> Vec<RestEvidence> {
         .collect()
 }
 
+/// Largest angle [rad] between the measured mean specific force at rest and the one an
+/// initial attitude predicts before the attitude is refused (5°).
+pub const MAX_TILT_MISMATCH: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
+/// Checks an initial roll and pitch [rad] against gravity: when the first seconds of `head` are
+/// at rest (by [`rest_evidence`] over up to 10 s), the mean specific force must point where the
+/// attitude says "up" is, within [`MAX_TILT_MISMATCH`]; returns the problem in words, or None
+/// (also when the start moves: then the data cannot judge).
+pub fn attitude_contradicts_gravity(head: &ImuData, roll: f64, pitch: f64) -> Option<String> {
+    let dt = head.interval();
+    if !(dt > 0.0) || head.duration() < 2.0 {
+        return None;
+    }
+    let win = ((head.duration().min(10.0) / dt) as usize).min(head.samples.len());
+    let first = ImuData {
+        samples: head.samples[..win].to_vec(),
+    };
+    let g = first.mean_rates().0.norm();
+    let ev = rest_evidence(&first, win, g);
+    if !ev
+        .first()
+        .is_some_and(|e| e.f_spread <= STATIC_F_SPREAD && e.w_spread <= STATIC_W_SPREAD)
+    {
+        return None;
+    }
+    let (f, _) = first.mean_rates();
+    // at rest f^b = C_n^b (0, 0, −g): "up" in the body is −f
+    let c = dcm_from_euler(roll, pitch, 0.0);
+    let predicted = c.transpose() * Vector3::new(0.0, 0.0, -1.0);
+    let angle = f.normalize().dot(&predicted).clamp(-1.0, 1.0).acos();
+    (angle > MAX_TILT_MISMATCH).then(|| {
+        let d = 180.0 / std::f64::consts::PI;
+        format!(
+            "the initial attitude contradicts gravity: roll {:.2} deg, pitch {:.2} deg put the specific force {:.1} deg away from \
+             what the first {:.0} s at rest measure (roll {:.2} deg, pitch {:.2} deg); check roll and pitch (a sensor mounted \
+             upside down has roll 180), or pass --force to run anyway",
+            roll * d,
+            pitch * d,
+            angle * d,
+            first.duration(),
+            (-f.y).atan2(-f.z) * d,
+            f.x.atan2((f.y * f.y + f.z * f.z).sqrt()) * d
+        )
+    })
+}
+
 /// Result of a static alignment.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Alignment {
