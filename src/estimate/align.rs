@@ -143,7 +143,7 @@ pub const MAX_TILT_MISMATCH: f64 = 5.0 * std::f64::consts::PI / 180.0;
 /// (also when the start moves: then the data cannot judge).
 pub fn attitude_contradicts_gravity(head: &ImuData, roll: f64, pitch: f64) -> Option<String> {
     let dt = head.interval();
-    if !(dt > 0.0) || head.duration() < 2.0 {
+    if dt.is_nan() || dt <= 0.0 || head.duration() < 2.0 {
         return None;
     }
     let win = ((head.duration().min(10.0) / dt) as usize).min(head.samples.len());
