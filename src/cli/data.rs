@@ -7,7 +7,7 @@ use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use sinsmodel::estimate::filter::{AidingEpoch, FilterConfig, Mode};
 use sinsmodel::io::imu::ImuData;
 use sinsmodel::io::truth::{TruthLookup, TruthRow};
-use sinsmodel::io::{aiding, readers, truth};
+use sinsmodel::io::{aiding, truth};
 use sinsmodel::model::Model;
 use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::strapdown::{NavState, Vertical};
@@ -23,20 +23,24 @@ pub struct ImuSource {
     /// IMU file if there is one, else chosen by the file's extension.
     #[arg(long)]
     pub imu_format: Option<PathBuf>,
+    /// GPST − IMU clock [s] for a GNSS_IMU .csv without its .tag file (0 keeps the IMU clock).
+    #[arg(long, allow_hyphen_values = true)]
+    pub clock_offset: Option<f64>,
 }
 
 impl ImuSource {
     /// Reads the IMU file; says on stderr which format was used.
     pub fn read(&self) -> Result<ImuData> {
-        let (data, how) = readers::read_imu(&self.imu, self.imu_format.as_deref())?;
-        eprintln!("reading {} {how}", self.imu.display());
-        Ok(data)
+        Ok(self.open()?.collect()?)
     }
 
     /// Opens the IMU file as a stream of validated samples; says on stderr which format was used.
     pub fn open(&self) -> Result<sinsmodel::io::imu_stream::ImuStream> {
-        let (stream, how) =
-            sinsmodel::io::imu_stream::ImuStream::open(&self.imu, self.imu_format.as_deref())?;
+        let (stream, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
+            &self.imu,
+            self.imu_format.as_deref(),
+            self.clock_offset,
+        )?;
         eprintln!("reading {} {how}", self.imu.display());
         Ok(stream)
     }
@@ -67,6 +71,9 @@ pub struct DataArgs {
     /// IMU file if there is one, else chosen by the file's extension.
     #[arg(long)]
     imu_format: Option<PathBuf>,
+    /// GPST − IMU clock [s] for a GNSS_IMU .csv without its .tag file (0 keeps the IMU clock).
+    #[arg(long, allow_hyphen_values = true)]
+    clock_offset: Option<f64>,
     /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
     #[arg(long)]
     aid: Option<PathBuf>,
@@ -110,6 +117,8 @@ pub struct Inputs {
     pub imu: PathBuf,
     /// Its format description, when given.
     pub imu_format: Option<PathBuf>,
+    /// `--clock-offset` [s], when given.
+    pub clock_offset: Option<f64>,
     /// Aiding epochs after the start.
     pub aid: Vec<AidingEpoch>,
     /// Truth rows, when given.
@@ -195,6 +204,7 @@ impl DataArgs {
     pub fn any_given(&self) -> bool {
         self.imu.is_some()
             || self.imu_format.is_some()
+            || self.clock_offset.is_some()
             || self.aid.is_some()
             || self.static_aid.is_some()
             || !self.prior.is_empty()
@@ -323,6 +333,7 @@ impl DataArgs {
         Ok(Inputs {
             imu: self.imu.clone().context("--imu FILE is required")?,
             imu_format: self.imu_format.clone(),
+            clock_offset: self.clock_offset,
             aid,
             truth,
             start,
@@ -338,8 +349,11 @@ impl DataArgs {
             bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
         let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
-        let (imu, how) =
-            sinsmodel::io::imu_stream::ImuStream::open(imu_path, args.imu_format.as_deref())?;
+        let (imu, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
+            imu_path,
+            args.imu_format.as_deref(),
+            args.clock_offset,
+        )?;
         eprintln!("reading {} {how}", imu_path.display());
         if let Some(z) = args.zupt {
             if !(z.is_finite() && z > 0.0 && z < 100.0) {

@@ -91,6 +91,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
             imu: sinsmodel::estimate::explain::ImuInput::File {
                 path: &inputs.imu,
                 format: inputs.imu_format.as_deref(),
+                clock_offset: inputs.clock_offset,
             },
             aid: &inputs.aid,
             truth: inputs.truth.as_deref(),

@@ -95,6 +95,8 @@ pub enum ImuInput<'a> {
         path: &'a std::path::Path,
         /// Its format description, when given.
         format: Option<&'a std::path::Path>,
+        /// GPST − IMU clock offset [s] (`--clock-offset`), when given.
+        clock_offset: Option<f64>,
     },
 }
 
@@ -103,8 +105,12 @@ impl ImuInput<'_> {
     pub fn samples(&self) -> anyhow::Result<Box<dyn filter::Samples + '_>> {
         Ok(match *self {
             ImuInput::Memory(d) => Box::new(filter::SliceSamples::new(&d.samples)),
-            ImuInput::File { path, format } => {
-                Box::new(crate::io::imu_stream::ImuStream::open(path, format)?.0)
+            ImuInput::File {
+                path,
+                format,
+                clock_offset,
+            } => {
+                Box::new(crate::io::imu_stream::ImuStream::open_with(path, format, clock_offset)?.0)
             }
         })
     }

@@ -173,6 +173,27 @@ impl ImuStream {
     /// beside it (`FILE.format.toml`), else by extension (`.imu` PSINS, `.csv` GNSS_IMU with its
     /// `.tag`, anything else the project's text); also returns the words saying which was used.
     pub fn open(path: &Path, format: Option<&Path>) -> Result<(ImuStream, String)> {
+        ImuStream::open_with(path, format, None)
+    }
+
+    /// [`ImuStream::open`] with a GPST − IMU clock offset [s] for a GNSS_IMU csv
+    /// (`--clock-offset`, instead of its `.tag` file); refused for other formats.
+    pub fn open_with(
+        path: &Path,
+        format: Option<&Path>,
+        clock_offset: Option<f64>,
+    ) -> Result<(ImuStream, String)> {
+        if let Some(o) = clock_offset {
+            if !(o.is_finite() && o.abs() <= 1e10) {
+                bail!("--clock-offset {o}: expected seconds within ±1e10");
+            }
+            let csv = format.is_none()
+                && crate::io::imu_format::beside(path).is_none()
+                && path.extension().is_some_and(|e| e == "csv");
+            if !csv {
+                bail!("--clock-offset applies to a GNSS_IMU .csv read by its extension (a format description sets its own [time] column and unit)");
+            }
+        }
         use crate::io::imu_format::{beside, ImuFormat};
         use crate::io::readers::{gnss_imu, psins};
         let name = path.display().to_string();
@@ -208,8 +229,11 @@ impl ImuStream {
                 ))
             }
             Some("csv") => {
-                let how = "as a GNSS_IMU csv on GPST with its .tag file (chosen by its extension)";
-                let log = gnss_imu::read(path).with_context(|| {
+                let how = match clock_offset {
+                    None => "as a GNSS_IMU csv on GPST with its .tag file (chosen by its extension)".to_string(),
+                    Some(o) => format!("as a GNSS_IMU csv, clock offset {o} s from --clock-offset (chosen by its extension)"),
+                };
+                let log = gnss_imu::read_with(path, clock_offset).with_context(|| {
                     format!("reading {name} {how}; {other} (formats/gnss-imu-csv.toml reads it without the .tag)")
                 })?;
                 Ok((
