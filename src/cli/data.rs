@@ -31,7 +31,7 @@ pub struct ImuSource {
 impl ImuSource {
     /// Reads the IMU file; says on stderr which format was used.
     pub fn read(&self) -> Result<ImuData> {
-        Ok(self.open()?.collect()?)
+        self.open()?.collect()
     }
 
     /// Opens the IMU file as a stream of validated samples; says on stderr which format was used.
