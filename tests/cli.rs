@@ -97,3 +97,79 @@ fn jacobian_rejects_bad_input_with_a_clear_message() {
     let (ok, _, err) = sinsmodel(&["model", "show", "P32"]);
     assert!(!ok && err.contains("unknown preset `P32`"), "{err}");
 }
+
+/// `--outage START,DURATION`: the fixes inside are dropped and the drift at the first fix after
+/// it is reported (terminal table and outages.json), finite and growing with the outage.
+#[test]
+fn filter_outages_drop_aiding_and_report_the_drift() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sim = dir.path().join("drive");
+    let (ok, _, err) = sinsmodel(&[
+        "simulate",
+        root.join("scenarios/drive.toml").to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let run = |outages: &[&str], out: &str| {
+        let mut a = vec![
+            "filter".to_string(),
+            "--model".into(),
+            "P28".into(),
+            "--imu".into(),
+            s("imu.txt"),
+            "--aid".into(),
+            s("gnss.txt"),
+            "--truth".into(),
+            s("truth.txt"),
+            "--out".into(),
+            dir.path().join(out).to_str().unwrap().to_string(),
+        ];
+        for o in outages {
+            a.push("--outage".into());
+            a.push(o.to_string());
+        }
+        let refs: Vec<&str> = a.iter().map(|x| x.as_str()).collect();
+        sinsmodel(&refs)
+    };
+    let (ok, _, err) = run(&["80,10", "120,40"], "with");
+    assert!(ok, "{err}");
+    assert!(err.contains("GNSS outages: drift"), "{err}");
+    let json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("with/outages.json")).unwrap(),
+    )
+    .unwrap();
+    let rows = json["outages"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    let drift: Vec<f64> = rows
+        .iter()
+        .map(|r| r["drift_horizontal_m"].as_f64().unwrap())
+        .collect();
+    assert!(drift.iter().all(|d| d.is_finite() && *d > 0.0), "{drift:?}");
+    assert!(
+        drift[1] > drift[0],
+        "a 40 s outage drifts more than a 10 s one: {drift:?}"
+    );
+    // the fixes inside the outages were not used: 50 fewer epochs of pos_ne (2 components)
+    let count = |d: &str| {
+        std::fs::read_to_string(dir.path().join(d).join("innovations.txt"))
+            .unwrap()
+            .lines()
+            .filter(|l| l.contains(" pos_ne "))
+            .count()
+    };
+    let (ok, _, err) = run(&[], "without");
+    assert!(ok, "{err}");
+    assert_eq!(count("without") - count("with"), 2 * 50);
+    // an outage past the data has nothing to measure against
+    let (ok, _, err) = run(&["5000,10"], "late");
+    assert!(
+        !ok && err.contains("--outage") && err.contains("no position fix after it"),
+        "{err}"
+    );
+    // malformed
+    let (ok, _, err) = run(&["nan,10"], "bad");
+    assert!(!ok && err.contains("--outage `nan,10`"), "{err}");
+}

@@ -108,6 +108,19 @@ pub struct DataArgs {
     /// Run even when the initial roll and pitch contradict the measured gravity direction.
     #[arg(long)]
     force: bool,
+    /// A GNSS outage: START,DURATION [s], START counted from the first IMU sample; the aiding
+    /// epochs inside are dropped and the drift at its end is reported (repeatable).
+    #[arg(long, allow_hyphen_values = true)]
+    outage: Vec<String>,
+}
+
+/// A GNSS outage window on the data's clock [s].
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Outage {
+    /// First second without aiding, on the data's clock [s].
+    pub start_s: f64,
+    /// End of the window [s].
+    pub end_s: f64,
 }
 
 /// What the data options load for a command that passes over the data more than once: the IMU
@@ -137,6 +150,8 @@ pub struct Opened {
     pub truth: Option<truth::TruthReader>,
     /// Initial navigation state.
     pub start: NavState,
+    /// GNSS outages (aiding dropped inside).
+    pub outages: Vec<Outage>,
 }
 
 /// Where the aiding epochs come from.
@@ -169,6 +184,17 @@ impl AidPlan {
             AidPlan::Fixes(f, _) => f.len(),
             AidPlan::Static { .. } => 0,
         }
+    }
+
+    /// The epochs in time order without those inside any outage window.
+    pub fn epochs_outside<'a>(
+        &'a self,
+        outages: &'a [Outage],
+    ) -> Box<dyn Iterator<Item = AidingEpoch> + 'a> {
+        Box::new(
+            self.epochs()
+                .filter(move |e| !outages.iter().any(|o| e.t >= o.start_s && e.t < o.end_s)),
+        )
     }
 
     /// The epochs in time order (endless for a static vehicle: the run ends with the IMU data).
@@ -213,6 +239,7 @@ impl DataArgs {
             || self.init.is_some()
             || self.zupt.is_some()
             || self.force
+            || !self.outage.is_empty()
     }
 
     /// The input files named by the options (so outputs never land on them).
@@ -326,7 +353,7 @@ impl DataArgs {
         let start = opened.start;
         let aid: Vec<AidingEpoch> = opened
             .aid
-            .epochs()
+            .epochs_outside(&opened.outages)
             .take_while(|e| e.t <= t_last + 1e-9)
             .collect();
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
@@ -534,11 +561,42 @@ impl DataArgs {
                 );
             }
         }
+        let mut outages = Vec::new();
+        for o in &args.outage {
+            let v: Vec<f64> = o
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|_| {
+                    anyhow::anyhow!(
+                        "--outage `{}`: expected START,DURATION in seconds",
+                        sinsmodel::io::lines::shown(o)
+                    )
+                })?;
+            if v.len() != 2
+                || !v.iter().all(|x| x.is_finite())
+                || v[0] < 0.0
+                || v[1] <= 0.0
+                || v[0] + v[1] > 1e7
+            {
+                bail!(
+                    "--outage `{}`: expected START,DURATION in seconds (START >= 0 from the first IMU sample, DURATION > 0)",
+                    sinsmodel::io::lines::shown(o)
+                );
+            }
+            let start_s = imu.first_t() + v[0];
+            outages.push(Outage {
+                start_s,
+                end_s: start_s + v[1],
+            });
+        }
+        outages.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
         Ok(Opened {
             imu,
             aid: fixes.after(t0),
             truth: truth_reader,
             start,
+            outages,
         })
     }
 

@@ -107,7 +107,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         Ok(())
     };
     let pb = progress::bar(1000, "filter");
-    let mut epochs = inputs.aid.epochs();
+    let mut epochs = inputs.aid.epochs_outside(&inputs.outages);
     let mut io = filter::StreamIo {
         samples: &mut inputs.imu,
         aiding: &mut epochs,
@@ -149,6 +149,17 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     if let Some(f) = model_error {
         f.commit()?;
     }
+    let outage_rows = outage_drifts(&inputs.outages, &run, t_last)?;
+    if !outage_rows.is_empty() {
+        sinsmodel::io::atomic_file::write_text(
+            &out.file("outages.json"),
+            &serde_json::to_string_pretty(&serde_json::json!({
+                "command": provenance,
+                "what": "GNSS outages: horizontal position drift of the filter's solution at the first aiding fix after each, against that fix (its pos_ne innovation), metres",
+                "outages": outage_rows,
+            }))?,
+        )?;
+    }
     out.commit()?;
     eprintln!(
         "filtered {} samples ({:.1} s) with {} ({} states, {} loop): {} scalar updates",
@@ -160,6 +171,24 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         run.innovations.len(),
     );
     eprint!("{}", nis_table(&run));
+    if !outage_rows.is_empty() {
+        eprintln!("GNSS outages: drift at the first fix after each (the filter's solution against that fix)");
+        eprintln!(
+            "  {:>10} {:>9} {:>10} {:>9} {:>9} {:>10}",
+            "start[s]", "length[s]", "fix at[s]", "north[m]", "east[m]", "horiz.[m]"
+        );
+        for r in &outage_rows {
+            eprintln!(
+                "  {:>10.1} {:>9.1} {:>10.1} {:>9.2} {:>9.2} {:>10.2}",
+                r.start_s - t_first,
+                r.end_s - r.start_s,
+                r.fix_t_s - t_first,
+                r.drift_n_m,
+                r.drift_e_m,
+                r.drift_horizontal_m
+            );
+        }
+    }
     if let (Some(first), Some(last)) = (errors.first(), errors.last()) {
         let mid = 0.5 * (first.0 + last.0);
         let half: Vec<[f64; 2]> = errors
@@ -183,8 +212,55 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     if with_truth {
         files.push("model_error.txt");
     }
+    if !inputs.outages.is_empty() {
+        files.push("outages.json");
+    }
     eprintln!("wrote {} in {}", files.join(", "), args.out.display());
     Ok(())
+}
+
+/// The drift at the end of one GNSS outage.
+#[derive(Debug, Clone, serde::Serialize)]
+struct OutageDrift {
+    start_s: f64,
+    end_s: f64,
+    /// Time of the first aiding fix after the outage [s].
+    fix_t_s: f64,
+    drift_n_m: f64,
+    drift_e_m: f64,
+    drift_horizontal_m: f64,
+}
+
+/// For each outage, the pos_ne innovation (computed − fix, before the update) at the first
+/// fix after it: the drift of the filter's solution over the outage.
+fn outage_drifts(
+    outages: &[super::data::Outage],
+    run: &filter::FilterRun,
+    t_last: f64,
+) -> Result<Vec<OutageDrift>> {
+    let mut out = Vec::new();
+    for o in outages {
+        let after = |c: usize| {
+            run.innovations
+                .iter()
+                .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
+        };
+        let (Some(n), Some(e)) = (after(0), after(1)) else {
+            anyhow::bail!(
+                "--outage ending at {:.1} s: no position fix after it inside the data (which end at {t_last:.1} s): nothing to measure the drift against",
+                o.end_s
+            );
+        };
+        out.push(OutageDrift {
+            start_s: o.start_s,
+            end_s: o.end_s,
+            fix_t_s: n.t,
+            drift_n_m: n.nu,
+            drift_e_m: e.nu,
+            drift_horizontal_m: n.nu.hypot(e.nu),
+        });
+    }
+    Ok(out)
 }
 
 /// The mean NIS of every channel against its 95 % band, with a word on each.
