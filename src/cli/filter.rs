@@ -18,10 +18,14 @@ pub struct FilterArgs {
     model: String,
     #[command(flatten)]
     data: DataArgs,
-    /// Output directory: states.txt, innovations.txt, model_error.txt (with truth); written
+    /// Output directory: states.txt, innovations.txt, nav.txt (the navigation solution with
+    /// 1-σ) and its plots, model_error.txt (with truth), outages.json (with --outage); written
     /// complete or not at all, replacing only an earlier sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
+    /// Rate of the navigation solution nav.txt [Hz] (default: every IMU sample).
+    #[arg(long)]
+    nav_rate: Option<f64>,
     /// Read the whole IMU file before filtering (the pre-streaming path, kept as the baseline
     /// `sinsmodel bench` measures the stream against).
     #[arg(long, hide = true)]
@@ -106,6 +110,17 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         errors.push((r.t, e_ne));
         Ok(())
     };
+    if let Some(r) = args.nav_rate {
+        if !(r.is_finite() && r > 0.0 && r <= 1e5) {
+            anyhow::bail!("--nav-rate {r}: expected a rate in (0, 1e5] Hz");
+        }
+    }
+    let every = match args.nav_rate {
+        Some(r) => (1.0 / (r * inputs.imu.interval())).round().max(1.0) as u64,
+        None => 1,
+    };
+    let mut nav =
+        super::nav_out::NavWriter::create(&out.file("nav.txt"), &model, every, &provenance)?;
     let pb = progress::bar(1000, "filter");
     let mut epochs = inputs.aid.epochs_outside(&inputs.outages);
     let mut io = filter::StreamIo {
@@ -123,7 +138,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         &mut io,
         |f| pb.set_position((f * 1000.0) as u64),
         &mut |_| {},
-        &mut filter::NoObserver,
+        &mut nav,
         &mut on_record,
         false,
     )?;
@@ -149,6 +164,8 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     if let Some(f) = model_error {
         f.commit()?;
     }
+    let nav_rows = nav.rows;
+    nav.finish(&out.file("nav.png"))?;
     let outage_rows = outage_drifts(&inputs.outages, &run, t_last)?;
     if !outage_rows.is_empty() {
         sinsmodel::io::atomic_file::write_text(
@@ -208,14 +225,24 @@ pub fn run(args: &FilterArgs) -> Result<()> {
             );
         }
     }
-    let mut files = vec!["states.txt", "innovations.txt"];
+    let mut files = vec![
+        "states.txt",
+        "innovations.txt",
+        "nav.txt",
+        "nav_track.png",
+        "nav_sigma.png",
+    ];
     if with_truth {
         files.push("model_error.txt");
     }
     if !inputs.outages.is_empty() {
         files.push("outages.json");
     }
-    eprintln!("wrote {} in {}", files.join(", "), args.out.display());
+    eprintln!(
+        "wrote {} in {} (nav.txt: {nav_rows} rows)",
+        files.join(", "),
+        args.out.display()
+    );
     Ok(())
 }
 

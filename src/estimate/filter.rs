@@ -233,6 +233,9 @@ pub trait Observer {
     /// model's A (n×n row-major; non-zeros at `pattern`) used for it.
     fn step(&mut self, _t: f64, _dt: f64, _np: &NavPoint, _a: &[f64], _pattern: &[(usize, usize)]) {
     }
+    /// After every IMU sample: the navigation state, and the error estimate x and covariance P
+    /// (n×n row-major) as of the last propagation step or update.
+    fn nav_sample(&mut self, _s: &NavState, _x: &[f64], _p: &[f64]) {}
     /// Before a scalar update is applied: its row `h`, gain `k` = P⁻hᵀ/S, innovation ν and
     /// variance S, and which measurement component it is.
     #[allow(clippy::too_many_arguments)]
@@ -812,6 +815,7 @@ pub fn run_stream(
         prev_t = smp.t;
         e.navigate(&smp, dt, obs);
         on_sample(&e.nav.state);
+        obs.nav_sample(&e.nav.state, &e.x, &e.p);
         if k.is_multiple_of(2000) {
             progress(io.samples.fraction());
         }
