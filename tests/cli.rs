@@ -265,3 +265,84 @@ fn filter_writes_a_navigation_solution_with_sigmas() {
     eprintln!("navigate alone: horizontal error RMS {raw_rms:.3} m");
     assert!(raw_rms > 5.0 * 0.5, "{raw_rms}");
 }
+
+/// GNSS velocity aiding: an 11-column aiding file (or an RTKLIB .pos with velocities) adds
+/// vel_ne updates with its σ; `--aid-use` chooses; asking for velocities a file lacks is refused.
+#[test]
+fn filter_uses_gnss_velocities_when_the_file_has_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sim = dir.path().join("drive");
+    let (ok, _, err) = sinsmodel(&[
+        "simulate",
+        root.join("scenarios/drive.toml").to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    // velocities from the truth at the fix times, σ 0.05 m/s
+    let truth: Vec<Vec<f64>> = std::fs::read_to_string(sim.join("truth.txt"))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let mut text = String::from("# t lat lon h sn se sd vn ve vd sv\n");
+    for l in std::fs::read_to_string(sim.join("gnss.txt"))
+        .unwrap()
+        .lines()
+    {
+        if l.starts_with('#') {
+            continue;
+        }
+        let t: f64 = l.split_whitespace().next().unwrap().parse().unwrap();
+        let tr = truth.iter().find(|r| (r[0] - t).abs() < 1e-6).unwrap();
+        text.push_str(&format!("{l} {} {} {} 0.05\n", tr[4], tr[5], tr[6]));
+    }
+    let aid11 = dir.path().join("aid11.txt");
+    std::fs::write(&aid11, text).unwrap();
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let filter = |aid: &str, extra: &[&str], out: &str| {
+        let o = dir.path().join(out);
+        let imu = s("imu.txt");
+        let mut a = vec![
+            "filter",
+            "--model",
+            "P28",
+            "--imu",
+            &imu,
+            "--init",
+            "40.0966,-105.1474,1601,0,0,30",
+            "--aid",
+            aid,
+            "--out",
+            o.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        let r = sinsmodel(&a);
+        let inn = std::fs::read_to_string(o.join("innovations.txt")).unwrap_or_default();
+        (
+            r,
+            inn.matches(" vel_ne ").count(),
+            inn.matches(" pos_ne ").count(),
+        )
+    };
+    let ((ok, _, err), vel, pos) = filter(aid11.to_str().unwrap(), &[], "both");
+    assert!(ok, "{err}");
+    assert_eq!((vel, pos), (2 * 220, 2 * 220), "{err}");
+    let ((ok, _, err), vel, pos) = filter(aid11.to_str().unwrap(), &["--aid-use", "vel"], "vel");
+    assert!(ok, "{err}");
+    assert_eq!((vel, pos), (2 * 220, 0));
+    let ((ok, _, _), vel, _) = filter(aid11.to_str().unwrap(), &["--aid-use", "pos"], "pos");
+    assert!(ok && vel == 0);
+    let ((ok, _, err), _, _) = filter(&s("gnss.txt"), &["--aid-use", "vel"], "none");
+    assert!(!ok && err.contains("has no velocity columns"), "{err}");
+    let ((ok, _, err), _, _) = filter(aid11.to_str().unwrap(), &["--zupt", "0.1"], "zupt");
+    assert!(!ok && err.contains("--zupt and GNSS velocity"), "{err}");
+    // the shared RTKLIB solution carries velocities and their sigma
+    let pos = root.join("../shared/data/gnss-imu-drive/gnss_1934_sf.pos");
+    let e = sinsmodel::io::readers::rtklib::read(&pos).unwrap();
+    assert!(e
+        .iter()
+        .all(|p| p.v_ned.is_some() && p.sigma_v_ne.is_some()));
+}

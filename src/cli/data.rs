@@ -77,6 +77,10 @@ pub struct DataArgs {
     /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
     #[arg(long)]
     aid: Option<PathBuf>,
+    /// Which parts of the aiding file to use: pos, vel or pos,vel (default: all the file has; an
+    /// RTKLIB .pos with vn ve vu, or an 11-column aiding file, has velocities).
+    #[arg(long)]
+    aid_use: Option<String>,
     /// A static vehicle at a known position: lat,lon [deg],h [m]; position updates (σ 0.1 m) and
     /// zero-velocity updates (σ from --zupt, default 0.01 m/s) at 1 Hz instead of --aid.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
@@ -156,8 +160,13 @@ pub struct Opened {
 
 /// Where the aiding epochs come from.
 pub enum AidPlan {
-    /// Fixes from a file, with the ZUPT σ [m/s] to add to each.
-    Fixes(Vec<aiding::PositionFix>, Option<f64>),
+    /// Fixes from a file (with their velocities when the file has them and `--aid-use` takes
+    /// them), with the ZUPT σ [m/s] to add to each and whether positions are used.
+    Fixes(
+        Vec<(aiding::PositionFix, Option<aiding::VelocityFix>)>,
+        Option<f64>,
+        bool,
+    ),
     /// A static vehicle: this fix every whole second from `first_s`, with a ZUPT σ [m/s].
     Static {
         /// The position (its `t` unused).
@@ -173,7 +182,9 @@ impl AidPlan {
     /// Only the epochs after `t0`.
     fn after(self, t0: f64) -> AidPlan {
         match self {
-            AidPlan::Fixes(f, z) => AidPlan::Fixes(f.into_iter().filter(|f| f.t > t0).collect(), z),
+            AidPlan::Fixes(f, z, p) => {
+                AidPlan::Fixes(f.into_iter().filter(|f| f.0.t > t0).collect(), z, p)
+            }
             s => s,
         }
     }
@@ -181,7 +192,7 @@ impl AidPlan {
     /// Number of epochs from a file (0 for the endless static plan).
     pub fn len(&self) -> usize {
         match self {
-            AidPlan::Fixes(f, _) => f.len(),
+            AidPlan::Fixes(f, _, _) => f.len(),
             AidPlan::Static { .. } => 0,
         }
     }
@@ -205,7 +216,16 @@ impl AidPlan {
             pos: Some((f.lat, f.lon, f.h, f.sigma)),
         };
         match self {
-            AidPlan::Fixes(f, zupt) => Box::new(f.iter().map(move |f| epoch(f, f.t, *zupt))),
+            AidPlan::Fixes(f, zupt, use_pos) => Box::new(f.iter().map(move |(p, v)| {
+                let mut e = epoch(p, p.t, *zupt);
+                if let Some(v) = v {
+                    e.vel = Some((Vector3::from(v.v_ned), v.sigma));
+                }
+                if !*use_pos {
+                    e.pos = None;
+                }
+                e
+            })),
             AidPlan::Static { fix, first_s, zupt } => {
                 Box::new((0u64..).map(move |k| epoch(fix, first_s + k as f64, *zupt)))
             }
@@ -232,6 +252,7 @@ impl DataArgs {
             || self.imu_format.is_some()
             || self.clock_offset.is_some()
             || self.aid.is_some()
+            || self.aid_use.is_some()
             || self.static_aid.is_some()
             || !self.prior.is_empty()
             || self.noise.is_some()
@@ -393,24 +414,66 @@ impl DataArgs {
             .map(|_| sinsmodel::model::measurement_sigma("vel_ne").unwrap_or(0.01)));
         let t0 = imu.first_t() - imu.interval();
         let fixes: AidPlan = match (&args.aid, &args.static_aid) {
-            (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => AidPlan::Fixes(
-                sinsmodel::io::readers::rtklib::read(p)?
-                    .iter()
-                    .map(|e| aiding::PositionFix {
-                        t: e.t,
-                        lat: e.lat_deg.to_radians(),
-                        lon: e.lon_deg.to_radians(),
-                        h: e.h,
-                        sigma: [
-                            e.sigma_neu[0].max(0.02),
-                            e.sigma_neu[1].max(0.02),
-                            e.sigma_neu[2].max(0.05),
-                        ],
-                    })
-                    .collect(),
-                zupt,
-            ),
-            (Some(p), None) => AidPlan::Fixes(aiding::read(p)?, zupt),
+            (Some(p), None) => {
+                let fixes: Vec<(aiding::PositionFix, Option<aiding::VelocityFix>)> =
+                    if p.extension().is_some_and(|e| e == "pos") {
+                        sinsmodel::io::readers::rtklib::read(p)?
+                            .iter()
+                            .map(|e| {
+                                (
+                                    aiding::PositionFix {
+                                        t: e.t,
+                                        lat: e.lat_deg.to_radians(),
+                                        lon: e.lon_deg.to_radians(),
+                                        h: e.h,
+                                        sigma: [
+                                            e.sigma_neu[0].max(0.02),
+                                            e.sigma_neu[1].max(0.02),
+                                            e.sigma_neu[2].max(0.05),
+                                        ],
+                                    },
+                                    e.v_ned.map(|v| aiding::VelocityFix {
+                                        v_ned: v,
+                                        // RTKLIB's velocity σ, floored at 1 cm/s
+                                        sigma: e
+                                            .sigma_v_ne
+                                            .map(|s| s[0].max(s[1]))
+                                            .unwrap_or(0.1)
+                                            .max(0.01),
+                                    }),
+                                )
+                            })
+                            .collect()
+                    } else {
+                        aiding::read_with_velocity(p)?
+                    };
+                let has_vel = fixes.iter().any(|f| f.1.is_some());
+                let (use_pos, use_vel) = match args.aid_use.as_deref() {
+                    None => (true, has_vel),
+                    Some("pos") => (true, false),
+                    Some("vel") => (false, true),
+                    Some("pos,vel") | Some("vel,pos") => (true, true),
+                    Some(o) => bail!(
+                        "--aid-use `{}`: expected pos, vel or pos,vel",
+                        sinsmodel::io::lines::shown(o)
+                    ),
+                };
+                if use_vel && !has_vel {
+                    bail!(
+                        "--aid-use {}: {} has no velocity columns (an RTKLIB .pos with vn ve vu, or an aiding file of 11 columns: t lat lon h sigma_n sigma_e sigma_d v_n v_e v_d sigma_v)",
+                        args.aid_use.as_deref().unwrap_or(""),
+                        p.display()
+                    );
+                }
+                if use_vel && args.zupt.is_some() {
+                    bail!("--zupt and GNSS velocity aiding both give the velocity: choose one (--aid-use pos keeps --zupt)");
+                }
+                let fixes = fixes
+                    .into_iter()
+                    .map(|(p, v)| (p, if use_vel { v } else { None }))
+                    .collect();
+                AidPlan::Fixes(fixes, zupt, use_pos)
+            }
             (None, Some(v)) if v.len() == 3 => {
                 use sinsmodel::io::bounds;
                 if let Some(p) = bounds::lat_deg(v[0])
@@ -529,7 +592,8 @@ impl DataArgs {
             }
         }
         drop(head);
-        if let AidPlan::Fixes(fixes, _) = &fixes {
+        if let AidPlan::Fixes(fixes, _, _) = &fixes {
+            let fixes: Vec<&aiding::PositionFix> = fixes.iter().map(|f| &f.0).collect();
             let after = fixes.iter().filter(|f| f.t > t0).count();
             if after < 10 {
                 bail!(

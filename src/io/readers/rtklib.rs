@@ -22,6 +22,8 @@ pub struct PosEpoch {
     pub sigma_neu: [f64; 3],
     /// NED velocity [m/s] when the file has it.
     pub v_ned: Option<[f64; 3]>,
+    /// 1-σ of the north and east velocity [m/s] when the file has them.
+    pub sigma_v_ne: Option<[f64; 2]>,
 }
 
 /// Days since 1970-01-01 of a proleptic Gregorian date.
@@ -94,7 +96,13 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         } else {
             None
         };
+        let sigma_v_ne = if f.len() >= 21 {
+            Some([num(18)?, num(19)?])
+        } else {
+            None
+        };
         let e = PosEpoch {
+            sigma_v_ne,
             t,
             lat_deg: num(2)?,
             lon_deg: num(3)?,
@@ -117,6 +125,11 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
                 e.v_ned
                     .is_some_and(|v| v.iter().any(|x| x.abs() > 1e4))
                     .then(|| "a velocity beyond ±1e4 m/s".to_string())
+            })
+            .or_else(|| {
+                e.sigma_v_ne
+                    .is_some_and(|s| s.iter().any(|x| !(0.0..=1e3).contains(x)))
+                    .then(|| "a velocity sigma outside 0 .. 1e3 m/s".to_string())
             });
         if let Some(b) = bad {
             bail!("{}: {b}", at());
