@@ -37,6 +37,62 @@ pub struct Line<'a> {
     pub file: &'a str,
 }
 
+/// A message made safe to print whatever it echoes: control characters and escape codes escaped
+/// (line breaks kept), runs of more than 20 digits (a 1e308 printed in full) shown in scientific
+/// notation, any word over 200 characters cut, and the whole cut at 4000 characters.
+pub fn printable_message(msg: &str) -> String {
+    let mut out = String::with_capacity(msg.len().min(4100));
+    for (k, line) in msg.split('\n').enumerate() {
+        if k > 0 {
+            out.push('\n');
+        }
+        let mut word = String::new();
+        let flush = |word: &mut String, out: &mut String| {
+            let digits = word.chars().filter(|c| c.is_ascii_digit()).count();
+            if digits > 20 {
+                let num = word.trim_end_matches(['.', ',', ';', ':']);
+                if let Ok(v) = num.parse::<f64>() {
+                    let rest = word[num.len()..].to_string();
+                    out.push_str(&format!("{v:e}{rest}"));
+                    word.clear();
+                    return;
+                }
+            }
+            if word.chars().count() > 200 {
+                let cut: String = word.chars().take(200).collect();
+                out.push_str(&cut);
+                out.push('…');
+            } else {
+                out.push_str(word);
+            }
+            word.clear();
+        };
+        for c in line.chars() {
+            if c == ' ' {
+                flush(&mut word, &mut out);
+                out.push(' ');
+            } else if c.is_control() || c == '\u{feff}' {
+                word.extend(c.escape_debug());
+            } else {
+                word.push(c);
+            }
+        }
+        flush(&mut word, &mut out);
+        if out.len() > 4000 {
+            break;
+        }
+    }
+    if out.len() > 4000 {
+        let mut end = 4000;
+        while !out.is_char_boundary(end) {
+            end -= 1;
+        }
+        out.truncate(end);
+        out.push_str("… (message cut)");
+    }
+    out
+}
+
 /// The 1-based line of byte offset `start` in `text` (an offset at column 0 is on its own line,
 /// not the one before).
 pub fn line_at(text: &str, start: usize) -> usize {
@@ -192,6 +248,19 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("f.txt:1: not UTF-8"), "{e}");
+    }
+
+    #[test]
+    fn messages_are_printable_and_short() {
+        let m = printable_message("--prior `eps\u{1b}[2J=1`: bad");
+        assert!(!m.contains('\u{1b}') && m.contains("\\u{1b}"), "{m}");
+        let big = format!("--lat {}: out of range", 1e308);
+        assert_eq!(printable_message(&big), "--lat 1e308: out of range");
+        let long = "x".repeat(100_000);
+        assert!(printable_message(&long).chars().count() <= 201);
+        let many = "word ".repeat(5000);
+        assert!(printable_message(&many).len() < 4100);
+        assert_eq!(printable_message("a\nb"), "a\nb");
     }
 
     #[test]
