@@ -723,7 +723,7 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
     if text.contains('=') && !path.exists() {
         return noise_inline(&text);
     }
-    let text = std::fs::read_to_string(path)
+    let text = sinsmodel::io::lines::read_small_text(path, "--noise")
         .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
         format!(

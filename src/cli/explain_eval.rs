@@ -148,7 +148,7 @@ fn merge(args: &EvalArgs) -> Result<()> {
     let mut cases: Vec<CaseResult> = Vec::new();
     for d in &args.merge {
         let path = d.join("cases.json");
-        let text = std::fs::read_to_string(&path)
+        let text = sinsmodel::io::lines::read_small_text(&path, "explain-eval result")
             .with_context(|| format!("--merge: cannot read {}", path.display()))?;
         let stored: Stored = serde_json::from_str(&text).with_context(|| {
             format!(

@@ -185,7 +185,7 @@ impl ImuFormat {
                 path.display()
             );
         }
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::lines::read_small_text(path, "IMU format description")
             .with_context(|| format!("--imu-format {}: cannot read the file", path.display()))?;
         ImuFormat::parse(&text, &path.display().to_string())
     }

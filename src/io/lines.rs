@@ -37,6 +37,46 @@ pub struct Line<'a> {
     pub file: &'a str,
 }
 
+/// Largest description-like input read whole [bytes] (scenarios, format descriptions, noise
+/// files, Jacobian points): 16 MiB.
+pub const MAX_SMALL_FILE: u64 = 16 << 20;
+
+/// Reads a small text input whole (a scenario, a description, a JSON file): refused when it is
+/// not a regular file (a device or a pipe would be read forever), larger than
+/// [`MAX_SMALL_FILE`], or not UTF-8; `what` names it in messages.
+pub fn read_small_text(path: &Path, what: &str) -> Result<String> {
+    let meta = std::fs::metadata(path)
+        .with_context(|| format!("{what} {}: cannot read", path.display()))?;
+    if !meta.is_file() {
+        bail!(
+            "{what} {}: not a regular file (a directory, device or pipe)",
+            path.display()
+        );
+    }
+    if meta.len() > MAX_SMALL_FILE {
+        bail!(
+            "{what} {}: {} bytes, more than the {} MiB such a file can be",
+            path.display(),
+            meta.len(),
+            MAX_SMALL_FILE >> 20
+        );
+    }
+    let bytes =
+        std::fs::read(path).with_context(|| format!("{what} {}: cannot read", path.display()))?;
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    match std::str::from_utf8(bytes) {
+        Ok(t) => Ok(t.to_string()),
+        Err(e) => {
+            let line = bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1;
+            bail!("{}:{line}: not UTF-8 text ({what})", path.display())
+        }
+    }
+}
+
 /// A message made safe to print whatever it echoes: control characters and escape codes escaped
 /// (line breaks kept), runs of more than 20 digits (a 1e308 printed in full) shown in scientific
 /// notation, any word over 200 characters cut, and the whole cut at 4000 characters.

@@ -223,7 +223,7 @@ impl Scenario {
 
     /// Reads and validates a scenario file.
     pub fn load(path: &Path) -> Result<Scenario> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::lines::read_small_text(path, "scenario")
             .with_context(|| format!("cannot read scenario {}", path.display()))?;
         Scenario::parse(&text, &path.display().to_string())
     }
