@@ -391,3 +391,46 @@ fn an_initial_attitude_against_gravity_is_refused_unless_forced() {
     let (ok, err) = filter("30,110,0,180,0,20");
     assert!(ok, "the right attitude runs: {err}");
 }
+
+/// Leftovers of a killed run (a staging directory, a set-aside directory, a temporary file,
+/// named with a process that is gone) are removed by the next run into the same place, and a
+/// re-run replaces the earlier run's directory whole.
+#[test]
+fn leftovers_of_killed_runs_are_cleaned_and_reruns_replace_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let imu = d.join("imu.txt");
+    std::fs::write(&imu, GOOD).unwrap();
+    // pid 4194304 is above Linux's pid_max: never a live process
+    std::fs::create_dir(d.join(".o.partial-4194304")).unwrap();
+    std::fs::write(d.join(".o.partial-4194304/states.txt"), "half").unwrap();
+    std::fs::create_dir(d.join(".o.old-4194304")).unwrap();
+    std::fs::write(d.join("nav.txt.partial-4194304-0"), "half").unwrap();
+    let (ok, err) = navigate(&imu, &d.join("nav.txt"));
+    assert!(ok, "{err}");
+    assert!(!d.join("nav.txt.partial-4194304-0").exists());
+    let sc = d.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 20.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let o = d.join("o");
+    for _ in 0..2 {
+        let (ok, err) = run(&[
+            "simulate",
+            sc.to_str().unwrap(),
+            "--out",
+            o.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+    }
+    assert!(!d.join(".o.partial-4194304").exists() && !d.join(".o.old-4194304").exists());
+    let left: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial") || n.contains(".old-"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    assert!(o.join("imu.txt").exists() && o.join("gnss.txt").exists());
+}
