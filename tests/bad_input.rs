@@ -434,3 +434,24 @@ fn leftovers_of_killed_runs_are_cleaned_and_reruns_replace_whole() {
     assert!(left.is_empty(), "{left:?}");
     assert!(o.join("imu.txt").exists() && o.join("gnss.txt").exists());
 }
+
+/// reproduce writes its directory like every other command: one holding a user's files is
+/// refused before any work, and the files are untouched.
+#[test]
+fn reproduce_refuses_a_directory_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("mine");
+    std::fs::create_dir(&o).unwrap();
+    std::fs::write(o.join("results.md"), "my notes").unwrap();
+    for extra in [&[][..], &["--consistency"][..]] {
+        let mut a = vec!["reproduce", "--quick", "--out", o.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        let (ok, err) = run(&a);
+        assert!(!ok && err.contains("was not written by sinsmodel"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(o.join("results.md")).unwrap(),
+        "my notes"
+    );
+    assert_eq!(std::fs::read_dir(&o).unwrap().count(), 1);
+}
