@@ -38,8 +38,8 @@ pub struct ExplainArgs {
     /// Demo only: length of the simulated run [s] (60 to 14400; default 600).
     #[arg(long)]
     demo_seconds: Option<f64>,
-    /// Demo only: seed of the simulation (default 1).
-    #[arg(long)]
+    /// Demo only: seed of the simulation (default 1; 0 to 1e12).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     demo_seed: Option<u64>,
 }
 

@@ -145,6 +145,16 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     drop(epochs);
     pb.finish_and_clear();
     run.check().map_err(anyhow::Error::msg)?;
+    if let Some(tr) = inputs.truth.take() {
+        tr.finish()?;
+        let covered = errors.iter().filter(|e| e.1.is_some()).count();
+        if covered < errors.len() {
+            eprintln!(
+                "warning: the truth file has a row at only {covered} of the {} update epochs: model_error.txt and the model-error RMS cover those only",
+                errors.len()
+            );
+        }
+    }
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
     super::data::check_inside(errors.len(), inputs.aid.len(), start.t, t_last)?;
     states.commit()?;

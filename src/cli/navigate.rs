@@ -155,9 +155,11 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             .iter()
             .all(|v| v.is_finite())
             || st.h.abs() > 1e7
+            || st.lat.abs() >= 89.9f64.to_radians()
+            || st.v.norm() > 1e4
         {
             bail!(
-                "{}: the navigation diverged at t = {:.3} s (sample {}): the increments are not physical there \
+                "{}: the navigation diverged at t = {:.3} s (sample {}): a non-finite state, a pole (the NED frame is undefined there) or a speed over 1e4 m/s; the increments are not physical there \
                  (check the IMU values, units and clock; `sinsmodel imu-check` shows what was read)",
                 args.src.imu.display(),
                 s.t,

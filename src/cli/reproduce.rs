@@ -24,7 +24,7 @@ pub struct ReproduceArgs {
     #[arg(long)]
     consistency: bool,
     /// Seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     seed: u64,
     /// Output directory.
     #[arg(long, default_value = "out/reproduce")]

@@ -52,10 +52,12 @@ pub fn create(path: &Path, header: &str) -> Result<AtomicFile> {
 /// Writes one row of the truth layout (`t lat lon h v_n v_e v_d roll pitch yaw`, degrees).
 pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
     let d = 180.0 / std::f64::consts::PI;
+    // longitude written in [-180, 180) whatever the navigator accumulated
+    let lon_deg = (r.lon * d + 180.0).rem_euclid(360.0) - 180.0;
     let cols: [(f64, usize); 10] = [
         (r.t, 4),
         (r.lat * d, 11),
-        (r.lon * d, 11),
+        (lon_deg, 11),
         (r.h, 4),
         (r.v.x, 6),
         (r.v.y, 6),
@@ -158,6 +160,14 @@ impl TruthReader {
             Some((line, v)) => Ok(Some(row_from(&name, line, v)?)),
             None => Ok(None),
         }
+    }
+}
+
+impl TruthReader {
+    /// Reads the rest of the file, so that a bad row after the last lookup is still reported.
+    pub fn finish(mut self) -> Result<()> {
+        while self.read_row()?.is_some() {}
+        Ok(())
     }
 }
 

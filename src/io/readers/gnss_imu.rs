@@ -45,8 +45,33 @@ pub fn read(path: &Path) -> Result<GnssImuLog> {
 /// Reads `path` with the clock offset [s] added to its times when given (`--clock-offset`: a
 /// log without its `.tag`, or another clock), else from the `.tag` file beside it.
 pub fn read_with(path: &Path, given_offset: Option<f64>) -> Result<GnssImuLog> {
+    let meta = std::fs::metadata(path)
+        .with_context(|| format!("cannot read IMU log {}", path.display()))?;
+    if !meta.is_file() {
+        bail!("{}: not a regular file", path.display());
+    }
     let bytes =
         std::fs::read(path).with_context(|| format!("cannot read IMU log {}", path.display()))?;
+    // the same text rules as every reader (crate::io::lines): NUL bytes, non-UTF-8 text and
+    // over-long lines refused with file:line; a byte-order mark is kept in the byte count (the
+    // tag counts it) but not in the first row
+    let mut lineno = 0usize;
+    for l in bytes.split(|&b| b == b'\n') {
+        lineno += 1;
+        let what = if l.len() > crate::io::lines::MAX_LINE_BYTES {
+            "a line longer than 1 MiB"
+        } else if l.contains(&0) {
+            "NUL bytes in the line"
+        } else if std::str::from_utf8(l).is_err() {
+            "not UTF-8 text"
+        } else {
+            continue;
+        };
+        bail!(
+            "{}:{lineno}: {what}: not a GNSS_IMU csv (binary data, or a truncated write)",
+            path.display()
+        );
+    }
     let text = String::from_utf8_lossy(&bytes);
     let lines: Vec<&str> = text.split('\n').collect();
     let n_lines = lines
@@ -74,21 +99,23 @@ pub fn read_with(path: &Path, given_offset: Option<f64>) -> Result<GnssImuLog> {
     for (i, line) in lines.iter().enumerate().take(n_lines) {
         let line = line.trim_end_matches('\r');
         offset += line.len() + line_end_bytes;
-        let l = line.trim();
+        let l = line.trim().trim_start_matches('\u{feff}');
         match parse_row(l) {
             Some(r) => rows.push((r, offset)),
             None if i == 0 || i + 1 == n_lines => {
                 eprintln!(
-                    "warning: {}:{}: partial or malformed line skipped: `{l}`",
+                    "warning: {}:{}: partial or malformed line skipped: `{}`",
                     path.display(),
-                    i + 1
+                    i + 1,
+                    crate::io::lines::shown(l)
                 );
                 skipped.push(i + 1);
             }
             None => bail!(
-                "{}:{}: malformed row `{l}` (expected 7 comma-separated numbers)",
+                "{}:{}: malformed row `{}` (expected 7 comma-separated numbers)",
                 path.display(),
-                i + 1
+                i + 1,
+                crate::io::lines::shown(l)
             ),
         }
     }
