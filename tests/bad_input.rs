@@ -455,3 +455,30 @@ fn reproduce_refuses_a_directory_it_did_not_write() {
     );
     assert_eq!(std::fs::read_dir(&o).unwrap().count(), 1);
 }
+
+/// A scenario within every bound whose vibration would take hours to simulate (10 000 random
+/// components up to 1e5 Hz at a 100 Hz IMU) is refused at once with the estimate; --force runs it.
+#[test]
+fn a_scenario_that_would_take_hours_is_refused_with_its_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("slow.toml");
+    std::fs::write(
+        &sc,
+        "name = \"slow\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n\
+         [[vibration]]\nkind = \"random\"\naxis = \"z\"\npsd = \"1e-4 g^2/Hz\"\nband_hz = [20.0, 1e5]\ncomponents = 10000\n",
+    )
+    .unwrap();
+    let t = std::time::Instant::now();
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("evaluations") && err.contains("--force"),
+        "{err}"
+    );
+    assert!(t.elapsed().as_secs() < 30, "refused before any work");
+    assert!(!dir.path().join("o").exists());
+}

@@ -217,6 +217,29 @@ fn line_of(text: &str, needle: &str) -> usize {
 
 impl Scenario {
     /// Total duration [s].
+    /// Vibration terms evaluated per quadrature node, and the sub-steps per IMU sample the
+    /// simulator takes (16 per period of the fastest vibration): the work the simulation does is
+    /// about samples × sub-steps × terms × 3 nodes.
+    pub fn vibration_work(&self) -> (f64, f64) {
+        let mut terms = 0.0;
+        let mut max_f: f64 = 0.0;
+        for v in &self.vibration {
+            match v.kind.as_str() {
+                "random" => {
+                    terms += v.components.unwrap_or(200).max(1) as f64;
+                    max_f = max_f.max(v.band_hz.map(|b| b[1]).unwrap_or(0.0));
+                }
+                _ => {
+                    terms += 1.0;
+                    max_f = max_f.max(v.freq_hz);
+                }
+            }
+        }
+        let sub = (16.0 * max_f / self.imu_rate_hz).ceil().max(1.0);
+        (terms, sub)
+    }
+
+    /// Duration of all segments [s].
     pub fn duration(&self) -> f64 {
         self.segments.iter().map(|s| s.duration_s).sum()
     }
