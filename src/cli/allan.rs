@@ -59,6 +59,14 @@ pub fn run(args: &AllanArgs) -> Result<()> {
     let data = args.src.read()?;
     data.check_time(&args.src.imu.display().to_string(), 5.0)?;
     let dt = data.interval();
+    if !(args.skip.is_finite() && args.skip >= 0.0) {
+        anyhow::bail!("--skip {}: expected seconds >= 0", args.skip);
+    }
+    if let Some(s) = args.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            anyhow::bail!("--seconds {s}: expected a positive number of seconds");
+        }
+    }
     let t0 = data.samples[0].t + args.skip;
     let t1 = args.seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);
     let span = ImuData {

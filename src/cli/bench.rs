@@ -139,6 +139,20 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             args.explain_seconds
         );
     }
+    if !(args.memory_seconds.is_finite()
+        && (args.memory_seconds == 0.0 || (10.0..=86_400.0).contains(&args.memory_seconds)))
+    {
+        anyhow::bail!(
+            "--memory-seconds {}: expected 0 (skip) or 10 to 86400 s",
+            args.memory_seconds
+        );
+    }
+    if args.explain_seconds > 0.0 && args.explain_seconds < 60.0 {
+        anyhow::bail!(
+            "--explain-seconds {}: expected 0 (skip) or 60 to 86400 s",
+            args.explain_seconds
+        );
+    }
     let model = Model::parse("P31")?;
     let hours = args.seconds / 3600.0;
 
@@ -274,11 +288,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         peak_rss_mib()
     );
     let _ = std::fs::remove_dir(&dir);
-    if args.memory_seconds > 0.0 {
-        memory_job(args.memory_seconds)?;
-    }
     if args.explain_seconds > 0.0 {
         explain_job(args.explain_seconds)?;
+    }
+    if args.memory_seconds > 0.0 {
+        memory_job(args.memory_seconds)?;
     }
     Ok(())
 }

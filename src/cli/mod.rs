@@ -24,9 +24,16 @@ pub fn command_line() -> String {
             let a: String = if k == 0 {
                 "sinsmodel".into()
             } else {
-                a.chars()
+                let a: String = a
+                    .chars()
                     .map(|c| if c.is_control() { '?' } else { c })
-                    .collect()
+                    .collect();
+                // a header line, not an echo of a 100 kB argument
+                if a.chars().count() > 200 {
+                    format!("{}…", a.chars().take(200).collect::<String>())
+                } else {
+                    a
+                }
             };
             if a.contains(' ') || a.is_empty() {
                 format!("'{a}'")

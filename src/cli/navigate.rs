@@ -80,8 +80,11 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if let Some(p) = bounds::height_m(args.h) {
         bail!("--h: {p}");
     }
-    if args.out_rate.is_nan() || args.out_rate <= 0.0 {
-        bail!("--out-rate must be positive");
+    if !(args.out_rate.is_finite() && args.out_rate > 0.0 && args.out_rate <= 1e5) {
+        bail!(
+            "--out-rate {}: expected a rate in (0, 1e5] Hz",
+            args.out_rate
+        );
     }
     args.src.check_output("--out", &args.out)?;
     // streamed: memory does not grow with the file; the output is written as it goes and

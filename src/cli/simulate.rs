@@ -74,10 +74,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let pb = progress::bar(1000, "simulate");
     let sim = simulate(&sc, |f| pb.set_position((f * 1000.0) as u64));
     pb.finish_and_clear();
+    check_output(&args.scenario, &sim)?;
     let header = format!(
         "{} (scenario `{}`, seed {})",
         super::command_line(),
-        sc.name,
+        sc.name.escape_debug(),
         sc.seed
     );
     imu::write_text(&out.file("imu.txt"), &sim.imu, &header)?;
@@ -96,5 +97,41 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         sim.gnss.len(),
         args.out.display()
     );
+    Ok(())
+}
+
+/// What simulate writes must be what its readers accept: a trajectory that runs past a pole or
+/// beyond 1e4 m/s, or increments beyond what any IMU measures, are refused with the time (a
+/// scenario can ask for them within each of its own bounds).
+fn check_output(
+    scenario: &std::path::Path,
+    sim: &sinsmodel::sim::simulator::SimOutput,
+) -> Result<()> {
+    use sinsmodel::io::bounds;
+    use sinsmodel::io::imu_stream::{MAX_FORCE, MAX_RATE};
+    let name = scenario.display();
+    for r in &sim.truth {
+        let d = 180.0 / std::f64::consts::PI;
+        let problem = bounds::lat_deg(r.lat * d)
+            .or_else(|| bounds::height_m(r.h))
+            .or_else(|| {
+                (r.v.norm() > 1e4).then(|| format!("speed {:.0} m/s beyond 1e4 m/s", r.v.norm()))
+            });
+        if let Some(p) = problem {
+            bail!("{name}: the simulated trajectory is not one the readers accept at t = {:.3} s: {p} (a path across a pole, or an acceleration or vibration too large for its duration)", r.t);
+        }
+    }
+    let mut prev = sim.start.t;
+    for s in &sim.imu.samples {
+        let dt = s.t - prev;
+        prev = s.t;
+        let (w, f) = (s.dtheta.norm() / dt, s.dv.norm() / dt);
+        if !(w.is_finite() && f.is_finite()) || w > MAX_RATE || f > MAX_FORCE {
+            bail!(
+                "{name}: at t = {:.3} s the simulated IMU measures {w:.3e} rad/s and {f:.3e} m/s^2, beyond any IMU (<= {MAX_RATE} rad/s, <= 2000 g): an injected error or a motion too large",
+                s.t
+            );
+        }
+    }
     Ok(())
 }

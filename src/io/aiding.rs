@@ -86,9 +86,9 @@ pub fn read_with_velocity(path: &Path) -> Result<Vec<(PositionFix, Option<Veloci
     }
     rows.into_iter()
         .map(|(line, v)| {
-            if v[4..7].iter().any(|s| !(*s > 0.0 && *s <= 1e5)) {
+            if v[4..7].iter().any(|s| !(*s >= 1e-6 && *s <= 1e5)) {
                 bail!(
-                    "{}:{line}: sigma must be in (0, 1e5] m (got {}, {}, {})",
+                    "{}:{line}: sigma must be in [1e-6, 1e5] m (got {}, {}, {})",
                     path.display(),
                     v[4],
                     v[5],
@@ -106,9 +106,9 @@ pub fn read_with_velocity(path: &Path) -> Result<Vec<(PositionFix, Option<Veloci
                 if v[7..10].iter().any(|x| x.abs() > 1e4) {
                     bail!("{}:{line}: a velocity beyond ±1e4 m/s", path.display());
                 }
-                if !(v[10] > 0.0 && v[10] <= 1e3) {
+                if !(v[10] >= 1e-6 && v[10] <= 1e3) {
                     bail!(
-                        "{}:{line}: velocity sigma must be in (0, 1e3] m/s (got {})",
+                        "{}:{line}: velocity sigma must be in [1e-6, 1e3] m/s (got {})",
                         path.display(),
                         v[10]
                     );

@@ -128,16 +128,16 @@ pub fn open(path: &Path) -> Result<(PsinsLog, PsinsSource)> {
     let (mut gscale, mut ascale) = ([0.0; 3], [0.0; 3]);
     for k in 0..3 {
         // a count is at most a few degrees or a few g over one sample at any IMU rate
-        if !(h2[k] > 0.0 && h2[k] <= 3600.0) {
+        if !(h2[k] >= 1e-9 && h2[k] <= 3600.0) {
             bail!(
-                "{name}:{l2}: header: gyro scale {} arcsec/count (axis {}) must be positive and at most 3600",
+                "{name}:{l2}: header: gyro scale {} arcsec/count (axis {}) must be within 1e-9 .. 3600",
                 h2[k],
                 k + 1
             );
         }
-        if !(h2[3 + k] > 0.0 && h2[3 + k] <= 1e6) {
+        if !(h2[3 + k] >= 1e-9 && h2[3 + k] <= 1e6) {
             bail!(
-                "{name}:{l2}: header: accelerometer scale {} ug*s/count (axis {}) must be positive and at most 1e6",
+                "{name}:{l2}: header: accelerometer scale {} ug*s/count (axis {}) must be within 1e-9 .. 1e6",
                 h2[3 + k],
                 k + 1
             );

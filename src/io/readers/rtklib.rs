@@ -26,6 +26,18 @@ pub struct PosEpoch {
     pub sigma_v_ne: Option<[f64; 2]>,
 }
 
+/// Days in month `m` (1–12) of year `y` (Gregorian; 0 for a month out of range).
+pub fn days_in_month(y: i64, m: i64) -> i64 {
+    let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    match m {
+        1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+        4 | 6 | 9 | 11 => 30,
+        2 if leap => 29,
+        2 => 28,
+        _ => 0,
+    }
+}
+
 /// Days since 1970-01-01 of a proleptic Gregorian date.
 pub fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
     let y = if m <= 2 { y - 1 } else { y };
@@ -56,6 +68,7 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         if date.len() != 3
             || time.len() != 3
             || !(1980..=2200).contains(&date[0])
+            || date[2] > days_in_month(date[0], date[1])
             || !(1..=12).contains(&date[1])
             || !(1..=31).contains(&date[2])
             || !(0.0..24.0).contains(&time[0])
