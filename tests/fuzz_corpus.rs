@@ -294,13 +294,21 @@ fn known_bad_inputs_are_refused_not_accepted() {
     let sine = std::fs::read_to_string(root.join("scenarios/sine.toml")).unwrap();
     for (base, from, extra, key) in [
         (&drive, "band_hz = [5.0, 40.0]", "freq_hz = nan", "freq_hz"),
-        (&drive, "band_hz = [5.0, 40.0]", "amplitude = \"1 g\"", "amplitude"),
+        (
+            &drive,
+            "band_hz = [5.0, 40.0]",
+            "amplitude = \"1 g\"",
+            "amplitude",
+        ),
         (&sine, "freq_hz = 90.0", "band_hz = [nan, 1.0]", "band_hz"),
         (&sine, "freq_hz = 90.0", "psd = \"1 g^2/Hz\"", "psd"),
     ] {
         let text = base.replacen(from, &format!("{from}\n{extra}"), 1);
         let e = Scenario::parse(&text, "s.toml").unwrap_err().to_string();
-        assert!(e.contains(&format!("`{key}` does not apply")), "{extra}: {e}");
+        assert!(
+            e.contains(&format!("`{key}` does not apply")),
+            "{extra}: {e}"
+        );
     }
     for name in TARGETS {
         let f = target(name).unwrap();
