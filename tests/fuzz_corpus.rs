@@ -1,11 +1,12 @@
 //! The fuzz targets of `sinsmodel::fuzzing` on stable, for CI: every file of every
-//! `fuzz/corpus/<target>/` is replayed, then each target gets a few seconds of seeded random
-//! mutations of its corpus (byte flips, inserts, deletes, splices of two files, interesting
+//! `fuzz/corpus/<target>/` is replayed, then the targets share 12 s of seeded random
+//! mutations of each corpus (byte flips, inserts, deletes, splices of two files, interesting
 //! tokens such as `nan`, `1e308`, `^2147483647`). Each input runs under `catch_unwind`; a broken
 //! property fails the test with the input shown, escaped. No coverage guidance: that is what
 //! `cargo +nightly fuzz run TARGET` adds (docs/fuzzing.md).
 //!
-//! `SINSMODEL_FUZZ_SECONDS` sets the mutation time per target (default 3, 0 to only replay) and
+//! `SINSMODEL_FUZZ_SECONDS` sets the mutation time of all targets together (default 12, shared
+//! equally, so that adding a target does not lengthen the test; 0 to only replay) and
 //! `SINSMODEL_FUZZ_SEED` the seed (default fixed, so a run is reproducible up to where its time
 //! budget ends).
 
@@ -190,7 +191,7 @@ fn env_or<T: std::str::FromStr>(key: &str, default: T) -> T {
 
 #[test]
 fn corpora_replay_and_mutations_keep_every_property() {
-    let seconds: f64 = env_or("SINSMODEL_FUZZ_SECONDS", 3.0);
+    let seconds = env_or("SINSMODEL_FUZZ_SECONDS", 12.0) / TARGETS.len() as f64;
     let seed: u64 = env_or("SINSMODEL_FUZZ_SEED", 0x5135_u64);
     // the targets' panics are caught and reported here; the default hook would print each one
     let hook = std::panic::take_hook();
