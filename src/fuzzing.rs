@@ -17,7 +17,19 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 /// Names of the targets, as `fuzz/fuzz_targets/NAME.rs` and `fuzz/corpus/NAME/` use them.
-pub const TARGETS: [&str; 4] = ["spec", "units", "scenario", "jacobian_point"];
+pub const TARGETS: [&str; 11] = [
+    "spec",
+    "units",
+    "scenario",
+    "jacobian_point",
+    "imu_text",
+    "psins",
+    "gnss_imu_csv",
+    "imu_format",
+    "rtklib_pos",
+    "aiding",
+    "truth",
+];
 
 /// The target function of a name in [`TARGETS`].
 pub fn target(name: &str) -> Option<fn(&[u8])> {
@@ -26,6 +38,13 @@ pub fn target(name: &str) -> Option<fn(&[u8])> {
         "units" => Some(units),
         "scenario" => Some(scenario),
         "jacobian_point" => Some(jacobian_point),
+        "imu_text" => Some(imu_text),
+        "psins" => Some(psins),
+        "gnss_imu_csv" => Some(gnss_imu_csv),
+        "imu_format" => Some(imu_format),
+        "rtklib_pos" => Some(rtklib_pos),
+        "aiding" => Some(aiding),
+        "truth" => Some(truth),
         _ => None,
     }
 }
@@ -248,6 +267,182 @@ pub fn jacobian_point(data: &[u8]) {
                         "H {name}[{i}][{j}] = {v} at accepted point {p:?}"
                     );
                 }
+            }
+        }
+    }
+}
+
+/// A per-process scratch directory for the reader targets (the readers read files): in
+/// /dev/shm when there is one, so that writing an input costs little.
+fn scratch() -> &'static Path {
+    static DIR: OnceLock<std::path::PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let base = if Path::new("/dev/shm").is_dir() {
+            std::path::PathBuf::from("/dev/shm")
+        } else {
+            std::env::temp_dir()
+        };
+        let d = base.join(format!("sinsmodel-fuzz-{}", std::process::id()));
+        std::fs::create_dir_all(&d).expect("scratch directory for the reader targets");
+        d
+    })
+}
+
+/// Writes each (file name, bytes) into the scratch directory and returns their paths.
+fn files(items: &[(&str, &[u8])]) -> Vec<std::path::PathBuf> {
+    items
+        .iter()
+        .map(|(name, bytes)| {
+            let p = scratch().join(name);
+            std::fs::write(&p, bytes).expect("write a fuzz input");
+            p
+        })
+        .collect()
+}
+
+/// Splits `data` in two at a length its first two bytes give (for targets that read two files).
+fn split2(data: &[u8]) -> Option<(&[u8], &[u8])> {
+    if data.len() < 2 {
+        return None;
+    }
+    let rest = &data[2..];
+    let k = u16::from_le_bytes([data[0], data[1]]) as usize % (rest.len() + 1);
+    Some(rest.split_at(k))
+}
+
+/// What every accepted IMU stream must hold: finite samples, strictly increasing time, rates and
+/// forces within what any IMU measures.
+fn check_imu(stream: crate::io::imu_stream::ImuStream) {
+    use crate::io::imu_stream::{MAX_FORCE, MAX_RATE};
+    let interval = stream.interval();
+    finite(interval, "median interval");
+    let Ok(data) = stream.collect() else {
+        return;
+    };
+    let mut prev: Option<f64> = None;
+    for s in &data.samples {
+        finite(s.t, "sample time");
+        for v in s.dtheta.iter().chain(s.dv.iter()) {
+            finite(*v, "increment");
+        }
+        let dt = match prev {
+            Some(p) => {
+                assert!(s.t > p, "accepted time {} after {p}", s.t);
+                s.t - p
+            }
+            None => interval,
+        };
+        assert!(
+            s.dtheta.norm() / dt <= MAX_RATE * (1.0 + 1e-12),
+            "accepted rate beyond bound"
+        );
+        assert!(
+            s.dv.norm() / dt <= MAX_FORCE * (1.0 + 1e-12),
+            "accepted force beyond bound"
+        );
+        prev = Some(s.t);
+    }
+}
+
+/// The project's IMU text, through the path every command takes ([`ImuStream::open`]).
+pub fn imu_text(data: &[u8]) {
+    let p = files(&[("imu.txt", data)]);
+    if let Ok((s, _)) = crate::io::imu_stream::ImuStream::open(&p[0], None) {
+        check_imu(s);
+    }
+}
+
+/// A PSINS `.imu` log, through [`ImuStream::open`]; an accepted header must be finite too.
+pub fn psins(data: &[u8]) {
+    let p = files(&[("log.imu", data)]);
+    if let Ok(log) = crate::io::readers::psins::read(&p[0]) {
+        for v in log.euler_deg.iter().chain(&log.v_ned) {
+            finite(*v, "PSINS header value");
+        }
+        finite(log.interval, "PSINS interval");
+    }
+    if let Ok((s, _)) = crate::io::imu_stream::ImuStream::open(&p[0], None) {
+        check_imu(s);
+    }
+}
+
+/// A GNSS_IMU csv with its RTKLIB time-tag file (the input split in two), through
+/// [`ImuStream::open`].
+pub fn gnss_imu_csv(data: &[u8]) {
+    let Some((tag, csv)) = split2(data) else {
+        return;
+    };
+    let p = files(&[("log.csv", csv), ("log.csv.tag", tag)]);
+    if let Ok((s, _)) = crate::io::imu_stream::ImuStream::open(&p[0], None) {
+        check_imu(s);
+    }
+}
+
+/// A format description and a data file it describes (the input split in two).
+pub fn imu_format(data: &[u8]) {
+    let Some((desc, body)) = split2(data) else {
+        return;
+    };
+    let p = files(&[("fmt.toml", desc), ("log.dat", body)]);
+    if let Ok((s, _)) = crate::io::imu_stream::ImuStream::open(&p[1], Some(&p[0])) {
+        check_imu(s);
+    }
+}
+
+/// An RTKLIB `.pos` solution: accepted epochs finite, in range, time increasing.
+pub fn rtklib_pos(data: &[u8]) {
+    let p = files(&[("sol.pos", data)]);
+    if let Ok(epochs) = crate::io::readers::rtklib::read(&p[0]) {
+        let mut prev = f64::NEG_INFINITY;
+        for e in &epochs {
+            for v in [e.t, e.lat_deg, e.lon_deg, e.h]
+                .iter()
+                .chain(&e.sigma_neu)
+                .chain(e.v_ned.iter().flatten())
+            {
+                finite(*v, ".pos value");
+            }
+            assert!(e.t > prev, "accepted .pos time does not increase");
+            assert!(e.lat_deg.abs() < 90.0, "accepted latitude {}", e.lat_deg);
+            prev = e.t;
+        }
+    }
+}
+
+/// A position aiding file: accepted fixes finite, σ positive.
+pub fn aiding(data: &[u8]) {
+    let p = files(&[("aid.txt", data)]);
+    if let Ok(fixes) = crate::io::aiding::read(&p[0]) {
+        for f in &fixes {
+            for v in [f.t, f.lat, f.lon, f.h].iter().chain(&f.sigma) {
+                finite(*v, "aiding value");
+            }
+            assert!(f.sigma.iter().all(|s| *s > 0.0), "accepted sigma <= 0");
+        }
+    }
+}
+
+/// A truth file, read whole and as the filter reads it ([`crate::io::truth::TruthReader`]).
+pub fn truth(data: &[u8]) {
+    use crate::io::truth::TruthLookup;
+    let p = files(&[("truth.txt", data)]);
+    if let Ok(rows) = crate::io::truth::read(&p[0]) {
+        for r in &rows {
+            for v in [r.t, r.lat, r.lon, r.h]
+                .iter()
+                .chain(r.v.iter())
+                .chain(r.euler.iter())
+            {
+                finite(*v, "truth value");
+            }
+        }
+    }
+    if let Ok(mut reader) = crate::io::truth::TruthReader::open(&p[0]) {
+        for k in 0..50 {
+            match reader.at(k as f64 * 0.5, 0.25) {
+                Ok(Some(r)) => finite(r.lat, "truth latitude"),
+                Ok(None) => {}
+                Err(_) => break,
             }
         }
     }

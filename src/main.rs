@@ -56,6 +56,23 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // A full disk or a closed file behind stdout/stderr makes println!/eprintln! panic: end with
+    // status 2 and one line (when stderr still takes it), not a panic message.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.starts_with("failed printing to") {
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "error: cannot write the output: {msg}");
+            std::process::exit(2);
+        }
+        default_hook(info);
+    }));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Model { action } => cli::model::run(action),
@@ -71,10 +88,22 @@ fn main() -> ExitCode {
         Command::ImuCheck(args) => cli::imu_check::run(&args),
         Command::Align(args) => cli::align::run(&args),
     };
+    // `sinsmodel bench` measures its child processes' peak memory this way: a parent's rusage
+    // counts the parent's own pages at fork and exec, the child's VmHWM does not
+    if std::env::var_os("SINSMODEL_REPORT_PEAK_RSS").is_some() {
+        if let Some(kib) = cli::bench::peak_rss_kib() {
+            eprintln!("peak-rss-kib {kib}");
+        }
+    }
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            use std::io::Write;
+            let _ = writeln!(
+                std::io::stderr(),
+                "error: {}",
+                sinsmodel::io::lines::printable_message(&format!("{e:#}"))
+            );
             ExitCode::from(2)
         }
     }

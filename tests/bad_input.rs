@@ -305,8 +305,153 @@ fn scenario_keys_are_found_by_whole_name_and_slow_data_does_not_panic_align() {
     )
     .unwrap();
     let (ok, err) = run(&["align", "--imu", slow.to_str().unwrap()]);
+    // refused where the samples are read (the interval is no IMU's), before align's own check
     assert!(
-        !ok && err.contains("1 Hz") && !err.contains("panicked"),
+        !ok && err.contains("median sample interval") && !err.contains("panicked"),
         "{err}"
     );
+}
+
+/// A start attitude that contradicts gravity (a sensor upside down given roll 0) stops
+/// navigate and filter with the attitude the data measure; `--force` runs anyway.
+#[test]
+fn an_initial_attitude_against_gravity_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("flip.toml");
+    std::fs::write(
+        &sc,
+        "name = \"flip\"\nimu_rate_hz = 100.0\ntruth_rate_hz = 1.0\nseed = 2\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n\
+         euler_deg = [180.0, 0.0, 20.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 30.0\n\
+         [noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n\
+         [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let sim = dir.path().join("sim");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let imu = sim.join("imu.txt");
+    let aid = sim.join("gnss.txt");
+    let out = dir.path().join("nav.txt");
+    let (ok, err) = navigate(&imu, &out);
+    assert!(
+        !ok && err.contains("--att: the initial attitude contradicts gravity")
+            && err.contains("roll 180.00")
+            || !ok && err.contains("roll -180.00"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let nav_forced = |extra: &[&str]| {
+        let mut a = vec![
+            "navigate",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--lat",
+            "30",
+            "--lon",
+            "110",
+            "--att",
+            "0,0,0",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let (ok, err) = nav_forced(&["--force"]);
+    assert!(
+        ok && err.contains("warning: the initial attitude contradicts gravity"),
+        "{err}"
+    );
+    let od = dir.path().join("f");
+    let filter = |init: &str| {
+        run(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--aid",
+            aid.to_str().unwrap(),
+            "--init",
+            init,
+            "--out",
+            od.to_str().unwrap(),
+        ])
+    };
+    let (ok, err) = filter("30,110,0,0,0,20");
+    assert!(
+        !ok && err.contains("--init: the initial attitude contradicts gravity"),
+        "{err}"
+    );
+    let (ok, err) = filter("30,110,0,180,0,20");
+    assert!(ok, "the right attitude runs: {err}");
+}
+
+/// Leftovers of a killed run (a staging directory, a set-aside directory, a temporary file,
+/// named with a process that is gone) are removed by the next run into the same place, and a
+/// re-run replaces the earlier run's directory whole.
+#[test]
+fn leftovers_of_killed_runs_are_cleaned_and_reruns_replace_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let imu = d.join("imu.txt");
+    std::fs::write(&imu, GOOD).unwrap();
+    // pid 4194304 is above Linux's pid_max: never a live process
+    std::fs::create_dir(d.join(".o.partial-4194304")).unwrap();
+    std::fs::write(d.join(".o.partial-4194304/states.txt"), "half").unwrap();
+    std::fs::create_dir(d.join(".o.old-4194304")).unwrap();
+    std::fs::write(d.join("nav.txt.partial-4194304-0"), "half").unwrap();
+    let (ok, err) = navigate(&imu, &d.join("nav.txt"));
+    assert!(ok, "{err}");
+    assert!(!d.join("nav.txt.partial-4194304-0").exists());
+    let sc = d.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 20.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let o = d.join("o");
+    for _ in 0..2 {
+        let (ok, err) = run(&[
+            "simulate",
+            sc.to_str().unwrap(),
+            "--out",
+            o.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+    }
+    assert!(!d.join(".o.partial-4194304").exists() && !d.join(".o.old-4194304").exists());
+    let left: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial") || n.contains(".old-"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    assert!(o.join("imu.txt").exists() && o.join("gnss.txt").exists());
+}
+
+/// reproduce writes its directory like every other command: one holding a user's files is
+/// refused before any work, and the files are untouched.
+#[test]
+fn reproduce_refuses_a_directory_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("mine");
+    std::fs::create_dir(&o).unwrap();
+    std::fs::write(o.join("results.md"), "my notes").unwrap();
+    for extra in [&[][..], &["--consistency"][..]] {
+        let mut a = vec!["reproduce", "--quick", "--out", o.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        let (ok, err) = run(&a);
+        assert!(!ok && err.contains("was not written by sinsmodel"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(o.join("results.md")).unwrap(),
+        "my notes"
+    );
+    assert_eq!(std::fs::read_dir(&o).unwrap().count(), 1);
 }

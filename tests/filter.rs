@@ -271,6 +271,7 @@ fn a_nan_or_negative_variance_stops_the_run_instead_of_printing_sigma_zero() {
         final_state: nav,
         nonfinite_updates: 0,
         first_nonfinite_t: None,
+        diverged: None,
     };
     assert!(run(0.5).check().is_ok());
     let err = run(f64::NAN).check().unwrap_err();
@@ -278,4 +279,60 @@ fn a_nan_or_negative_variance_stops_the_run_instead_of_printing_sigma_zero() {
         err.contains("diverged") && err.contains("t = 1.000"),
         "{err}"
     );
+}
+
+/// Divergence is caught at the step where it happens, with the time, the state and a cause:
+/// a process noise that makes a variance non-finite stops the run at the first propagation
+/// step; a measurement σ of zero against a zero prior (S = 0) stops it at the first update.
+#[test]
+fn divergence_stops_at_its_step_with_time_state_and_cause() {
+    let case = &reproduce::cases(true, 5)[0];
+    let sim = simulate(&Scenario::parse(&case.scenario, "static").unwrap(), |_| {});
+    let priors = Priors::default();
+    let aid = reproduce::aiding_from_truth(&sim, &priors, false, 5).unwrap();
+    let model = Model::parse("P13").unwrap();
+    let t0 = sim.imu.samples[0].t;
+    let mut cfg = FilterConfig::new(&model);
+    let i = model.index_of("eps_x").unwrap();
+    cfg.q[i] = f64::INFINITY;
+    let run = filter::run(&model, &cfg, &sim.imu, sim.start, &aid, None, |_| {});
+    let err = run.check().unwrap_err();
+    assert!(
+        err.contains("diverged at t = ")
+            && err.contains("(propagation)")
+            && err.contains("eps_x")
+            && err.contains("navigation state lat")
+            && err.contains("likely cause"),
+        "{err}"
+    );
+    // it stopped at the first step (0.01 s), not at the end of the data
+    let t_stop: f64 = err
+        .split("diverged at t = ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap();
+    assert!(t_stop <= t0 + cfg.step_s + 1e-6, "stopped at {t_stop}");
+    assert!(
+        run.records.is_empty(),
+        "records written after the divergence"
+    );
+
+    // S <= 0: zero prior on every state and a zero measurement sigma
+    let mut cfg = FilterConfig::new(&model);
+    cfg.prior_sigma.iter_mut().for_each(|s| *s = 0.0);
+    cfg.q.iter_mut().for_each(|q| *q = 0.0);
+    let mut aid0 = aid.clone();
+    for ep in &mut aid0 {
+        if let Some(p) = ep.pos.as_mut() {
+            p.3 = [0.0; 3];
+        }
+    }
+    let run = filter::run(&model, &cfg, &sim.imu, sim.start, &aid0, None, |_| {});
+    let err = run.check().unwrap_err();
+    assert!(
+        err.contains("diverged at t = ") && err.contains("S <= 0") && err.contains("likely cause"),
+        "{err}"
+    );
+    assert!(run.records.is_empty());
 }

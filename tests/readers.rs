@@ -93,3 +93,47 @@ fn gnss_imu_drive_on_gpst_with_rtk_aligned() {
         "IMU {t_imu} vs RTK {t_rtk}"
     );
 }
+
+/// A GNSS_IMU csv without its `.tag`: refused with the way out named; with `--clock-offset`
+/// (here the offset the tag gives) the same samples as with the tag.
+#[test]
+fn gnss_imu_csv_without_tag_takes_a_clock_offset() {
+    let with_tag = gnss_imu::read(&data("gnss-imu-drive/imu_1934.csv")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("imu_1934.csv");
+    std::fs::copy(data("gnss-imu-drive/imu_1934.csv"), &copy).unwrap();
+    let e = gnss_imu::read(&copy).unwrap_err();
+    assert!(format!("{e:#}").contains("--clock-offset"), "{e:#}");
+    let given = gnss_imu::read_with(&copy, Some(with_tag.clock_offset)).unwrap();
+    assert_eq!(given.imu.samples, with_tag.imu.samples);
+    // through the command line: refused without, read with
+    let bin = env!("CARGO_BIN_EXE_sinsmodel");
+    let run = |extra: &[&str]| {
+        let mut a = vec!["imu-check", "--imu", copy.to_str().unwrap(), "--tilted"];
+        a.extend_from_slice(extra);
+        std::process::Command::new(bin).args(&a).output().unwrap()
+    };
+    let out = run(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--clock-offset"));
+    let out = run(&["--clock-offset", "0"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && err.contains("clock offset 0 s from --clock-offset"),
+        "{err}"
+    );
+    // a text IMU file takes no clock offset
+    let txt = dir.path().join("x.txt");
+    std::fs::write(&txt, "0.01 0 0 0 0 0 -0.098\n0.02 0 0 0 0 0 -0.098\n").unwrap();
+    let out = std::process::Command::new(bin)
+        .args([
+            "imu-check",
+            "--imu",
+            txt.to_str().unwrap(),
+            "--clock-offset",
+            "5",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -23,7 +23,7 @@ pub struct AlignArgs {
     /// Prior 1-σ of the gyro biases in the fine alignment [deg/h] (bounds the heading σ).
     #[arg(long, default_value_t = 0.2)]
     gyro_bias_sigma: f64,
-    /// Use at most this many seconds after the disturbed start.
+    /// Use at most this many seconds of the stretch at rest.
     #[arg(long)]
     seconds: Option<f64>,
     /// JSON output {roll_deg, pitch_deg, heading_deg, heading_sigma_deg, lat_deg, lat_sigma_deg, …}.
@@ -73,11 +73,23 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         args.h,
         args.gyro_bias_sigma * d / 3600.0,
     )?;
-    println!("skipped disturbed start: {:.0} s", a.skipped_s);
     println!(
-        "roll {:.4} deg  pitch {:.4} deg  heading {:.3} deg (1-sigma {:.3} deg)",
-        a.roll_deg, a.pitch_deg, a.heading_deg, a.heading_sigma_deg
+        "at rest from {:.0} s after the start (the longest stretch judged at rest)",
+        a.skipped_s
     );
+    match (a.heading_deg, a.heading_sigma_deg) {
+        (Some(hd), Some(hs)) => println!(
+            "roll {:.4} deg  pitch {:.4} deg  heading {hd:.3} deg (1-sigma {hs:.3} deg)",
+            a.roll_deg, a.pitch_deg
+        ),
+        _ => println!(
+            "roll {:.4} deg  pitch {:.4} deg  heading: not determined (see below)",
+            a.roll_deg, a.pitch_deg
+        ),
+    }
+    if let Some(n) = &a.heading_note {
+        println!("{n}");
+    }
     match args.lat {
         Some(_) => println!("latitude {:.4} deg (given)", a.lat_deg),
         None if a.lat_sigma_deg > 0.0 => println!(

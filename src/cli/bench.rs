@@ -20,6 +20,11 @@ pub struct BenchArgs {
     /// Seconds of 2 kHz IMU data for the explain job (the target: 7200 s in ≤ 30 s); 0 skips it.
     #[arg(long, default_value_t = 7200.0)]
     explain_seconds: f64,
+    /// Seconds of 2 kHz IMU text for the streaming job (navigate and filter as child processes,
+    /// peak memory and time, streamed against reading the whole file; the target: 7200 s, a
+    /// 2.3 GB file, in at most 64 MiB); 0 skips it.
+    #[arg(long, default_value_t = 600.0)]
+    memory_seconds: f64,
 }
 
 fn data(rate: f64, seconds: f64) -> Result<(SimOutput, Vec<AidingEpoch>)> {
@@ -34,20 +39,21 @@ fn data(rate: f64, seconds: f64) -> Result<(SimOutput, Vec<AidingEpoch>)> {
     Ok((sim, aid))
 }
 
-fn peak_rss_mib() -> f64 {
+/// This process's peak resident memory (VmHWM) [KiB].
+pub fn peak_rss_kib() -> Option<u64> {
     std::fs::read_to_string("/proc/self/status")
+        .ok()?
+        .lines()
+        .find(|l| l.starts_with("VmHWM:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
         .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .map(|l| l.to_string())
-        })
-        .and_then(|l| {
-            l.split_whitespace()
-                .nth(1)
-                .and_then(|k| k.parse::<f64>().ok())
-        })
-        .map(|kb| kb / 1024.0)
+}
+
+fn peak_rss_mib() -> f64 {
+    peak_rss_kib()
+        .map(|k| k as f64 / 1024.0)
         .unwrap_or(f64::NAN)
 }
 
@@ -66,7 +72,7 @@ fn explain_job(seconds: f64) -> Result<()> {
     let plain = filter::run(&model, &cfg, &sim.imu, sim.start, &aid, None, |_| {});
     let t_plain = t.elapsed().as_secs_f64();
     let data = ExplainData {
-        imu: &sim.imu,
+        imu: sinsmodel::estimate::explain::ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: None,
         start: sim.start,
@@ -268,9 +274,137 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         peak_rss_mib()
     );
     let _ = std::fs::remove_dir(&dir);
+    if args.memory_seconds > 0.0 {
+        memory_job(args.memory_seconds)?;
+    }
     if args.explain_seconds > 0.0 {
         explain_job(args.explain_seconds)?;
     }
+    Ok(())
+}
+
+/// A child process's wall time [s] and peak resident memory [MiB] (its own VmHWM, which it
+/// prints when `SINSMODEL_REPORT_PEAK_RSS` is set; a parent's rusage would count the parent's
+/// pages at fork).
+fn run_child(args: &[&std::ffi::OsStr]) -> Result<(f64, f64)> {
+    let exe = std::env::current_exe()?;
+    let t = Instant::now();
+    let out = std::process::Command::new(&exe)
+        .args(args)
+        .env("SINSMODEL_REPORT_PEAK_RSS", "1")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .output()?;
+    let el = t.elapsed().as_secs_f64();
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        anyhow::bail!("bench: {:?} failed: {}", args, err.trim());
+    }
+    let kib: f64 = err
+        .lines()
+        .find_map(|l| l.strip_prefix("peak-rss-kib "))
+        .and_then(|v| v.trim().parse().ok())
+        .ok_or_else(|| anyhow::anyhow!("bench: {:?} did not report its peak memory", args))?;
+    Ok((el, kib / 1024.0))
+}
+
+/// Job 4: navigate and filter on `seconds` of 2 kHz IMU text (the sine case), each as a child
+/// process, streamed and reading the whole file first (the baseline), interleaved, fastest of
+/// three; peak resident memory of each.
+fn memory_job(seconds: f64) -> Result<()> {
+    use std::ffi::OsStr;
+    let dir = tempfile_dir()?.join("memory");
+    let scenario = include_str!("../../scenarios/sine.toml")
+        .replace("duration_s = 600.0", &format!("duration_s = {seconds}"));
+    std::fs::create_dir_all(&dir)?;
+    let sc = dir.join("scenario.toml");
+    std::fs::write(&sc, scenario)?;
+    let data = dir.join("sine");
+    let t = Instant::now();
+    run_child(&[
+        OsStr::new("simulate"),
+        sc.as_os_str(),
+        OsStr::new("--out"),
+        data.as_os_str(),
+        OsStr::new("--force"),
+    ])?;
+    let t_sim = t.elapsed().as_secs_f64();
+    let imu = data.join("imu.txt");
+    let size_gb = std::fs::metadata(&imu)?.len() as f64 / 1e9;
+    println!(
+        "job 4 (streaming): {seconds:.0} s of 2 kHz IMU text ({:.0} samples, {size_gb:.2} GB, simulated in {t_sim:.0} s); navigate and P31 filter as child processes, streamed vs reading the whole file first (interleaved, fastest of 3)",
+        seconds * 2000.0
+    );
+    let nav_out = dir.join("nav.txt");
+    let filt_out = dir.join("filter");
+    let nav = |whole: bool| -> Result<(f64, f64)> {
+        let mut a: Vec<&OsStr> = vec![
+            OsStr::new("navigate"),
+            OsStr::new("--imu"),
+            imu.as_os_str(),
+            OsStr::new("--lat"),
+            OsStr::new("28.22"),
+            OsStr::new("--lon"),
+            OsStr::new("112.99"),
+            OsStr::new("--att"),
+            OsStr::new("0,0,0"),
+            OsStr::new("--out"),
+            nav_out.as_os_str(),
+        ];
+        if whole {
+            a.push(OsStr::new("--in-memory"));
+        }
+        run_child(&a)
+    };
+    let aid = data.join("gnss.txt");
+    let truth = data.join("truth.txt");
+    let filt = |whole: bool| -> Result<(f64, f64)> {
+        let mut a: Vec<&OsStr> = vec![
+            OsStr::new("filter"),
+            OsStr::new("--model"),
+            OsStr::new("P31"),
+            OsStr::new("--imu"),
+            imu.as_os_str(),
+            OsStr::new("--aid"),
+            aid.as_os_str(),
+            OsStr::new("--truth"),
+            truth.as_os_str(),
+            OsStr::new("--out"),
+            filt_out.as_os_str(),
+        ];
+        if whole {
+            a.push(OsStr::new("--in-memory"));
+        }
+        run_child(&a)
+    };
+    type Best = (f64, f64);
+    let mut best: [Best; 4] = [(f64::INFINITY, 0.0); 4];
+    for _ in 0..3 {
+        for (k, r) in [nav(false)?, nav(true)?, filt(false)?, filt(true)?]
+            .into_iter()
+            .enumerate()
+        {
+            if r.0 < best[k].0 {
+                best[k].0 = r.0;
+            }
+            best[k].1 = best[k].1.max(r.1);
+        }
+    }
+    for (name, s, w) in [
+        ("navigate", best[0], best[1]),
+        ("filter P31", best[2], best[3]),
+    ] {
+        println!(
+            "  {name:<10} streamed: {:.2} s, peak RSS {:.1} MiB; whole file: {:.2} s, {:.1} MiB; time ratio whole / streamed {:.2}, memory ratio {:.1}",
+            s.0,
+            s.1,
+            w.0,
+            w.1,
+            w.0 / s.0,
+            w.1 / s.1
+        );
+    }
+    std::fs::remove_dir_all(&dir)?;
     Ok(())
 }
 

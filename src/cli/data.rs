@@ -6,8 +6,8 @@ use clap::Args;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use sinsmodel::estimate::filter::{AidingEpoch, FilterConfig, Mode};
 use sinsmodel::io::imu::ImuData;
-use sinsmodel::io::truth::TruthRow;
-use sinsmodel::io::{aiding, readers, truth};
+use sinsmodel::io::truth::{TruthLookup, TruthRow};
+use sinsmodel::io::{aiding, truth};
 use sinsmodel::model::Model;
 use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::strapdown::{NavState, Vertical};
@@ -23,14 +23,26 @@ pub struct ImuSource {
     /// IMU file if there is one, else chosen by the file's extension.
     #[arg(long)]
     pub imu_format: Option<PathBuf>,
+    /// GPST − IMU clock [s] for a GNSS_IMU .csv without its .tag file (0 keeps the IMU clock).
+    #[arg(long, allow_hyphen_values = true)]
+    pub clock_offset: Option<f64>,
 }
 
 impl ImuSource {
     /// Reads the IMU file; says on stderr which format was used.
     pub fn read(&self) -> Result<ImuData> {
-        let (data, how) = readers::read_imu(&self.imu, self.imu_format.as_deref())?;
+        self.open()?.collect()
+    }
+
+    /// Opens the IMU file as a stream of validated samples; says on stderr which format was used.
+    pub fn open(&self) -> Result<sinsmodel::io::imu_stream::ImuStream> {
+        let (stream, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
+            &self.imu,
+            self.imu_format.as_deref(),
+            self.clock_offset,
+        )?;
         eprintln!("reading {} {how}", self.imu.display());
-        Ok(data)
+        Ok(stream)
     }
 
     /// The input files (so outputs never land on them).
@@ -59,9 +71,16 @@ pub struct DataArgs {
     /// IMU file if there is one, else chosen by the file's extension.
     #[arg(long)]
     imu_format: Option<PathBuf>,
+    /// GPST − IMU clock [s] for a GNSS_IMU .csv without its .tag file (0 keeps the IMU clock).
+    #[arg(long, allow_hyphen_values = true)]
+    clock_offset: Option<f64>,
     /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
     #[arg(long)]
     aid: Option<PathBuf>,
+    /// Which parts of the aiding file to use: pos, vel or pos,vel (default: all the file has; an
+    /// RTKLIB .pos with vn ve vu, or an 11-column aiding file, has velocities).
+    #[arg(long)]
+    aid_use: Option<String>,
     /// A static vehicle at a known position: lat,lon [deg],h [m]; position updates (σ 0.1 m) and
     /// zero-velocity updates (σ from --zupt, default 0.01 m/s) at 1 Hz instead of --aid.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
@@ -90,12 +109,33 @@ pub struct DataArgs {
     /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
     #[arg(long)]
     zupt: Option<f64>,
+    /// Run even when the initial roll and pitch contradict the measured gravity direction.
+    #[arg(long)]
+    force: bool,
+    /// A GNSS outage: START,DURATION [s], START counted from the first IMU sample; the aiding
+    /// epochs inside are dropped and the drift at its end is reported (repeatable).
+    #[arg(long, allow_hyphen_values = true)]
+    outage: Vec<String>,
 }
 
-/// What the data options load: IMU samples, aiding epochs, truth, the initial state.
+/// A GNSS outage window on the data's clock [s].
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Outage {
+    /// First second without aiding, on the data's clock [s].
+    pub start_s: f64,
+    /// End of the window [s].
+    pub end_s: f64,
+}
+
+/// What the data options load for a command that passes over the data more than once: the IMU
+/// file (read again on every pass), aiding epochs, truth, the initial state.
 pub struct Inputs {
-    /// IMU increments (FRD body frame).
-    pub imu: ImuData,
+    /// The IMU file.
+    pub imu: PathBuf,
+    /// Its format description, when given.
+    pub imu_format: Option<PathBuf>,
+    /// `--clock-offset` [s], when given.
+    pub clock_offset: Option<f64>,
     /// Aiding epochs after the start.
     pub aid: Vec<AidingEpoch>,
     /// Truth rows, when given.
@@ -104,18 +144,123 @@ pub struct Inputs {
     pub start: NavState,
 }
 
+/// The data options opened for one streamed pass.
+pub struct Opened {
+    /// IMU samples, validated as they are read.
+    pub imu: sinsmodel::io::imu_stream::ImuStream,
+    /// Aiding epochs after the start.
+    pub aid: AidPlan,
+    /// Truth, read as the run advances.
+    pub truth: Option<truth::TruthReader>,
+    /// Initial navigation state.
+    pub start: NavState,
+    /// GNSS outages (aiding dropped inside).
+    pub outages: Vec<Outage>,
+}
+
+/// Where the aiding epochs come from.
+pub enum AidPlan {
+    /// Fixes from a file (with their velocities when the file has them and `--aid-use` takes
+    /// them), with the ZUPT σ [m/s] to add to each and whether positions are used.
+    Fixes(
+        Vec<(aiding::PositionFix, Option<aiding::VelocityFix>)>,
+        Option<f64>,
+        bool,
+    ),
+    /// A static vehicle: this fix every whole second from `first_s`, with a ZUPT σ [m/s].
+    Static {
+        /// The position (its `t` unused).
+        fix: aiding::PositionFix,
+        /// Time of the first epoch [s].
+        first_s: f64,
+        /// Zero-velocity σ [m/s].
+        zupt: Option<f64>,
+    },
+}
+
+impl AidPlan {
+    /// Only the epochs after `t0`.
+    fn after(self, t0: f64) -> AidPlan {
+        match self {
+            AidPlan::Fixes(f, z, p) => {
+                AidPlan::Fixes(f.into_iter().filter(|f| f.0.t > t0).collect(), z, p)
+            }
+            s => s,
+        }
+    }
+
+    /// Number of epochs from a file (0 for the endless static plan).
+    pub fn len(&self) -> usize {
+        match self {
+            AidPlan::Fixes(f, _, _) => f.len(),
+            AidPlan::Static { .. } => 0,
+        }
+    }
+
+    /// The epochs in time order without those inside any outage window.
+    pub fn epochs_outside<'a>(
+        &'a self,
+        outages: &'a [Outage],
+    ) -> Box<dyn Iterator<Item = AidingEpoch> + 'a> {
+        Box::new(
+            self.epochs()
+                .filter(move |e| !outages.iter().any(|o| e.t >= o.start_s && e.t < o.end_s)),
+        )
+    }
+
+    /// The epochs in time order (endless for a static vehicle: the run ends with the IMU data).
+    pub fn epochs(&self) -> Box<dyn Iterator<Item = AidingEpoch> + '_> {
+        let epoch = |f: &aiding::PositionFix, t: f64, zupt: Option<f64>| AidingEpoch {
+            t,
+            vel: zupt.map(|s| (Vector3::zeros(), s)),
+            pos: Some((f.lat, f.lon, f.h, f.sigma)),
+        };
+        match self {
+            AidPlan::Fixes(f, zupt, use_pos) => Box::new(f.iter().map(move |(p, v)| {
+                let mut e = epoch(p, p.t, *zupt);
+                if let Some(v) = v {
+                    e.vel = Some((Vector3::from(v.v_ned), v.sigma));
+                }
+                if !*use_pos {
+                    e.pos = None;
+                }
+                e
+            })),
+            AidPlan::Static { fix, first_s, zupt } => {
+                Box::new((0u64..).map(move |k| epoch(fix, first_s + k as f64, *zupt)))
+            }
+        }
+    }
+}
+
+/// At least 10 aiding epochs must have fallen inside the IMU data (t0, t_last]: `used` of
+/// `total` (0: a static plan) did.
+pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<()> {
+    if used < 10 {
+        bail!(
+            "only {used}{} aiding epochs fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (the filter works on innovations)",
+            if total > 0 { format!(" of {total}") } else { String::new() }
+        );
+    }
+    Ok(())
+}
+
 impl DataArgs {
     /// True when any data option was given (explain runs its embedded demo when none is).
     pub fn any_given(&self) -> bool {
         self.imu.is_some()
             || self.imu_format.is_some()
+            || self.clock_offset.is_some()
             || self.aid.is_some()
+            || self.aid_use.is_some()
             || self.static_aid.is_some()
             || !self.prior.is_empty()
             || self.noise.is_some()
             || self.truth.is_some()
             || self.init.is_some()
             || self.zupt.is_some()
+            || self.force
+            || !self.outage.is_empty()
     }
 
     /// The input files named by the options (so outputs never land on them).
@@ -214,54 +359,140 @@ impl DataArgs {
         Ok(())
     }
 
-    /// Reads the IMU, aiding and truth files and builds the initial state.
-    pub fn load(&self) -> Result<Inputs> {
+    /// For a command that passes over the IMU file more than once (explain): reads the file
+    /// through once (every sample validated, its end found; memory does not grow with it), then
+    /// the aiding epochs inside it, the truth and the initial state. Each pass reads the file
+    /// again ([`sinsmodel::estimate::explain::ImuInput::File`]).
+    pub fn load_for_passes(&self) -> Result<Inputs> {
+        let mut opened = self.open()?;
+        while opened.imu.next()?.is_some() {}
+        let t_last = opened.imu.last_t();
+        let truth = match &self.truth {
+            Some(p) => Some(truth::read(p)?),
+            None => None,
+        };
+        let start = opened.start;
+        let aid: Vec<AidingEpoch> = opened
+            .aid
+            .epochs_outside(&opened.outages)
+            .take_while(|e| e.t <= t_last + 1e-9)
+            .collect();
+        check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
+        Ok(Inputs {
+            imu: self.imu.clone().context("--imu FILE is required")?,
+            imu_format: self.imu_format.clone(),
+            clock_offset: self.clock_offset,
+            aid,
+            truth,
+            start,
+        })
+    }
+
+    /// Opens the IMU, aiding and truth files for one streamed pass and builds the initial
+    /// state; everything that can be checked before the run is (the aiding epochs that fall
+    /// inside the IMU data are counted after it: [`check_inside`]).
+    pub fn open(&self) -> Result<Opened> {
         let args = self;
         if !(args.step.is_finite() && args.step > 0.0 && args.step <= 10.0) {
             bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
         let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
-        let (imu, how) = readers::read_imu(imu_path, args.imu_format.as_deref())?;
+        let (imu, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
+            imu_path,
+            args.imu_format.as_deref(),
+            args.clock_offset,
+        )?;
         eprintln!("reading {} {how}", imu_path.display());
-        imu.check_time(&imu_path.display().to_string(), 5.0)?;
-        let fixes = match (&args.aid, &args.static_aid) {
-            (Some(p), None) if p.extension().is_some_and(|e| e == "pos") => {
-                sinsmodel::io::readers::rtklib::read(p)?
-                    .iter()
-                    .map(|e| aiding::PositionFix {
-                        t: e.t,
-                        lat: e.lat_deg.to_radians(),
-                        lon: e.lon_deg.to_radians(),
-                        h: e.h,
-                        sigma: [
-                            e.sigma_neu[0].max(0.02),
-                            e.sigma_neu[1].max(0.02),
-                            e.sigma_neu[2].max(0.05),
-                        ],
-                    })
-                    .collect()
+        if let Some(z) = args.zupt {
+            if !(z.is_finite() && z > 0.0 && z < 100.0) {
+                bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");
             }
-            (Some(p), None) => aiding::read(p)?,
-            (None, Some(v)) if v.len() == 3 => {
-                if !v.iter().all(|x| x.is_finite())
-                    || v[0].abs() > 90.0
-                    || v[1].abs() > 360.0
-                    || !(-1000.0..=20_000.0).contains(&v[2])
-                {
-                    bail!("--static-aid {v:?}: expected LAT in [-90, 90] deg, LON in [-360, 360] deg, H in [-1000, 20000] m");
+        }
+        let zupt = args.zupt.or(args
+            .static_aid
+            .as_ref()
+            .map(|_| sinsmodel::model::measurement_sigma("vel_ne").unwrap_or(0.01)));
+        let t0 = imu.first_t() - imu.interval();
+        let fixes: AidPlan = match (&args.aid, &args.static_aid) {
+            (Some(p), None) => {
+                let fixes: Vec<(aiding::PositionFix, Option<aiding::VelocityFix>)> =
+                    if p.extension().is_some_and(|e| e == "pos") {
+                        sinsmodel::io::readers::rtklib::read(p)?
+                            .iter()
+                            .map(|e| {
+                                (
+                                    aiding::PositionFix {
+                                        t: e.t,
+                                        lat: e.lat_deg.to_radians(),
+                                        lon: e.lon_deg.to_radians(),
+                                        h: e.h,
+                                        sigma: [
+                                            e.sigma_neu[0].max(0.02),
+                                            e.sigma_neu[1].max(0.02),
+                                            e.sigma_neu[2].max(0.05),
+                                        ],
+                                    },
+                                    e.v_ned.map(|v| aiding::VelocityFix {
+                                        v_ned: v,
+                                        // RTKLIB's velocity σ, floored at 1 cm/s
+                                        sigma: e
+                                            .sigma_v_ne
+                                            .map(|s| s[0].max(s[1]))
+                                            .unwrap_or(0.1)
+                                            .max(0.01),
+                                    }),
+                                )
+                            })
+                            .collect()
+                    } else {
+                        aiding::read_with_velocity(p)?
+                    };
+                let has_vel = fixes.iter().any(|f| f.1.is_some());
+                let (use_pos, use_vel) = match args.aid_use.as_deref() {
+                    None => (true, has_vel),
+                    Some("pos") => (true, false),
+                    Some("vel") => (false, true),
+                    Some("pos,vel") | Some("vel,pos") => (true, true),
+                    Some(o) => bail!(
+                        "--aid-use `{}`: expected pos, vel or pos,vel",
+                        sinsmodel::io::lines::shown(o)
+                    ),
+                };
+                if use_vel && !has_vel {
+                    bail!(
+                        "--aid-use {}: {} has no velocity columns (an RTKLIB .pos with vn ve vu, or an aiding file of 11 columns: t lat lon h sigma_n sigma_e sigma_d v_n v_e v_d sigma_v)",
+                        args.aid_use.as_deref().unwrap_or(""),
+                        p.display()
+                    );
                 }
-                let (t_first, t_last) = (imu.samples[0].t, imu.samples[imu.samples.len() - 1].t);
-                (1..)
-                    .map(|k| t_first.floor() + k as f64)
-                    .take_while(|t| *t <= t_last)
-                    .map(|t| aiding::PositionFix {
-                        t,
+                if use_vel && args.zupt.is_some() {
+                    bail!("--zupt and GNSS velocity aiding both give the velocity: choose one (--aid-use pos keeps --zupt)");
+                }
+                let fixes = fixes
+                    .into_iter()
+                    .map(|(p, v)| (p, if use_vel { v } else { None }))
+                    .collect();
+                AidPlan::Fixes(fixes, zupt, use_pos)
+            }
+            (None, Some(v)) if v.len() == 3 => {
+                use sinsmodel::io::bounds;
+                if let Some(p) = bounds::lat_deg(v[0])
+                    .or_else(|| bounds::lon_deg(v[1]))
+                    .or_else(|| bounds::height_m(v[2]))
+                {
+                    bail!("--static-aid: {p}");
+                }
+                AidPlan::Static {
+                    fix: aiding::PositionFix {
+                        t: 0.0,
                         lat: v[0].to_radians(),
                         lon: v[1].to_radians(),
                         h: v[2],
                         sigma: [0.1, 0.1, 0.1],
-                    })
-                    .collect()
+                    },
+                    first_s: imu.first_t().floor() + 1.0,
+                    zupt,
+                }
             }
             (Some(_), Some(_)) => bail!("give --aid FILE or --static-aid LAT,LON,H, not both"),
             (None, Some(v)) => bail!(
@@ -272,17 +503,8 @@ impl DataArgs {
                 "no aiding: give --aid FILE or --static-aid LAT,LON,H (the filter works on innovations)"
             ),
         };
-        if let Some(z) = args.zupt {
-            if !(z.is_finite() && z > 0.0 && z < 100.0) {
-                bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");
-            }
-        }
-        let zupt = args.zupt.or(args
-            .static_aid
-            .as_ref()
-            .map(|_| sinsmodel::model::measurement_sigma("vel_ne").unwrap_or(0.01)));
-        let truth_rows = match &args.truth {
-            Some(p) => Some(truth::read(p)?),
+        let mut truth_reader = match &args.truth {
+            Some(p) => Some(truth::TruthReader::open(p)?),
             None => None,
         };
         if args.step < 0.999 * imu.interval() {
@@ -292,9 +514,8 @@ impl DataArgs {
                 imu.interval()
             );
         }
-        let t0 = imu.samples[0].t - imu.interval();
         let d = std::f64::consts::PI / 180.0;
-        let start = match (&args.init, &truth_rows) {
+        let start = match (&args.init, &mut truth_reader) {
             (Some(v), _) => {
                 if v.len() != 6 && v.len() != 9 {
                     bail!(
@@ -342,8 +563,7 @@ impl DataArgs {
             }
             (None, Some(tr)) => {
                 let r = tr
-                    .iter()
-                    .find(|r| (r.t - t0).abs() < 1e-6)
+                    .at(t0, 1e-6)?
                     .context("no truth row at the IMU start time; give --init")?;
                 let c = dcm_from_euler(r.euler.x, r.euler.y, r.euler.z);
                 NavState {
@@ -357,41 +577,90 @@ impl DataArgs {
             }
             (None, None) => bail!("give --init or --truth for the initial state"),
         };
-        let t_last = imu.samples[imu.samples.len() - 1].t;
-        let inside = fixes.iter().filter(|f| f.t > t0 && f.t <= t_last).count();
-        if inside < 10 {
-            bail!(
-                "only {inside} of {} aiding epochs fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (the filter works on innovations)",
-                fixes.len()
-            );
+        let e = start.euler();
+        let (roll, pitch) = (e.x, e.y);
+        let head = sinsmodel::io::imu::ImuData {
+            samples: imu.head().to_vec(),
+        };
+        if let Some(p) =
+            sinsmodel::estimate::align::attitude_contradicts_gravity(&head, roll, pitch)
+        {
+            if args.force {
+                eprintln!("warning: {p} (--force given)");
+            } else {
+                bail!("{}{p}", if args.init.is_some() { "--init: " } else { "" });
+            }
         }
-        // the initial position and the first aiding fix must describe the same place
-        if let Some(f) = fixes.iter().find(|f| f.t > t0) {
-            let dn = (f.lat - start.lat) * 6.371e6;
-            let de = (f.lon - start.lon) * 6.371e6 * start.lat.cos();
-            let dist = dn.hypot(de);
-            if dist > 20_000.0 {
+        drop(head);
+        if let AidPlan::Fixes(fixes, _, _) = &fixes {
+            let fixes: Vec<&aiding::PositionFix> = fixes.iter().map(|f| &f.0).collect();
+            let after = fixes.iter().filter(|f| f.t > t0).count();
+            if after < 10 {
                 bail!(
-                    "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
-                    dist / 1000.0,
-                    f.t
+                    "only {after} of {} aiding epochs come after the IMU start ({t0:.3} s); at least 10 are needed (the filter works on innovations)",
+                    fixes.len()
+                );
+            }
+            // the initial position and the first aiding fix must describe the same place
+            if let Some(f) = fixes.iter().find(|f| f.t > t0) {
+                let dn = (f.lat - start.lat) * 6.371e6;
+                let de = (f.lon - start.lon) * 6.371e6 * start.lat.cos();
+                let dist = dn.hypot(de);
+                if dist > 20_000.0 {
+                    bail!(
+                        "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
+                        dist / 1000.0,
+                        f.t
+                    );
+                }
+            }
+        }
+        if let AidPlan::Static { fix, .. } = &fixes {
+            let dn = (fix.lat - start.lat) * 6.371e6;
+            let de = (fix.lon - start.lon) * 6.371e6 * start.lat.cos();
+            if dn.hypot(de) > 20_000.0 {
+                bail!(
+                    "the initial position is {:.1} km from the first aiding fix (--static-aid): check --init / --static-aid",
+                    dn.hypot(de) / 1000.0
                 );
             }
         }
-        let aid: Vec<AidingEpoch> = fixes
-            .iter()
-            .filter(|f| f.t > t0)
-            .map(|f| AidingEpoch {
-                t: f.t,
-                vel: zupt.map(|s| (Vector3::zeros(), s)),
-                pos: Some((f.lat, f.lon, f.h, f.sigma)),
-            })
-            .collect();
-        Ok(Inputs {
+        let mut outages = Vec::new();
+        for o in &args.outage {
+            let v: Vec<f64> = o
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|_| {
+                    anyhow::anyhow!(
+                        "--outage `{}`: expected START,DURATION in seconds",
+                        sinsmodel::io::lines::shown(o)
+                    )
+                })?;
+            if v.len() != 2
+                || !v.iter().all(|x| x.is_finite())
+                || v[0] < 0.0
+                || v[1] <= 0.0
+                || v[0] + v[1] > 1e7
+            {
+                bail!(
+                    "--outage `{}`: expected START,DURATION in seconds (START >= 0 from the first IMU sample, DURATION > 0)",
+                    sinsmodel::io::lines::shown(o)
+                );
+            }
+            let start_s = imu.first_t() + v[0];
+            outages.push(Outage {
+                start_s,
+                end_s: start_s + v[1],
+            });
+        }
+        outages.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+        Ok(Opened {
             imu,
-            aid,
-            truth: truth_rows,
+            aid: fixes.after(t0),
+            truth: truth_reader,
             start,
+            outages,
         })
     }
 
@@ -454,7 +723,7 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
     if text.contains('=') && !path.exists() {
         return noise_inline(&text);
     }
-    let text = std::fs::read_to_string(path)
+    let text = sinsmodel::io::lines::read_small_text(path, "--noise")
         .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
         format!(

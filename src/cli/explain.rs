@@ -38,8 +38,8 @@ pub struct ExplainArgs {
     /// Demo only: length of the simulated run [s] (60 to 14400; default 600).
     #[arg(long)]
     demo_seconds: Option<f64>,
-    /// Demo only: seed of the simulation (default 1).
-    #[arg(long)]
+    /// Demo only: seed of the simulation (default 1; 0 to 1e12).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     demo_seed: Option<u64>,
 }
 
@@ -86,9 +86,13 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         opts.candidate_sigma = args.data.term_priors()?;
         let out = OutputDir::create(&args.out, &args.data.input_paths())?;
         args.data.print_noise()?;
-        let inputs = args.data.load()?;
+        let inputs = args.data.load_for_passes()?;
         let data = ExplainData {
-            imu: &inputs.imu,
+            imu: sinsmodel::estimate::explain::ImuInput::File {
+                path: &inputs.imu,
+                format: inputs.imu_format.as_deref(),
+                clock_offset: inputs.clock_offset,
+            },
             aid: &inputs.aid,
             truth: inputs.truth.as_deref(),
             start: inputs.start,
@@ -163,7 +167,7 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let priors = reproduce::Priors::default();
     let aid = reproduce::aiding_from_truth(&sim, &priors, case.velocity_updates, seed)?;
     let data = ExplainData {
-        imu: &sim.imu,
+        imu: sinsmodel::estimate::explain::ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,

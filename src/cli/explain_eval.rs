@@ -20,18 +20,18 @@ pub struct EvalArgs {
     /// Number of cases (1 to 100000).
     #[arg(long)]
     cases: Option<usize>,
-    /// Campaign seed.
-    #[arg(long, default_value_t = 1)]
+    /// Campaign seed (0 to 1e12).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     seed: u64,
     /// Index of the first case (shards of one campaign: `--first 0 --cases 100`, `--first 100 …`).
-    #[arg(long, default_value_t = 0)]
-    first: usize,
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000))]
+    first: u64,
     /// Library groups to draw from (default all: d,kaq,kas,kao,kgf,kgq,size).
     #[arg(long, value_delimiter = ',')]
     groups: Option<Vec<String>>,
     /// Threads (default: all cores).
-    #[arg(long)]
-    jobs: Option<usize>,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    jobs: Option<u64>,
     /// Simulated seconds per case (300 to 7200).
     #[arg(long, default_value_t = 600.0)]
     seconds: f64,
@@ -109,14 +109,14 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     opts.broken_selector = args.broken_selector;
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(j) = args.jobs {
-        pool = pool.num_threads(j);
+        pool = pool.num_threads(j as usize);
     }
     let pool = pool.build()?;
     let pb = progress::bar(n as u64, "cases");
     let done = AtomicUsize::new(0);
     let t0 = std::time::Instant::now();
     let results: Vec<Result<CaseResult>> = pool.install(|| {
-        (args.first..args.first + n)
+        (args.first as usize..args.first as usize + n)
             .into_par_iter()
             .map(|i| {
                 let r = explain_eval::run_case(&spec, i, &opts)
@@ -148,7 +148,7 @@ fn merge(args: &EvalArgs) -> Result<()> {
     let mut cases: Vec<CaseResult> = Vec::new();
     for d in &args.merge {
         let path = d.join("cases.json");
-        let text = std::fs::read_to_string(&path)
+        let text = sinsmodel::io::lines::read_small_text(&path, "explain-eval result")
             .with_context(|| format!("--merge: cannot read {}", path.display()))?;
         let stored: Stored = serde_json::from_str(&text).with_context(|| {
             format!(

@@ -18,30 +18,38 @@ pub struct FilterArgs {
     model: String,
     #[command(flatten)]
     data: DataArgs,
-    /// Output directory: states.txt, innovations.txt, model_error.txt (with truth); written
+    /// Output directory: states.txt, innovations.txt, nav.txt (the navigation solution with
+    /// 1-σ) and its plots, model_error.txt (with truth), outages.json (with --outage); written
     /// complete or not at all, replacing only an earlier sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
+    /// Rate of the navigation solution nav.txt [Hz] (default: every IMU sample).
+    #[arg(long)]
+    nav_rate: Option<f64>,
+    /// Read the whole IMU file before filtering (the pre-streaming path, kept as the baseline
+    /// `sinsmodel bench` measures the stream against).
+    #[arg(long, hide = true)]
+    in_memory: bool,
 }
 
-/// Runs the command.
+/// Runs the command: one streamed pass (memory does not grow with the IMU or truth file);
+/// states.txt and model_error.txt are written as the epochs come, innovations.txt at the end,
+/// and the directory appears only when the run succeeded.
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
     let cfg = args.data.config(&model, false)?;
     let out = OutputDir::create(&args.out, &args.data.input_paths())?;
     args.data.print_noise()?;
-    let inputs = args.data.load()?;
-    let (imu, aid, truth_rows, start) = (&inputs.imu, &inputs.aid, &inputs.truth, inputs.start);
-    let pb = progress::bar(1000, "filter");
-    let run = filter::run(&model, &cfg, imu, start, aid, truth_rows.as_deref(), |f| {
-        pb.set_position((f * 1000.0) as u64)
-    });
-    pb.finish_and_clear();
-    run.check().map_err(anyhow::Error::msg)?;
-
-    let mut f = AtomicFile::create(&out.file("states.txt"))?;
-    let w = f.writer();
+    let mut inputs = args.data.open()?;
+    if args.in_memory {
+        inputs.imu = inputs.imu.into_memory()?;
+    }
+    let start = inputs.start;
     let provenance = super::command_line();
+    let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
+
+    let mut states = AtomicFile::create(&out.file("states.txt"))?;
+    let w = states.writer();
     writeln!(w, "# {provenance}")?;
     writeln!(
         w,
@@ -58,14 +66,98 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         write!(w, " sigma_{n}")?;
     }
     writeln!(w)?;
-    for r in &run.records {
+    let with_truth = inputs.truth.is_some();
+    let mut model_error = match with_truth {
+        true => {
+            let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
+            let w = f.writer();
+            writeln!(w, "# {provenance}")?;
+            writeln!(
+                w,
+                "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
+            )?;
+            Some(f)
+        }
+        false => None,
+    };
+    // what the summary needs of each epoch: t and the model error e = φ̂ − φ (north, east)
+    let mut errors: Vec<(f64, Option<[f64; 2]>)> = Vec::new();
+    let mut on_record = |r: &filter::Record| -> Result<()> {
+        let w = states.writer();
         write!(w, "{:.4}", r.t)?;
         for v in r.x.iter().chain(&r.sigma) {
             write!(w, " {v:.6e}")?;
         }
         writeln!(w)?;
+        let mut e_ne = None;
+        if let (Some(f), Some(p)) = (model_error.as_mut(), r.phi_true) {
+            let e = r.phi_est - p;
+            e_ne = Some([e.x, e.y]);
+            writeln!(
+                f.writer(),
+                "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
+                r.t,
+                p.x * arcsec,
+                p.y * arcsec,
+                p.z * arcsec,
+                r.phi_est.x * arcsec,
+                r.phi_est.y * arcsec,
+                r.phi_est.z * arcsec,
+                e.x * arcsec,
+                e.y * arcsec
+            )?;
+        }
+        errors.push((r.t, e_ne));
+        Ok(())
+    };
+    if let Some(r) = args.nav_rate {
+        if !(r.is_finite() && r > 0.0 && r <= 1e5) {
+            anyhow::bail!("--nav-rate {r}: expected a rate in (0, 1e5] Hz");
+        }
     }
-    f.commit()?;
+    let every = match args.nav_rate {
+        Some(r) => (1.0 / (r * inputs.imu.interval())).round().max(1.0) as u64,
+        None => 1,
+    };
+    let mut nav =
+        super::nav_out::NavWriter::create(&out.file("nav.txt"), &model, every, &provenance)?;
+    let pb = progress::bar(1000, "filter");
+    let mut epochs = inputs.aid.epochs_outside(&inputs.outages);
+    let mut io = filter::StreamIo {
+        samples: &mut inputs.imu,
+        aiding: &mut epochs,
+        truth: inputs
+            .truth
+            .as_mut()
+            .map(|t| t as &mut dyn sinsmodel::io::truth::TruthLookup),
+    };
+    let run = filter::run_stream(
+        &model,
+        &cfg,
+        start,
+        &mut io,
+        |f| pb.set_position((f * 1000.0) as u64),
+        &mut |_| {},
+        &mut nav,
+        &mut on_record,
+        false,
+    )?;
+    drop(epochs);
+    pb.finish_and_clear();
+    run.check().map_err(anyhow::Error::msg)?;
+    if let Some(tr) = inputs.truth.take() {
+        tr.finish()?;
+        let covered = errors.iter().filter(|e| e.1.is_some()).count();
+        if covered < errors.len() {
+            eprintln!(
+                "warning: the truth file has a row at only {covered} of the {} update epochs: model_error.txt and the model-error RMS cover those only",
+                errors.len()
+            );
+        }
+    }
+    let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
+    super::data::check_inside(errors.len(), inputs.aid.len(), start.t, t_last)?;
+    states.commit()?;
 
     let mut f = AtomicFile::create(&out.file("innovations.txt"))?;
     let w = f.writer();
@@ -79,62 +171,133 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         )?;
     }
     f.commit()?;
-
-    if truth_rows.is_some() {
-        let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
-        let w = f.writer();
-        let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
-        writeln!(w, "# {provenance}")?;
-        writeln!(
-            w,
-            "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
-        )?;
-        for r in &run.records {
-            if let Some(p) = r.phi_true {
-                let e = r.phi_est - p;
-                writeln!(
-                    w,
-                    "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
-                    r.t,
-                    p.x * arcsec,
-                    p.y * arcsec,
-                    p.z * arcsec,
-                    r.phi_est.x * arcsec,
-                    r.phi_est.y * arcsec,
-                    r.phi_est.z * arcsec,
-                    e.x * arcsec,
-                    e.y * arcsec
-                )?;
-            }
-        }
+    if let Some(f) = model_error {
         f.commit()?;
+    }
+    let nav_rows = nav.rows;
+    nav.finish(&out.file("nav.png"))?;
+    let outage_rows = outage_drifts(&inputs.outages, &run, t_last)?;
+    if !outage_rows.is_empty() {
+        sinsmodel::io::atomic_file::write_text(
+            &out.file("outages.json"),
+            &serde_json::to_string_pretty(&serde_json::json!({
+                "command": provenance,
+                "what": "GNSS outages: horizontal position drift of the filter's solution at the first aiding fix after each, against that fix (its pos_ne innovation), metres",
+                "outages": outage_rows,
+            }))?,
+        )?;
     }
     out.commit()?;
     eprintln!(
         "filtered {} samples ({:.1} s) with {} ({} states, {} loop): {} scalar updates",
-        imu.samples.len(),
-        imu.duration(),
+        inputs.imu.count(),
+        t_last - t_first,
         model.name,
         model.n(),
         cfg.mode.word(),
         run.innovations.len(),
     );
     eprint!("{}", nis_table(&run));
-    if let (Some(first), Some(last)) = (run.records.first(), run.records.last()) {
-        let mid = 0.5 * (first.t + last.t);
-        if let Some([n, e]) = filter::model_error_rms_arcsec(&run, mid, last.t) {
+    if !outage_rows.is_empty() {
+        eprintln!("GNSS outages: drift at the first fix after each (the filter's solution against that fix)");
+        eprintln!(
+            "  {:>10} {:>9} {:>10} {:>9} {:>9} {:>10}",
+            "start[s]", "length[s]", "fix at[s]", "north[m]", "east[m]", "horiz.[m]"
+        );
+        for r in &outage_rows {
             eprintln!(
-                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s): north {n:.2} arcsec, east {e:.2} arcsec",
-                last.t
+                "  {:>10.1} {:>9.1} {:>10.1} {:>9.2} {:>9.2} {:>10.2}",
+                r.start_s - t_first,
+                r.end_s - r.start_s,
+                r.fix_t_s - t_first,
+                r.drift_n_m,
+                r.drift_e_m,
+                r.drift_horizontal_m
             );
         }
     }
-    let mut files = vec!["states.txt", "innovations.txt"];
-    if truth_rows.is_some() {
+    if let (Some(first), Some(last)) = (errors.first(), errors.last()) {
+        let mid = 0.5 * (first.0 + last.0);
+        let half: Vec<[f64; 2]> = errors
+            .iter()
+            .filter(|e| e.0 >= mid)
+            .map_while(|e| e.1)
+            .collect();
+        if !half.is_empty() && errors.iter().filter(|e| e.0 >= mid).all(|e| e.1.is_some()) {
+            let rms = |c: usize| {
+                (half.iter().map(|e| e[c] * e[c]).sum::<f64>() / half.len() as f64).sqrt() * arcsec
+            };
+            eprintln!(
+                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s): north {:.2} arcsec, east {:.2} arcsec",
+                last.0,
+                rms(0),
+                rms(1)
+            );
+        }
+    }
+    let mut files = vec![
+        "states.txt",
+        "innovations.txt",
+        "nav.txt",
+        "nav_track.png",
+        "nav_sigma.png",
+    ];
+    if with_truth {
         files.push("model_error.txt");
     }
-    eprintln!("wrote {} in {}", files.join(", "), args.out.display());
+    if !inputs.outages.is_empty() {
+        files.push("outages.json");
+    }
+    eprintln!(
+        "wrote {} in {} (nav.txt: {nav_rows} rows)",
+        files.join(", "),
+        args.out.display()
+    );
     Ok(())
+}
+
+/// The drift at the end of one GNSS outage.
+#[derive(Debug, Clone, serde::Serialize)]
+struct OutageDrift {
+    start_s: f64,
+    end_s: f64,
+    /// Time of the first aiding fix after the outage [s].
+    fix_t_s: f64,
+    drift_n_m: f64,
+    drift_e_m: f64,
+    drift_horizontal_m: f64,
+}
+
+/// For each outage, the pos_ne innovation (computed − fix, before the update) at the first
+/// fix after it: the drift of the filter's solution over the outage.
+fn outage_drifts(
+    outages: &[super::data::Outage],
+    run: &filter::FilterRun,
+    t_last: f64,
+) -> Result<Vec<OutageDrift>> {
+    let mut out = Vec::new();
+    for o in outages {
+        let after = |c: usize| {
+            run.innovations
+                .iter()
+                .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
+        };
+        let (Some(n), Some(e)) = (after(0), after(1)) else {
+            anyhow::bail!(
+                "--outage ending at {:.1} s: no position fix after it inside the data (which end at {t_last:.1} s): nothing to measure the drift against",
+                o.end_s
+            );
+        };
+        out.push(OutageDrift {
+            start_s: o.start_s,
+            end_s: o.end_s,
+            fix_t_s: n.t,
+            drift_n_m: n.nu,
+            drift_e_m: e.nu,
+            drift_horizontal_m: n.nu.hypot(e.nu),
+        });
+    }
+    Ok(out)
 }
 
 /// The mean NIS of every channel against its 95 % band, with a word on each.

@@ -24,7 +24,7 @@ pub struct JacobianArgs {
 /// Runs the command.
 pub fn run(args: &JacobianArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
-    let text = std::fs::read_to_string(&args.at)
+    let text = sinsmodel::io::lines::read_small_text(&args.at, "--at")
         .with_context(|| format!("cannot read {}", args.at.display()))?;
     let at = args.at.display();
     let out = match parse_points(&text).with_context(|| format!("{at}"))? {

@@ -10,6 +10,7 @@ pub mod filter;
 pub mod imu_check;
 pub mod jacobian;
 pub mod model;
+pub mod nav_out;
 pub mod navigate;
 pub mod reproduce;
 pub mod simulate;

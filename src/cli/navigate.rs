@@ -44,6 +44,13 @@ pub struct NavigateArgs {
     /// Output file (truth layout of DESIGN §9).
     #[arg(long)]
     out: PathBuf,
+    /// Run even when --att's roll and pitch contradict the measured gravity direction.
+    #[arg(long)]
+    force: bool,
+    /// Read the whole IMU file before navigating (the pre-streaming path, kept as the baseline
+    /// `sinsmodel bench` measures the stream against).
+    #[arg(long, hide = true)]
+    in_memory: bool,
 }
 
 /// Runs the command.
@@ -77,19 +84,38 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         bail!("--out-rate must be positive");
     }
     args.src.check_output("--out", &args.out)?;
-    let data = args.src.read()?;
-    data.check_time(&args.src.imu.display().to_string(), 5.0)?;
+    // streamed: memory does not grow with the file; the output is written as it goes and
+    // appears only when complete
+    let mut data = args.src.open()?;
+    if args.in_memory {
+        data = data.into_memory()?;
+    }
     // the same plausibility imu-check applies, on the first 10 s: warn, do not stop (a start
     // that moves or a tilted mounting are legitimate here)
+    let head = sinsmodel::io::imu::ImuData {
+        samples: data.head().to_vec(),
+    };
     let check =
-        sinsmodel::estimate::imu_check::check(&data, Some(args.lat.to_radians()), 0.0, 10.0, true);
+        sinsmodel::estimate::imu_check::check(&head, Some(args.lat.to_radians()), 0.0, 10.0, true);
     for p in &check.problems {
         eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
     }
     let d = std::f64::consts::PI / 180.0;
+    if let Some(p) = sinsmodel::estimate::align::attitude_contradicts_gravity(
+        &head,
+        args.att[0] * d,
+        args.att[1] * d,
+    ) {
+        if args.force {
+            eprintln!("warning: {p} (--force given)");
+        } else {
+            bail!("--att: {p}");
+        }
+    }
+    drop(head);
     let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
     let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
-    let t0 = data.samples[0].t - data.interval();
+    let t0 = data.first_t() - data.interval();
     let start = NavState {
         t: t0,
         lat: args.lat * d,
@@ -99,7 +125,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
     };
     let mut nav = Navigator::new(start, args.vertical);
-    let every = (data.rate_hz() / args.out_rate).round().max(1.0) as usize;
+    let every = (1.0 / (data.interval() * args.out_rate)).round().max(1.0) as u64;
     let row = |s: &NavState| TruthRow {
         t: s.t,
         lat: s.lat,
@@ -108,20 +134,32 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         v: s.v,
         euler: s.euler(),
     };
-    let mut rows = vec![row(&nav.state)];
-    let pb = progress::bar(data.samples.len() as u64, "navigate");
+    let mut out = truth::create(
+        &args.out,
+        &format!(
+            "{} (vertical {})",
+            super::command_line(),
+            args.vertical.word()
+        ),
+    )?;
+    truth::write_row(out.writer(), &row(&nav.state))?;
+    let mut rows = 1u64;
+    let pb = progress::bar(1000, "navigate");
     let mut prev_t = t0;
-    for (k, s) in data.samples.iter().enumerate() {
+    while let Some(s) = data.next()? {
+        let k = data.count() - 1;
         nav.step(&s.dtheta, &s.dv, s.t - prev_t);
         nav.state.t = s.t;
         let st = &nav.state;
-        if ![st.lat, st.lon, st.h, st.v.x, st.v.y, st.v.z]
+        if ![st.lat, st.lon, st.h, st.v.x, st.v.y, st.v.z, st.q.w, st.q.i]
             .iter()
             .all(|v| v.is_finite())
             || st.h.abs() > 1e7
+            || st.lat.abs() >= 89.9f64.to_radians()
+            || st.v.norm() > 1e4
         {
             bail!(
-                "{}: the navigation diverged at t = {:.3} s (sample {}): the increments are not physical there \
+                "{}: the navigation diverged at t = {:.3} s (sample {}): a non-finite state, a pole (the NED frame is undefined there) or a speed over 1e4 m/s; the increments are not physical there \
                  (check the IMU values, units and clock; `sinsmodel imu-check` shows what was read)",
                 args.src.imu.display(),
                 s.t,
@@ -130,27 +168,20 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         }
         prev_t = s.t;
         if (k + 1) % every == 0 {
-            rows.push(row(&nav.state));
+            truth::write_row(out.writer(), &row(&nav.state))?;
+            rows += 1;
         }
         if k % 100_000 == 0 {
-            pb.set_position(k as u64);
+            pb.set_position((data.fraction() * 1000.0) as u64);
         }
     }
     pb.finish_and_clear();
-    truth::write(
-        &args.out,
-        &rows,
-        &format!(
-            "{} (vertical {})",
-            super::command_line(),
-            args.vertical.word()
-        ),
-    )?;
+    out.commit()?;
     eprintln!(
         "navigated {} samples ({:.1} s), wrote {} rows to {}",
-        data.samples.len(),
-        data.duration(),
-        rows.len(),
+        data.count(),
+        data.last_t() - data.first_t(),
+        rows,
         args.out.display()
     );
     let (s0, s1) = (&start, &nav.state);

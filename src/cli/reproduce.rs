@@ -1,7 +1,7 @@
 //! `sinsmodel reproduce [--quick] [--priors-grid] [--consistency] --out DIR`: the paper's §3 and
 //! Fig. 1 (DESIGN §6) with P28 and P31, figures, the priors study and the consistency check.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::filter::FilterRun;
@@ -24,7 +24,7 @@ pub struct ReproduceArgs {
     #[arg(long)]
     consistency: bool,
     /// Seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     seed: u64,
     /// Output directory.
     #[arg(long, default_value = "out/reproduce")]
@@ -57,10 +57,10 @@ fn model_error_series(run: &FilterRun, label: &str, comp: usize) -> Series {
 
 /// Runs the command.
 pub fn run(args: &ReproduceArgs) -> Result<()> {
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    // one run's outputs, complete or none; a directory sinsmodel did not write is left alone
+    let dir = sinsmodel::io::atomic_file::OutputDir::create(&args.out, &[])?;
     if args.consistency {
-        return consistency(args);
+        return consistency(args, dir);
     }
     let priors = Priors::default();
     let mut results = Vec::new();
@@ -104,7 +104,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
                     .collect(),
             };
             line_plot(
-                &args.out.join("fig1_position_error.png"),
+                &dir.file("fig1_position_error.png"),
                 "Fig. 1: free-inertial position error from d only (8 g, 90 Hz on N, E, D)",
                 "time [h]",
                 "position error [km]",
@@ -114,9 +114,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         }
         for (comp, axis) in [(0, "north"), (1, "east")] {
             line_plot(
-                &args
-                    .out
-                    .join(format!("{}_model_error_{axis}.png", case.name)),
+                &dir.file(&format!("{}_model_error_{axis}.png", case.name)),
                 &format!(
                     "{}: model error e_{} = phi_hat - phi",
                     case.name,
@@ -160,10 +158,11 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         notes,
     };
     atomic_file::write_text(
-        &args.out.join("results.json"),
+        &dir.file("results.json"),
         &serde_json::to_string_pretty(&out)?,
     )?;
-    atomic_file::write_text(&args.out.join("results.md"), &markdown(&out, args.quick))?;
+    atomic_file::write_text(&dir.file("results.md"), &markdown(&out, args.quick))?;
+    dir.commit()?;
     if args.quick {
         eprintln!(
             "reference: the full run (2 h cases) is in docs/reproduce/results.md. Its ratios are \
@@ -224,7 +223,7 @@ fn markdown(r: &Results, quick: bool) -> String {
 }
 
 /// The consistency Monte Carlo (library: `report::reproduce::consistency`), printed and plotted.
-fn consistency(args: &ReproduceArgs) -> Result<()> {
+fn consistency(args: &ReproduceArgs, dir: sinsmodel::io::atomic_file::OutputDir) -> Result<()> {
     let pb = progress::bar(20, "monte carlo");
     let out = reproduce::consistency(args.quick, |k, _| pb.set_position(k as u64))?;
     pb.finish_and_clear();
@@ -253,7 +252,7 @@ fn consistency(args: &ReproduceArgs) -> Result<()> {
             .collect(),
     };
     line_plot(
-        &args.out.join("consistency_nees.png"),
+        &dir.file("consistency_nees.png"),
         "Average NEES / n over 20 seeds (P31, true model)",
         "update epoch [s]",
         "NEES / n",
@@ -272,9 +271,10 @@ fn consistency(args: &ReproduceArgs) -> Result<()> {
         Scale::Linear,
     )?;
     atomic_file::write_text(
-        &args.out.join("consistency.json"),
+        &dir.file("consistency.json"),
         &serde_json::to_string_pretty(&out)?,
     )?;
+    dir.commit()?;
     eprintln!(
         "wrote consistency.json and consistency_nees.png in {}",
         args.out.display()

@@ -6,7 +6,7 @@
 use crate::nav::attitude::dcm_from_euler;
 
 use crate::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
-use crate::io::imu::{ImuData, ImuSample};
+use crate::io::imu::{mean_rates_of, ImuData, ImuSample};
 use crate::model::Model;
 use crate::nav::strapdown::{NavState, Vertical};
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
@@ -25,10 +25,10 @@ pub struct Coarse {
 }
 
 /// Analytic alignment from the mean specific force and rate of `samples`.
+/// Each increment is divided by its own interval ([`mean_rates_of`]), so a jittered clock gives
+/// the same means as a uniform one.
 pub fn coarse(samples: &[ImuSample], dt: f64) -> Coarse {
-    let n = samples.len() as f64;
-    let f = samples.iter().map(|s| s.dv).sum::<Vector3<f64>>() / (n * dt);
-    let w = samples.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / (n * dt);
+    let (f, w) = mean_rates_of(samples, dt);
     let roll = (-f.y).atan2(-f.z);
     let pitch = f.x.atan2((f.y * f.y + f.z * f.z).sqrt());
     // rate in the levelled body frame (yaw 0): its horizontal part is Ω cos L (cos ψ, −sin ψ)
@@ -58,7 +58,7 @@ pub fn disturbed_windows(data: &ImuData, win_s: f64) -> (usize, Vec<bool>) {
         .samples
         .chunks(w)
         .filter(|c| c.len() == w)
-        .map(|c| c.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / (w as f64 * dt))
+        .map(|c| mean_rates_of(c, dt).1)
         .collect();
     let med = |v: &mut Vec<f64>| {
         v.sort_by(f64::total_cmp);
@@ -74,15 +74,109 @@ pub fn disturbed_windows(data: &ImuData, win_s: f64) -> (usize, Vec<bool>) {
     (w, dev.iter().map(|d| *d > 5.0 * 1.4826 * mad).collect())
 }
 
-/// Index of the first sample after the last disturbed window in the first half of the data.
-pub fn quiet_start(data: &ImuData, win_s: f64) -> usize {
-    let (w, flags) = disturbed_windows(data, win_s);
-    let half = flags.len() / 2;
-    flags[..half]
-        .iter()
-        .rposition(|f| *f)
-        .map(|k| (k + 1) * w)
-        .unwrap_or(0)
+/// At rest, judged from absolute evidence: the RMS deviation of the 1-s mean specific forces of
+/// a window from their mean [m/s²] stays below this (5 mg: engine vibration averages out within
+/// a second, a vehicle that rolls, brakes or is carried does not).
+pub const STATIC_F_SPREAD: f64 = 0.05;
+/// At rest: the RMS deviation of the 1-s mean angular rates from their mean [rad/s] stays below
+/// this (0.1 deg/s: about five times the 1-s noise of a consumer MEMS gyro; a gyro bias is
+/// constant and does not count).
+pub const STATIC_W_SPREAD: f64 = 0.1 * std::f64::consts::PI / 180.0;
+/// At rest: the mean |f| is within this of local gravity [m/s²] (0.05 g: room for a MEMS
+/// accelerometer's bias and scale).
+pub const STATIC_G_ERROR: f64 = 0.05 * 9.80665;
+
+/// What one window of data says about being at rest.
+#[derive(Debug, Clone, Copy)]
+pub struct RestEvidence {
+    /// RMS deviation of the 1-s mean specific forces from the window mean [m/s²].
+    pub f_spread: f64,
+    /// RMS deviation of the 1-s mean angular rates from the window mean [rad/s].
+    pub w_spread: f64,
+    /// |mean f| − local gravity [m/s²].
+    pub g_error: f64,
+}
+
+impl RestEvidence {
+    /// True when every measure is within its threshold.
+    pub fn at_rest(&self) -> bool {
+        self.f_spread <= STATIC_F_SPREAD
+            && self.w_spread <= STATIC_W_SPREAD
+            && self.g_error.abs() <= STATIC_G_ERROR
+    }
+}
+
+/// Evidence of rest of each whole window of `win` samples (1-s sub-means), with `g` the local
+/// gravity [m/s²].
+pub fn rest_evidence(data: &ImuData, win: usize, g: f64) -> Vec<RestEvidence> {
+    let dt = data.interval();
+    let sub = ((1.0 / dt).round() as usize).clamp(2, win.max(2));
+    data.samples
+        .chunks(win)
+        .filter(|c| c.len() == win)
+        .map(|c| {
+            let means: Vec<(Vector3<f64>, Vector3<f64>)> = c
+                .chunks(sub)
+                .filter(|s| s.len() == sub)
+                .map(|s| mean_rates_of(s, dt))
+                .collect();
+            let k = means.len().max(1) as f64;
+            let fm = means.iter().map(|m| m.0).sum::<Vector3<f64>>() / k;
+            let wm = means.iter().map(|m| m.1).sum::<Vector3<f64>>() / k;
+            let rms = |dev: Vec<f64>| (dev.iter().map(|d| d * d).sum::<f64>() / k).sqrt();
+            RestEvidence {
+                f_spread: rms(means.iter().map(|m| (m.0 - fm).norm()).collect()),
+                w_spread: rms(means.iter().map(|m| (m.1 - wm).norm()).collect()),
+                g_error: fm.norm() - g,
+            }
+        })
+        .collect()
+}
+
+/// Largest angle [rad] between the measured mean specific force at rest and the one an
+/// initial attitude predicts before the attitude is refused (5°).
+pub const MAX_TILT_MISMATCH: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
+/// Checks an initial roll and pitch [rad] against gravity: when the first seconds of `head` are
+/// at rest (by [`rest_evidence`] over up to 10 s), the mean specific force must point where the
+/// attitude says "up" is, within [`MAX_TILT_MISMATCH`]; returns the problem in words, or None
+/// (also when the start moves: then the data cannot judge).
+pub fn attitude_contradicts_gravity(head: &ImuData, roll: f64, pitch: f64) -> Option<String> {
+    let dt = head.interval();
+    if dt.is_nan() || dt <= 0.0 || head.duration() < 2.0 {
+        return None;
+    }
+    let win = ((head.duration().min(10.0) / dt) as usize).min(head.samples.len());
+    let first = ImuData {
+        samples: head.samples[..win].to_vec(),
+    };
+    let g = first.mean_rates().0.norm();
+    let ev = rest_evidence(&first, win, g);
+    if !ev
+        .first()
+        .is_some_and(|e| e.f_spread <= STATIC_F_SPREAD && e.w_spread <= STATIC_W_SPREAD)
+    {
+        return None;
+    }
+    let (f, _) = first.mean_rates();
+    // at rest f^b = C_n^b (0, 0, −g): "up" in the body is −f
+    let c = dcm_from_euler(roll, pitch, 0.0);
+    let predicted = c.transpose() * Vector3::new(0.0, 0.0, -1.0);
+    let angle = f.normalize().dot(&predicted).clamp(-1.0, 1.0).acos();
+    (angle > MAX_TILT_MISMATCH).then(|| {
+        let d = 180.0 / std::f64::consts::PI;
+        format!(
+            "the initial attitude contradicts gravity: roll {:.2} deg, pitch {:.2} deg put the specific force {:.1} deg away from \
+             what the first {:.0} s at rest measure (roll {:.2} deg, pitch {:.2} deg); check roll and pitch (a sensor mounted \
+             upside down has roll 180), or pass --force to run anyway",
+            roll * d,
+            pitch * d,
+            angle * d,
+            first.duration(),
+            (-f.y).atan2(-f.z) * d,
+            f.x.atan2((f.y * f.y + f.z * f.z).sqrt()) * d
+        )
+    })
 }
 
 /// Result of a static alignment.
@@ -92,10 +186,16 @@ pub struct Alignment {
     pub roll_deg: f64,
     /// Pitch [deg].
     pub pitch_deg: f64,
-    /// Heading [deg], 0..360.
-    pub heading_deg: f64,
-    /// 1-σ of the heading from the fine alignment [deg].
-    pub heading_sigma_deg: f64,
+    /// Heading [deg], 0..360; None when the gyros cannot find north (their bias, or its prior,
+    /// hides the Earth rate): see `heading_note`.
+    pub heading_deg: Option<f64>,
+    /// 1-σ of the heading from the fine alignment [deg], including the gyro-bias prior.
+    pub heading_sigma_deg: Option<f64>,
+    /// Why there is no heading, or what widened its σ.
+    pub heading_note: Option<String>,
+    /// Gyro-bias 1-σ used in the fine alignment [deg/h]: the given prior, widened to the bias
+    /// the data show at rest when that is larger.
+    pub gyro_bias_sigma_used_deg_h: f64,
     /// Latitude: given, or estimated [deg].
     pub lat_deg: f64,
     /// 1-σ of the estimated latitude [deg] (0 when given).
@@ -129,14 +229,67 @@ pub fn align(
             "the IMU interval is {dt} s: alignment needs data at 1 Hz or faster (10 s windows of samples)"
         );
     }
-    let q0 = quiet_start(data, 10.0);
-    let mut used: Vec<ImuSample> = data.samples[q0..].to_vec();
+    // at rest by absolute evidence (10 s windows of 1-s means) and not disturbed relative to
+    // the other windows; the longest run of such windows is used
+    let g_local = crate::nav::earth::gravity(lat.unwrap_or(45f64.to_radians()), h);
+    let (w10, disturbed) = disturbed_windows(data, 10.0);
+    let evidence = rest_evidence(data, w10, g_local);
+    let rest: Vec<bool> = evidence.iter().map(|e| e.at_rest()).collect();
+    let (mut best, mut run_start) = ((0usize, 0usize), None);
+    for (k, r) in rest.iter().chain(std::iter::once(&false)).enumerate() {
+        match (r, run_start) {
+            (true, None) => run_start = Some(k),
+            (false, Some(s0)) => {
+                if k - s0 > best.1 - best.0 {
+                    best = (s0, k);
+                }
+                run_start = None;
+            }
+            _ => {}
+        }
+    }
+    let rest_s = (best.1 - best.0) as f64 * w10 as f64 * dt;
+    if rest_s < 60.0 {
+        let moving: Vec<&RestEvidence> = evidence.iter().filter(|e| !e.at_rest()).collect();
+        let worst =
+            |f: &dyn Fn(&RestEvidence) -> f64| moving.iter().map(|e| f(e)).fold(0.0, f64::max);
+        anyhow::bail!(
+            "the data are not at rest long enough to align: the longest stretch at rest is {rest_s:.0} s of {:.0} s, 60 s are needed. \
+             In the {} of {} ten-second windows judged moving: specific-force spread up to {:.3} m/s^2 (at rest <= {STATIC_F_SPREAD}), \
+             angular-rate spread up to {:.3} deg/s (at rest <= {:.2}), | |f| - g | up to {:.3} m/s^2 (at rest <= {:.2}). \
+             Give the attitude instead: --init for filter/explain, --att for navigate (from a known mounting, or a GNSS course once moving)",
+            data.duration(),
+            moving.len(),
+            evidence.len(),
+            worst(&|e| e.f_spread),
+            worst(&|e| e.w_spread).to_degrees(),
+            STATIC_W_SPREAD.to_degrees(),
+            worst(&|e| e.g_error.abs()),
+            STATIC_G_ERROR
+        );
+    }
+    // inside it, a disturbed start (a touch, a door: at rest by the thresholds but unlike the
+    // other windows) is skipped as before: after the last disturbed window of the first half
+    let half = best.0 + (best.1 - best.0) / 2;
+    let first = disturbed[best.0..half]
+        .iter()
+        .rposition(|d| *d)
+        .map(|k| best.0 + k + 1)
+        .unwrap_or(best.0);
+    let q0 = first * w10;
+    // a run that reaches the last whole window keeps the samples after it too
+    let end = if best.1 == rest.len() {
+        data.samples.len()
+    } else {
+        best.1 * w10
+    };
+    let mut used: Vec<ImuSample> = data.samples[q0..end].to_vec();
     if let Some(s) = seconds {
         let n = ((s / dt).round() as usize).min(used.len());
         used.truncate(n);
     }
     if used.len() < (60.0 / dt) as usize {
-        anyhow::bail!("fewer than 60 s of quiet data to align on");
+        anyhow::bail!("fewer than 60 s of data at rest to align on (--seconds)");
     }
     // coarse alignment on the quiet windows only (later disturbances excluded from the means)
     let used_data = ImuData {
@@ -168,6 +321,41 @@ pub fn align(
         / k.sqrt();
     let lat_used = lat.unwrap_or(c.lat);
 
+    // what the gyros can say about north: the horizontal Earth rate against the gyro bias. At
+    // rest |ω̄| = |Ω + b|: above 2 Ω the bias is at least |ω̄| − Ω (≥ Ω) and the prior is
+    // widened to it (the heading σ must include the bias the data show); between 0.5 and 2 Ω a
+    // scale error explains the difference as well as a bias, and the prior stands.
+    let omega_h = crate::nav::earth::OMEGA * lat_used.cos();
+    let ratio = c.w_mean.norm() / crate::nav::earth::OMEGA;
+    let bias_seen = if ratio > 2.0 {
+        c.w_mean.norm() - crate::nav::earth::OMEGA
+    } else {
+        0.0
+    };
+    let bias_sigma = gyro_bias_sigma.max(bias_seen);
+    let deg_h = 180.0 / std::f64::consts::PI * 3600.0;
+    let mut heading_note = (bias_sigma > gyro_bias_sigma).then(|| {
+        format!(
+            "gyro-bias prior widened from {:.3} to {:.3} deg/h: at rest the gyros read {:.3} deg/h against Earth rate {:.3} deg/h",
+            gyro_bias_sigma * deg_h,
+            bias_sigma * deg_h,
+            c.w_mean.norm() * deg_h,
+            crate::nav::earth::OMEGA * deg_h
+        )
+    });
+    // σ_ψ ≈ σ_b / (Ω cos L): beyond ~20° the gyros do not find north
+    let no_heading = bias_sigma / omega_h > 20f64.to_radians();
+    if no_heading {
+        heading_note = Some(format!(
+            "no heading: the gyro bias ({:.3} deg/h at rest{}) is {:.1}x the horizontal Earth rate ({:.3} deg/h at this latitude), \
+             so gyrocompassing cannot find north (sigma would exceed 20 deg); give the heading with --init / --att, or align on a GNSS course once moving",
+            bias_sigma * deg_h,
+            if bias_sigma > gyro_bias_sigma { ", seen in the data" } else { ", the --gyro-bias-sigma prior" },
+            bias_sigma / omega_h,
+            omega_h * deg_h
+        ));
+    }
+
     // fine alignment: P13, closed loop, zero velocity and known position at 1 Hz
     let model = Model::parse("P13")?;
     let mut cfg = FilterConfig::new(&model);
@@ -177,7 +365,7 @@ pub fn align(
     cfg.set_prior(&model, "phi_e", 1e-3);
     cfg.set_prior(&model, "phi_d", 0.1);
     for n in ["eps_x", "eps_y", "eps_z"] {
-        cfg.set_prior(&model, n, gyro_bias_sigma);
+        cfg.set_prior(&model, n, bias_sigma);
     }
     cfg.set_prior(&model, "nabla_x", 1e-3);
     cfg.set_prior(&model, "nabla_y", 1e-3);
@@ -219,8 +407,10 @@ pub fn align(
     Ok(Alignment {
         roll_deg: e.x * deg,
         pitch_deg: e.y * deg,
-        heading_deg: (e.z * deg).rem_euclid(360.0),
-        heading_sigma_deg: last.sigma[i_phid] * deg,
+        heading_deg: (!no_heading).then(|| (e.z * deg).rem_euclid(360.0)),
+        heading_sigma_deg: (!no_heading).then(|| last.sigma[i_phid] * deg),
+        heading_note,
+        gyro_bias_sigma_used_deg_h: bias_sigma * deg_h,
         lat_deg: lat_used * deg,
         lat_sigma_deg: if lat.is_some() { 0.0 } else { lat_sigma * deg },
         // rounded to the microsecond: q0·dt carries the interval's binary rounding

@@ -83,11 +83,44 @@ impl Default for ExplainOptions {
     }
 }
 
+/// Where explain's IMU samples come from: memory (simulations), or a file read again on every
+/// pass, so that memory does not grow with the file.
+#[derive(Clone, Copy)]
+pub enum ImuInput<'a> {
+    /// Samples in memory.
+    Memory(&'a ImuData),
+    /// A file and its format description (`--imu`, `--imu-format`).
+    File {
+        /// The IMU file.
+        path: &'a std::path::Path,
+        /// Its format description, when given.
+        format: Option<&'a std::path::Path>,
+        /// GPST − IMU clock offset [s] (`--clock-offset`), when given.
+        clock_offset: Option<f64>,
+    },
+}
+
+impl ImuInput<'_> {
+    /// A fresh pass over the samples.
+    pub fn samples(&self) -> anyhow::Result<Box<dyn filter::Samples + '_>> {
+        Ok(match *self {
+            ImuInput::Memory(d) => Box::new(filter::SliceSamples::new(&d.samples)),
+            ImuInput::File {
+                path,
+                format,
+                clock_offset,
+            } => {
+                Box::new(crate::io::imu_stream::ImuStream::open_with(path, format, clock_offset)?.0)
+            }
+        })
+    }
+}
+
 /// The data explain works on (the same as the filter's).
 #[derive(Clone, Copy)]
 pub struct ExplainData<'a> {
     /// IMU increments, FRD.
-    pub imu: &'a ImuData,
+    pub imu: ImuInput<'a>,
     /// Aiding epochs.
     pub aid: &'a [AidingEpoch],
     /// Truth, when known (simulations).
@@ -824,17 +857,26 @@ fn run_pass(
     progress: &mut dyn FnMut(f64),
 ) -> anyhow::Result<Pass> {
     let mut sig = Signatures::new(model, cands);
-    let run = filter::run_observed(
+    let mut samples = data.imu.samples()?;
+    let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
+    let mut io = filter::StreamIo {
+        samples: &mut *samples,
+        aiding: &mut data.aid.iter().copied(),
+        truth: truth
+            .as_mut()
+            .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
+    };
+    let run = filter::run_stream(
         model,
         cfg,
-        data.imu,
         data.start,
-        data.aid,
-        data.truth,
+        &mut io,
         progress,
         &mut |_| {},
         &mut sig,
-    );
+        &mut |_| Ok(()),
+        true,
+    )?;
     run.check()
         .map_err(|e| anyhow::anyhow!("{} pass: {e}", model.name))?;
     let stats = pass_stats(model, &run, &sig.level, data.truth);
@@ -1409,11 +1451,22 @@ pub fn explain(
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let extended_stats = pass.stats.clone();
     let last = pass.run.records.last();
-    for f in &mut findings {
-        let t = common::TERMS
-            .iter()
-            .position(|x| x.name == f.term)
-            .expect("finding is a spec term");
+    let finding_terms: Vec<usize> = findings
+        .iter()
+        .map(|f| {
+            common::TERMS
+                .iter()
+                .position(|x| x.name == f.term)
+                .expect("finding is a spec term")
+        })
+        .collect();
+    let means = if finding_terms.is_empty() {
+        Vec::new()
+    } else {
+        regressor_means(data, &finding_terms)?
+    };
+    for (k, f) in findings.iter_mut().enumerate() {
+        let t = finding_terms[k];
         let info = &common::TERMS[t];
         let to_display = 1.0 / info.display_to_si;
         if let (Some(i), Some(r)) = (model.index_of(info.name), last) {
@@ -1423,7 +1476,7 @@ pub fn explain(
             f.prior_sigma = used * to_display;
             f.prior_widened = used > prior_sigma(t, opts);
         }
-        let c = pass_cands_mean(&pass, data, t);
+        let c = means[k];
         let (rm, ru) = regressor_in_natural_units(info.regressor, c);
         f.regressor_mean = rm;
         f.regressor_unit = ru;
@@ -1474,21 +1527,25 @@ pub fn explain(
     Ok(expl)
 }
 
-/// Mean over the run of term `t`'s regressor (SI), from the pass's accumulators: the extended
-/// pass has no candidates, so it is recomputed from the IMU samples directly.
-fn pass_cands_mean(_pass: &Pass, data: &ExplainData, t: usize) -> f64 {
-    let id = common::TERMS[t].regressor;
+/// Mean over the run of each term's regressor (SI), in one pass over the IMU samples (the
+/// extended pass has no candidates, so it is computed from the samples directly).
+fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f64>> {
     let mut prev = data.start.t;
-    let (mut s, mut c) = (0.0, 0usize);
-    for smp in &data.imu.samples {
+    let mut sums = vec![0.0; terms.len()];
+    let mut c = 0usize;
+    let mut samples = data.imu.samples()?;
+    while let Some(smp) = samples.next_sample()? {
         let dt = smp.t - prev;
         prev = smp.t;
         if dt > 0.0 {
-            s += common::regressor_value(id, &(smp.dv / dt), &(smp.dtheta / dt));
+            let (f, w) = (smp.dv / dt, smp.dtheta / dt);
+            for (sum, &t) in sums.iter_mut().zip(terms) {
+                *sum += common::regressor_value(common::TERMS[t].regressor, &f, &w);
+            }
             c += 1;
         }
     }
-    s / c.max(1) as f64
+    Ok(sums.into_iter().map(|s| s / c.max(1) as f64).collect())
 }
 
 fn normalised(run: &FilterRun) -> Vec<(f64, String, f64)> {
@@ -1816,7 +1873,7 @@ pub fn run_hidden_on(
     let baseline = Model::parse(&case.baseline)?;
     let cands = parse_candidates(None, &baseline).map_err(anyhow::Error::msg)?;
     let data = ExplainData {
-        imu: &sim.imu,
+        imu: ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,

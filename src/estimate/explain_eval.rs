@@ -122,7 +122,7 @@ pub fn run_case(
             .ok_or_else(|| anyhow::anyhow!("hidden term `{name}` is not a spec term"))?;
         let baseline = Model::parse(&case.baseline)?;
         let data = ExplainData {
-            imu: &sim.imu,
+            imu: crate::estimate::explain::ImuInput::Memory(&sim.imu),
             aid: &aid,
             truth: Some(&sim.truth),
             start: sim.start,

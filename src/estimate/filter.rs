@@ -16,8 +16,8 @@
 //!   update attitude, velocity and position are corrected and every instrument term's estimate is
 //!   moved into a correction applied to all later increments (per sample, with its regressor).
 
-use crate::io::imu::ImuData;
-use crate::io::truth::TruthRow;
+use crate::io::imu::{ImuData, ImuSample};
+use crate::io::truth::{TruthLookup, TruthRow, TruthSlice};
 use crate::model::catalog::{Sensor, StateRef, WhiteNoise};
 use crate::model::covariance::SparsePropagator;
 use crate::model::generated::common;
@@ -188,12 +188,17 @@ pub struct FilterRun {
     pub nonfinite_updates: usize,
     /// Time of the first non-finite update [s].
     pub first_nonfinite_t: Option<f64>,
+    /// Why the run stopped early: the filter diverged (time, state, likely cause).
+    pub diverged: Option<String>,
 }
 
 impl FilterRun {
     /// An error when the run cannot support an answer: non-finite updates or states, or no
     /// innovations at all.
     pub fn check(&self) -> Result<(), String> {
+        if let Some(d) = &self.diverged {
+            return Err(d.clone());
+        }
         if self.nonfinite_updates > 0 {
             return Err(format!(
                 "the filter diverged: {} of {} scalar updates were not finite (first at t = {:.3} s); check --init, --prior, --noise and the IMU values",
@@ -228,6 +233,9 @@ pub trait Observer {
     /// model's A (n×n row-major; non-zeros at `pattern`) used for it.
     fn step(&mut self, _t: f64, _dt: f64, _np: &NavPoint, _a: &[f64], _pattern: &[(usize, usize)]) {
     }
+    /// After every IMU sample: the navigation state, and the error estimate x and covariance P
+    /// (n×n row-major) as of the last propagation step or update.
+    fn nav_sample(&mut self, _s: &NavState, _x: &[f64], _p: &[f64]) {}
     /// Before a scalar update is applied: its row `h`, gain `k` = P⁻hᵀ/S, innovation ν and
     /// variance S, and which measurement component it is.
     #[allow(clippy::too_many_arguments)]
@@ -245,7 +253,7 @@ pub trait Observer {
 }
 
 /// An observer that watches nothing.
-struct NoObserver;
+pub struct NoObserver;
 impl Observer for NoObserver {}
 
 enum Kernel {
@@ -324,8 +332,6 @@ struct Engine<'a> {
     i_dv: [Option<usize>; 3],
     i_pos: [Option<usize>; 3],
     innovations: Vec<Innovation>,
-    records: Vec<Record>,
-    truth_i: usize,
 }
 
 impl<'a> Engine<'a> {
@@ -384,8 +390,6 @@ impl<'a> Engine<'a> {
             innovations: Vec::new(),
             nonfinite: 0,
             first_nonfinite_t: None,
-            records: Vec::new(),
-            truth_i: 0,
         }
     }
 
@@ -507,16 +511,16 @@ impl<'a> Engine<'a> {
     }
 
     /// The record of an update epoch: estimates, σ, and with truth the true φ and position error.
-    fn record(&mut self, ep: &AidingEpoch, truth: Option<&[TruthRow]>) {
+    fn record<'t>(
+        &mut self,
+        ep: &AidingEpoch,
+        truth: Option<&mut (dyn TruthLookup + 't)>,
+    ) -> anyhow::Result<Record> {
         let n = self.n;
-        let truth_i = &mut self.truth_i;
-        let truth_row = truth.and_then(|tr| {
-            while *truth_i + 1 < tr.len() && tr[*truth_i].t < ep.t - 1e-6 {
-                *truth_i += 1;
-            }
-            let row = tr.get(*truth_i)?;
-            ((row.t - ep.t).abs() < 0.5 * self.cfg.step_s).then_some(*row)
-        });
+        let truth_row = match truth {
+            Some(tr) => tr.at(ep.t, 0.5 * self.cfg.step_s)?,
+            None => None,
+        };
         let s = self.nav.state;
         let phi_true = truth_row.map(|row| {
             let c_true = dcm_from_euler(row.euler.x, row.euler.y, row.euler.z);
@@ -538,7 +542,7 @@ impl<'a> Engine<'a> {
         for &(i, _) in &self.terms {
             xr[i] += self.correction[i];
         }
-        self.records.push(Record {
+        Ok(Record {
             t: ep.t,
             x: xr,
             // a NaN variance, or one negative beyond round-off, is kept as NaN (never shown as
@@ -559,7 +563,81 @@ impl<'a> Engine<'a> {
             pos_err_ne,
             nav: s,
             cov: self.cfg.keep_covariance.then(|| self.p.clone()),
-        });
+        })
+    }
+
+    /// Why the filter cannot go on after the propagation step ending at `t`, if it cannot: a
+    /// non-finite estimate or variance, or a variance negative beyond round-off (checked every
+    /// step, so the time named is the step where it happened).
+    fn step_divergence(&self, t: f64) -> Option<String> {
+        let n = self.n;
+        let bad = (0..n).find(|&i| {
+            let v = self.p[i * n + i];
+            !self.x[i].is_finite() || !v.is_finite() || v < -1e-9 * self.cfg.prior_sigma[i].powi(2)
+        })?;
+        let s = &self.nav.state;
+        let nav_finite = [s.lat, s.lon, s.h, s.v.x, s.v.y, s.v.z]
+            .iter()
+            .all(|v| v.is_finite());
+        Some(format!(
+            "the filter diverged at t = {t:.3} s (propagation): the estimate or variance of state {} is not finite or negative beyond round-off (navigation state lat {:.6} deg, lon {:.6} deg, h {:.1} m, speed {:.3} m/s); likely cause: {}; check --init, --prior, --noise and the IMU values",
+            self.model.names[bad],
+            s.lat.to_degrees(),
+            s.lon.to_degrees(),
+            s.h,
+            s.v.norm(),
+            if nav_finite {
+                "A(t) or the process noise out of scale (IMU values beyond the model's range, priors or --noise far too large)"
+            } else {
+                "the navigation itself diverged: IMU values, units or the initial state are not physical"
+            }
+        ))
+    }
+
+    /// Why the filter cannot go on after this epoch's updates, if it cannot: a scalar update
+    /// whose innovation or variance S was not finite or S ≤ 0, or a non-finite estimate or
+    /// variance (or one negative beyond round-off) in the record. Names the time, the navigation
+    /// state and the likely cause.
+    fn divergence(&self, rec: &Record) -> Option<String> {
+        let s = &self.nav.state;
+        let state = format!(
+            "navigation state lat {:.6} deg, lon {:.6} deg, h {:.1} m, speed {:.3} m/s",
+            s.lat.to_degrees(),
+            s.lon.to_degrees(),
+            s.h,
+            s.v.norm()
+        );
+        let nav_finite = [s.lat, s.lon, s.h, s.v.x, s.v.y, s.v.z]
+            .iter()
+            .all(|v| v.is_finite());
+        if self.nonfinite > 0 {
+            let cause = if !nav_finite {
+                "the navigation itself diverged: IMU values, units or the initial state are not physical"
+            } else {
+                "an innovation variance S = HPH' + R that is not positive and finite: a covariance that lost positive definiteness (priors or --noise out of scale for the data) or a measurement sigma of zero"
+            };
+            return Some(format!(
+                "the filter diverged at t = {:.3} s: a scalar update was not finite or had S <= 0 ({state}); likely cause: {cause}; check --init, --prior, --noise and the IMU values",
+                rec.t
+            ));
+        }
+        let bad_x = rec.x.iter().position(|v| !v.is_finite());
+        let bad_p = rec.sigma.iter().position(|v| !v.is_finite());
+        if let Some(i) = bad_x.or(bad_p) {
+            return Some(format!(
+                "the filter diverged at t = {:.3} s: {} of state {} is {} ({state}); likely cause: {}; check --init, --prior, --noise and the IMU values",
+                rec.t,
+                if bad_x.is_some() { "the estimate" } else { "the variance" },
+                self.model.names[i],
+                if bad_x.is_some() { "not finite" } else { "not finite or negative beyond round-off" },
+                if nav_finite {
+                    "A(t) or the process noise out of scale (IMU values beyond the model's range, priors or --noise far too large)"
+                } else {
+                    "the navigation itself diverged: IMU values, units or the initial state are not physical"
+                }
+            ));
+        }
+        None
     }
 
     /// Closed loop: moves the navigation error estimates into the navigator and the instrument
@@ -627,47 +705,160 @@ pub fn run_observed(
     start: NavState,
     aiding: &[AidingEpoch],
     truth: Option<&[TruthRow]>,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
     on_sample: &mut dyn FnMut(&NavState),
     obs: &mut dyn Observer,
 ) -> FilterRun {
+    let mut samples = SliceSamples {
+        samples: &imu.samples,
+        next: 0,
+    };
+    let mut truth = truth.map(TruthSlice::new);
+    let mut stream = StreamIo {
+        samples: &mut samples,
+        aiding: &mut aiding.iter().copied(),
+        truth: truth.as_mut().map(|t| t as &mut dyn TruthLookup),
+    };
+    match run_stream(
+        model,
+        cfg,
+        start,
+        &mut stream,
+        progress,
+        on_sample,
+        obs,
+        &mut |_| Ok(()),
+        true,
+    ) {
+        Ok(run) => run,
+        // in-memory samples and truth rows are read without I/O: nothing can fail
+        Err(e) => unreachable!("in-memory filter input failed: {e}"),
+    }
+}
+
+/// IMU samples handed to the filter one at a time.
+pub trait Samples {
+    /// The next sample, or None at the end.
+    fn next_sample(&mut self) -> anyhow::Result<Option<ImuSample>>;
+    /// Fraction of the input read so far.
+    fn fraction(&self) -> f64;
+}
+
+/// Samples in memory handed out one at a time.
+pub struct SliceSamples<'a> {
+    samples: &'a [ImuSample],
+    next: usize,
+}
+
+impl<'a> SliceSamples<'a> {
+    /// From the first sample.
+    pub fn new(samples: &'a [ImuSample]) -> Self {
+        SliceSamples { samples, next: 0 }
+    }
+}
+
+impl Samples for SliceSamples<'_> {
+    fn next_sample(&mut self) -> anyhow::Result<Option<ImuSample>> {
+        let s = self.samples.get(self.next).copied();
+        self.next += 1;
+        Ok(s)
+    }
+    fn fraction(&self) -> f64 {
+        self.next as f64 / self.samples.len().max(1) as f64
+    }
+}
+
+impl Samples for crate::io::imu_stream::ImuStream {
+    fn next_sample(&mut self) -> anyhow::Result<Option<ImuSample>> {
+        self.next()
+    }
+    fn fraction(&self) -> f64 {
+        crate::io::imu_stream::ImuStream::fraction(self)
+    }
+}
+
+/// What a streamed filter run reads: samples, aiding epochs in time order, and truth.
+pub struct StreamIo<'a> {
+    /// IMU samples.
+    pub samples: &'a mut dyn Samples,
+    /// Aiding epochs in increasing time (may be endless: the run ends with the samples).
+    pub aiding: &'a mut dyn Iterator<Item = AidingEpoch>,
+    /// Truth rows for the records, when given.
+    pub truth: Option<&'a mut dyn TruthLookup>,
+}
+
+/// The filter over streamed input: every record goes to `on_record` as it is made (and is kept in
+/// the returned run only with `keep_records`), so memory does not grow with the input; a read
+/// error of the input, or of `on_record`, ends the run with that error.
+#[allow(clippy::too_many_arguments)]
+pub fn run_stream(
+    model: &Model,
+    cfg: &FilterConfig,
+    start: NavState,
+    io: &mut StreamIo<'_>,
+    mut progress: impl FnMut(f64),
+    on_sample: &mut dyn FnMut(&NavState),
+    obs: &mut dyn Observer,
+    on_record: &mut dyn FnMut(&Record) -> anyhow::Result<()>,
+    keep_records: bool,
+) -> anyhow::Result<FilterRun> {
     let mut e = Engine::new(model, cfg, start);
-    let mut next_aid = 0usize;
-    let report = (imu.samples.len() / 200).max(1);
+    let mut aiding = io.aiding.peekable();
+    let mut records = Vec::new();
     let mut prev_t = start.t;
-    for (k, smp) in imu.samples.iter().enumerate() {
+    let mut k = 0u64;
+    let mut next = io.samples.next_sample()?;
+    let mut diverged = None;
+    while let Some(smp) = next {
+        next = io.samples.next_sample()?;
         let dt = smp.t - prev_t;
         prev_t = smp.t;
-        e.navigate(smp, dt, obs);
+        e.navigate(&smp, dt, obs);
         on_sample(&e.nav.state);
-        if k % report == 0 {
-            progress(k as f64 / imu.samples.len() as f64);
+        obs.nav_sample(&e.nav.state, &e.x, &e.p);
+        if k.is_multiple_of(2000) {
+            progress(io.samples.fraction());
         }
-        let aid_due = next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9;
+        k += 1;
+        let aid_due = aiding.peek().is_some_and(|a| a.t <= smp.t + 1e-9);
         let step_done = smp.t - e.step_t0 + 1e-9 >= cfg.step_s;
-        if !step_done && !aid_due && k + 1 < imu.samples.len() {
+        if !step_done && !aid_due && next.is_some() {
             continue;
         }
         e.propagate(smp.t, obs);
-        while next_aid < aiding.len() && aiding[next_aid].t <= smp.t + 1e-9 {
-            let ep = &aiding[next_aid];
-            next_aid += 1;
-            e.update(ep, obs);
-            e.record(ep, truth);
+        diverged = e.step_divergence(smp.t);
+        if diverged.is_some() {
+            break;
+        }
+        while let Some(ep) = aiding.next_if(|a| a.t <= smp.t + 1e-9) {
+            e.update(&ep, obs);
+            let rec = e.record(&ep, io.truth.as_deref_mut())?;
+            diverged = e.divergence(&rec);
+            if diverged.is_some() {
+                break;
+            }
+            on_record(&rec)?;
+            if keep_records {
+                records.push(rec);
+            }
             if cfg.mode == Mode::ClosedLoop {
                 e.feedback();
             }
         }
+        if diverged.is_some() {
+            break;
+        }
     }
     progress(1.0);
-    FilterRun {
+    Ok(FilterRun {
         names: model.names.clone(),
-        records: e.records,
+        records,
         innovations: e.innovations,
         final_state: e.nav.state,
         nonfinite_updates: e.nonfinite,
         first_nonfinite_t: e.first_nonfinite_t,
-    }
+        diverged,
+    })
 }
 
 /// Scalar update in Joseph form: P ← (I − K h) P (I − K h)ᵀ + K r Kᵀ, expanded for a row h;

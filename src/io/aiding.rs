@@ -1,5 +1,6 @@
 //! Position aiding files (DESIGN §9, KF-GINS GNSS layout):
-//! `t [s]  lat lon [deg]  h [m]  sigma_n sigma_e sigma_d [m]`.
+//! `t [s]  lat lon [deg]  h [m]  sigma_n sigma_e sigma_d [m]`, optionally followed by a velocity
+//! set `v_n v_e v_d [m/s]  sigma_v [m/s]` (11 columns; every row the same width).
 
 use crate::io::atomic_file::AtomicFile;
 use crate::io::imu::read_table;
@@ -20,6 +21,15 @@ pub struct PositionFix {
     pub h: f64,
     /// 1-σ north, east, down [m].
     pub sigma: [f64; 3],
+}
+
+/// A velocity fix: NED velocity and its 1-σ per component.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VelocityFix {
+    /// NED velocity [m/s].
+    pub v_ned: [f64; 3],
+    /// 1-σ of each component [m/s].
+    pub sigma: f64,
 }
 
 /// Writes fixes atomically.
@@ -48,8 +58,33 @@ pub fn write(path: &Path, rows: &[PositionFix], header: &str) -> Result<()> {
 
 /// Reads a position aiding file; σ must be positive, time increasing.
 pub fn read(path: &Path) -> Result<Vec<PositionFix>> {
-    read_table(path, 7, "aiding file")?
-        .into_iter()
+    Ok(read_with_velocity(path)?.into_iter().map(|f| f.0).collect())
+}
+
+/// Reads an aiding file of 7 columns (positions) or 11 (positions and velocities), the width
+/// taken from its first data row; σ positive, time increasing, ranges checked.
+pub fn read_with_velocity(path: &Path) -> Result<Vec<(PositionFix, Option<VelocityFix>)>> {
+    let mut lines = crate::io::lines::Lines::open(path, "aiding file")?;
+    let mut width = 7;
+    while let Some(l) = lines.next_line()? {
+        let t = l.text.trim();
+        if t.is_empty() || t.starts_with('#') {
+            continue;
+        }
+        let n = t
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|s| !s.is_empty())
+            .count();
+        if n == 11 {
+            width = 11;
+        }
+        break;
+    }
+    let rows = read_table(path, width, "aiding file")?;
+    if rows.is_empty() {
+        bail!("{}: the aiding file has no data rows", path.display());
+    }
+    rows.into_iter()
         .map(|(line, v)| {
             if v[4..7].iter().any(|s| !(*s > 0.0 && *s <= 1e5)) {
                 bail!(
@@ -67,13 +102,34 @@ pub fn read(path: &Path) -> Result<Vec<PositionFix>> {
             {
                 bail!("{}:{line}: {p}", path.display());
             }
-            Ok(PositionFix {
-                t: v[0],
-                lat: v[1].to_radians(),
-                lon: v[2].to_radians(),
-                h: v[3],
-                sigma: [v[4], v[5], v[6]],
-            })
+            let vel = if width == 11 {
+                if v[7..10].iter().any(|x| x.abs() > 1e4) {
+                    bail!("{}:{line}: a velocity beyond ±1e4 m/s", path.display());
+                }
+                if !(v[10] > 0.0 && v[10] <= 1e3) {
+                    bail!(
+                        "{}:{line}: velocity sigma must be in (0, 1e3] m/s (got {})",
+                        path.display(),
+                        v[10]
+                    );
+                }
+                Some(VelocityFix {
+                    v_ned: [v[7], v[8], v[9]],
+                    sigma: v[10],
+                })
+            } else {
+                None
+            };
+            Ok((
+                PositionFix {
+                    t: v[0],
+                    lat: v[1].to_radians(),
+                    lon: v[2].to_radians(),
+                    h: v[3],
+                    sigma: [v[4], v[5], v[6]],
+                },
+                vel,
+            ))
         })
         .collect()
 }

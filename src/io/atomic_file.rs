@@ -9,7 +9,35 @@ use std::path::{Path, PathBuf};
 pub struct AtomicFile {
     tmp: PathBuf,
     target: PathBuf,
-    out: Option<BufWriter<std::fs::File>>,
+    out: Option<NamedWriter>,
+}
+
+/// A buffered file writer whose errors name the file they happened in (a full disk while
+/// writing says which output it was).
+pub struct NamedWriter {
+    inner: BufWriter<std::fs::File>,
+    target: PathBuf,
+}
+
+impl NamedWriter {
+    fn named(&self, e: std::io::Error) -> std::io::Error {
+        std::io::Error::new(
+            e.kind(),
+            format!("cannot write {}: {e}", self.target.display()),
+        )
+    }
+}
+
+impl Write for NamedWriter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.inner.write(buf).map_err(|e| self.named(e))
+    }
+    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
+        self.inner.write_all(buf).map_err(|e| self.named(e))
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush().map_err(|e| self.named(e))
+    }
 }
 
 impl AtomicFile {
@@ -28,6 +56,14 @@ impl AtomicFile {
             std::fs::create_dir_all(parent)
                 .with_context(|| format!("cannot create {}", parent.display()))?;
         }
+        if let (Some(dir), Some(name)) = (target.parent(), target.file_name()) {
+            let dir = if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            };
+            remove_stale(dir, &format!("{}.", name.to_string_lossy()));
+        }
         // unique per process and file: concurrent runs never share a temporary
         static SERIAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
         let k = SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -39,19 +75,22 @@ impl AtomicFile {
         Ok(AtomicFile {
             tmp,
             target: target.to_path_buf(),
-            out: Some(BufWriter::with_capacity(1 << 20, f)),
+            out: Some(NamedWriter {
+                inner: BufWriter::with_capacity(1 << 20, f),
+                target: target.to_path_buf(),
+            }),
         })
     }
 
     /// The writer.
-    pub fn writer(&mut self) -> &mut BufWriter<std::fs::File> {
+    pub fn writer(&mut self) -> &mut NamedWriter {
         self.out.as_mut().expect("not committed")
     }
 
     /// Flushes and renames into place.
     pub fn commit(mut self) -> Result<()> {
         let mut w = self.out.take().expect("not committed");
-        if let Err(e) = w.flush().and_then(|_| w.get_ref().sync_all()) {
+        if let Err(e) = w.inner.flush().and_then(|_| w.inner.get_ref().sync_all()) {
             drop(w);
             let _ = std::fs::remove_file(&self.tmp);
             anyhow::bail!(
@@ -163,7 +202,8 @@ impl OutputDir {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| "out".into());
-        let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        remove_stale(&parent, &format!(".{name}."));
+        let staging = sibling(target, "partial");
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir(&staging)
             .with_context(|| format!("cannot create {}", staging.display()))?;
@@ -191,8 +231,12 @@ impl OutputDir {
             &self.staging.join(RUN_MARKER),
             &format!("written by sinsmodel; its files:\n{}\n", names.join("\n")),
         )?;
+        // two renames, each atomic: the earlier run moves aside whole, the new one moves in
+        // whole; a kill between them leaves no target (never a mixed or half-deleted one), and
+        // the hidden leftovers are removed by the next run
+        let old = sibling(&self.target, "old");
         if self.target.exists() {
-            std::fs::remove_dir_all(&self.target)
+            std::fs::rename(&self.target, &old)
                 .with_context(|| format!("cannot replace {}", self.target.display()))?;
         }
         std::fs::rename(&self.staging, &self.target).with_context(|| {
@@ -203,6 +247,7 @@ impl OutputDir {
             )
         })?;
         self.committed = true;
+        let _ = std::fs::remove_dir_all(&old);
         Ok(())
     }
 }
@@ -211,6 +256,56 @@ impl Drop for OutputDir {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+/// `.NAME.KIND-PID` beside `target`: this process's hidden staging or set-aside directory.
+fn sibling(target: &Path, kind: &str) -> PathBuf {
+    let parent = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    parent.join(format!(".{name}.{kind}-{}", std::process::id()))
+}
+
+/// True unless the process `pid` is known to be gone (Linux: no /proc/PID).
+fn pid_alive(pid: u32) -> bool {
+    if !Path::new("/proc/self").exists() {
+        return true;
+    }
+    Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// Removes leftovers of killed runs in `dir`: entries named `PREFIX…-PID` or `PREFIX…-PID-N`
+/// (temporaries, staging and set-aside directories) whose process is gone.
+fn remove_stale(dir: &Path, prefix: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.filter_map(|e| e.ok()) {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(rest) = name.strip_prefix(prefix) else {
+            continue;
+        };
+        // KIND-PID or KIND-PID-N, KIND one of partial, old
+        let mut parts = rest.rsplit('-');
+        let (Some(a), Some(b)) = (parts.next(), parts.next()) else {
+            continue;
+        };
+        let kind_ok = |k: &str| k.ends_with("partial") || k.ends_with("old");
+        let pid = match (a.parse::<u32>(), b.parse::<u32>()) {
+            (Ok(_), Ok(pid)) if parts.next().is_some_and(kind_ok) => pid,
+            (Ok(pid), _) if kind_ok(b) => pid,
+            _ => continue,
+        };
+        if pid != std::process::id() && !pid_alive(pid) {
+            let p = e.path();
+            let _ = std::fs::remove_dir_all(&p).or_else(|_| std::fs::remove_file(&p));
         }
     }
 }

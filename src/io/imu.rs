@@ -3,7 +3,8 @@
 //! FRD body frame, whitespace or comma separated, `#` comment lines.
 
 use crate::io::atomic_file::AtomicFile;
-use anyhow::{bail, Context, Result};
+use crate::io::lines::{shown, Lines};
+use anyhow::{bail, Result};
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::Path;
@@ -65,13 +66,10 @@ impl ImuData {
         }
     }
 
-    /// Mean specific force and angular rate over all samples (Σ increments / Σ intervals).
+    /// Mean specific force [m/s²] and angular rate [rad/s] over all samples: Σ increments /
+    /// Σ intervals, each sample over its own interval ([`mean_rates_of`]).
     pub fn mean_rates(&self) -> (Vector3<f64>, Vector3<f64>) {
-        let dt = self.interval();
-        let n = self.samples.len() as f64;
-        let f = self.samples.iter().map(|s| s.dv).sum::<Vector3<f64>>() / (n * dt);
-        let w = self.samples.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / (n * dt);
-        (f, w)
+        mean_rates_of(&self.samples, self.interval())
     }
 
     /// Checks time order and gaps; `what` names the source in messages.
@@ -95,101 +93,150 @@ impl ImuData {
     }
 }
 
-/// Splits a data line on whitespace and commas and parses `n` finite numbers.
-pub fn parse_numbers(line: &str, n: usize, file: &Path, lineno: usize) -> Result<Vec<f64>> {
-    let fields: Vec<&str> = line
+/// Mean specific force [m/s²] and angular rate [rad/s] of consecutive samples, each increment
+/// over its own interval: the increments after the first, summed, over the time from the first
+/// sample to the last (exact on a jittered clock, where dividing by a median interval is not);
+/// a single sample is divided by `dt` [s].
+pub fn mean_rates_of(samples: &[ImuSample], dt: f64) -> (Vector3<f64>, Vector3<f64>) {
+    match samples {
+        [] => (Vector3::zeros(), Vector3::zeros()),
+        [one] => (one.dv / dt, one.dtheta / dt),
+        [first, rest @ ..] => {
+            let span = rest[rest.len() - 1].t - first.t;
+            let f = rest.iter().map(|s| s.dv).sum::<Vector3<f64>>() / span;
+            let w = rest.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / span;
+            (f, w)
+        }
+    }
+}
+
+/// Splits a data line on whitespace and commas and parses `n` finite numbers into `out`
+/// (cleared first).
+pub fn parse_numbers_into(
+    line: &str,
+    n: usize,
+    file: &str,
+    lineno: usize,
+    out: &mut Vec<f64>,
+) -> Result<()> {
+    out.clear();
+    let mut count = 0usize;
+    for f in line
         .split(|c: char| c.is_whitespace() || c == ',')
         .filter(|s| !s.is_empty())
-        .collect();
-    if fields.len() != n {
-        bail!(
-            "{}:{lineno}: expected {n} columns, found {}",
-            file.display(),
-            fields.len()
-        );
+    {
+        count += 1;
+        if count > n {
+            continue;
+        }
+        let v: f64 = f.parse().map_err(|_| {
+            anyhow::anyhow!(
+                "{file}:{lineno}: column {count}: `{}` is not a number",
+                shown(f)
+            )
+        })?;
+        if !v.is_finite() {
+            bail!(
+                "{file}:{lineno}: column {count}: `{}` is not finite",
+                shown(f)
+            );
+        }
+        out.push(v);
     }
-    fields
-        .iter()
-        .enumerate()
-        .map(|(k, f)| {
-            let v: f64 = f.parse().map_err(|_| {
-                anyhow::anyhow!(
-                    "{}:{lineno}: column {}: `{f}` is not a number",
-                    file.display(),
-                    k + 1
-                )
-            })?;
-            if !v.is_finite() {
-                bail!(
-                    "{}:{lineno}: column {}: `{f}` is not finite",
-                    file.display(),
-                    k + 1
-                );
+    if count != n {
+        bail!("{file}:{lineno}: expected {n} columns, found {count}");
+    }
+    Ok(())
+}
+
+/// Splits a data line on whitespace and commas and parses `n` finite numbers.
+pub fn parse_numbers(line: &str, n: usize, file: &Path, lineno: usize) -> Result<Vec<f64>> {
+    let mut out = Vec::with_capacity(n);
+    parse_numbers_into(line, n, &file.display().to_string(), lineno, &mut out)?;
+    Ok(out)
+}
+
+/// A whitespace/comma separated numeric table with a fixed number of columns whose first column
+/// is a strictly increasing time, read one row at a time; `#` comment and blank lines are
+/// skipped; every problem names the file and line.
+pub struct TableRows<R> {
+    lines: Lines<R>,
+    ncols: usize,
+    prev_t: Option<f64>,
+    row: Vec<f64>,
+}
+
+impl TableRows<std::io::BufReader<std::fs::File>> {
+    /// Opens `path`; `what` names the kind of file in messages.
+    pub fn open(path: &Path, ncols: usize, what: &str) -> Result<Self> {
+        Ok(TableRows::new(Lines::open(path, what)?, ncols))
+    }
+}
+
+impl<R: std::io::BufRead> TableRows<R> {
+    /// Rows of `lines` with `ncols` columns.
+    pub fn new(lines: Lines<R>, ncols: usize) -> Self {
+        TableRows {
+            lines,
+            ncols,
+            prev_t: None,
+            row: Vec::with_capacity(ncols),
+        }
+    }
+
+    /// The file's name as messages show it.
+    pub fn name(&self) -> &str {
+        self.lines.name()
+    }
+
+    /// Fraction of the file read so far.
+    pub fn fraction(&self) -> f64 {
+        self.lines.fraction()
+    }
+
+    /// The next row (line number, values), or None at the end of the file.
+    pub fn next_row(&mut self) -> Result<Option<(usize, &[f64])>> {
+        loop {
+            let Some(line) = self.lines.next_line()? else {
+                return Ok(None);
+            };
+            let l = line.text.trim();
+            if l.is_empty() || l.starts_with('#') {
+                continue;
             }
-            Ok(v)
-        })
-        .collect()
+            let lineno = line.no;
+            parse_numbers_into(l, self.ncols, line.file, lineno, &mut self.row)?;
+            let t = self.row[0];
+            if let Some(prev) = self.prev_t {
+                if t <= prev {
+                    bail!(
+                        "{}:{lineno}: time {t} does not increase (previous {prev})",
+                        line.file
+                    );
+                }
+            }
+            self.prev_t = Some(t);
+            return Ok(Some((lineno, &self.row)));
+        }
+    }
 }
 
 /// Reads a whitespace/comma separated numeric table with `ncols` columns whose first column is a
 /// strictly increasing time; `#` comment and blank lines are skipped. Returns (line, values) rows;
 /// every problem names the file and line. `what` names the kind of file in messages.
 pub fn read_table(path: &Path, ncols: usize, what: &str) -> Result<Vec<(usize, Vec<f64>)>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read {what} {}", path.display()))?;
-    let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let l = line.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
-        let v = parse_numbers(l, ncols, path, i + 1)?;
-        if let Some((_, prev)) = rows.last() {
-            if v[0] <= prev[0] {
-                bail!(
-                    "{}:{}: time {} does not increase (previous {})",
-                    path.display(),
-                    i + 1,
-                    v[0],
-                    prev[0]
-                );
-            }
-        }
-        rows.push((i + 1, v));
+    let mut t = TableRows::open(path, ncols, what)?;
+    let mut rows = Vec::new();
+    while let Some((line, v)) = t.next_row()? {
+        rows.push((line, v.to_vec()));
     }
     Ok(rows)
 }
 
-/// Reads the text IMU format; any malformed row, NaN, non-increasing time or gap longer than 5
-/// intervals is an error naming the file and line.
+/// Reads the text IMU format; any malformed row, NaN, non-increasing time, implausible rate or
+/// force, or gap longer than 5 intervals is an error naming the file and line.
 pub fn read_text(path: &Path) -> Result<ImuData> {
-    let rows = read_table(path, 7, "IMU file")?;
-    let lines_of: Vec<usize> = rows.iter().map(|r| r.0).collect();
-    let samples: Vec<ImuSample> = rows
-        .iter()
-        .map(|(_, v)| ImuSample {
-            t: v[0],
-            dtheta: Vector3::new(v[1], v[2], v[3]),
-            dv: Vector3::new(v[4], v[5], v[6]),
-        })
-        .collect();
-    if samples.len() < 2 {
-        bail!("{}: fewer than two IMU samples", path.display());
-    }
-    let data = ImuData { samples };
-    let dt = data.interval();
-    for (k, w) in data.samples.windows(2).enumerate() {
-        if w[1].t - w[0].t > 5.0 * dt {
-            bail!(
-                "{}:{}: gap of {:.4} s after t = {} (more than 5 sample intervals of {dt:.4} s)",
-                path.display(),
-                lines_of[k + 1],
-                w[1].t - w[0].t,
-                w[0].t
-            );
-        }
-    }
-    Ok(data)
+    crate::io::imu_stream::ImuStream::text(path)?.collect()
 }
 
 /// Writes the text IMU format atomically (shortest round-trip decimal for every number).

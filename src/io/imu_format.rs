@@ -5,6 +5,8 @@
 //! project's FRD increments over each sample interval. Format: `docs/formats.md`.
 
 use crate::io::imu::{ImuData, ImuSample};
+use crate::io::imu_stream::{ImuStream, SampleSource, MAX_FORCE, MAX_RATE};
+use crate::io::lines::{shown, Lines};
 use crate::io::units::{parse_quantity, parse_unit};
 use anyhow::{anyhow, bail, Context, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -134,11 +136,6 @@ fn column_words(c: &ColumnRef) -> String {
     }
 }
 
-/// Physical bounds on what an IMU measures: rate [rad/s], specific force [m/s²], interval [s].
-const MAX_RATE: f64 = 100.0;
-const MAX_FORCE: f64 = 2000.0 * crate::io::units::STANDARD_GRAVITY;
-const INTERVAL_RANGE: (f64, f64) = (1e-5, 10.0);
-
 /// The FRD body unit vector a direction word names.
 fn direction(word: &str) -> Option<Vector3<f64>> {
     Some(match word.trim().to_ascii_lowercase().as_str() {
@@ -188,19 +185,19 @@ impl ImuFormat {
                 path.display()
             );
         }
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::lines::read_small_text(path, "IMU format description")
             .with_context(|| format!("--imu-format {}: cannot read the file", path.display()))?;
         ImuFormat::parse(&text, &path.display().to_string())
     }
 
     /// Parses and checks description text; `origin` names it in messages (`origin:line: …`).
     pub fn parse(text: &str, origin: &str) -> Result<ImuFormat> {
-        let line = |start: usize| text[..start.min(text.len())].lines().count().max(1);
+        let line = |start: usize| crate::io::lines::line_at(text, start);
         let at = |span: std::ops::Range<usize>, msg: String| {
-            anyhow!("{origin}:{}: {msg}", line(span.start + 1))
+            anyhow!("{origin}:{}: {msg}", line(span.start))
         };
         let raw: RawFormat = toml::from_str(text).map_err(|e| {
-            let l = e.span().map(|s| line(s.start + 1)).unwrap_or(0);
+            let l = e.span().map(|s| line(s.start)).unwrap_or(0);
             let msg = e.message().trim();
             let msg = if msg.contains("untagged enum ColumnRef") {
                 "a column is a header name (a string) or a 1-based index (a whole number)"
@@ -439,46 +436,85 @@ impl ImuFormat {
     /// Reads a data file described by this format into FRD increments; errors name the data
     /// file and line (or the description's line for a column name it lacks).
     pub fn read(&self, path: &Path) -> Result<ImuData> {
-        if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
-            bail!(
-                "{}: not a regular file (missing, a directory, a device or a pipe)",
-                path.display()
-            );
-        }
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read IMU file {}", path.display()))?;
-        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        let file = path.display().to_string();
-        let mut cols: Option<[usize; 7]> = None;
-        let mut width: Option<usize> = None;
-        let mut prev: Option<(f64, Vector3<f64>, Vector3<f64>)> = None;
-        let mut samples = Vec::new();
+        self.stream(path)?.collect()
+    }
+
+    /// A stream of the validated samples of a data file described by this format.
+    pub fn stream(&self, path: &Path) -> Result<ImuStream> {
+        ImuStream::with_hint(
+            self.source(path)?,
+            &path.display().to_string(),
+            &format!("[time] unit in {}", self.origin),
+        )
+    }
+
+    /// The samples of a data file described by this format, read one at a time.
+    pub fn source(&self, path: &Path) -> Result<Box<dyn SampleSource>> {
+        let lines = Lines::open(path, "IMU file")?;
+        Ok(Box::new(FormatSource {
+            fmt: self.clone(),
+            lines,
+            cols: None,
+            width: None,
+            prev: None,
+            skipped: 0,
+        }))
+    }
+}
+
+/// A described data file's rows turned into samples one at a time.
+struct FormatSource {
+    fmt: ImuFormat,
+    lines: Lines<std::io::BufReader<std::fs::File>>,
+    cols: Option<[usize; 7]>,
+    width: Option<usize>,
+    prev: Option<(f64, Vector3<f64>, Vector3<f64>)>,
+    skipped: usize,
+}
+
+impl SampleSource for FormatSource {
+    fn fraction(&self) -> f64 {
+        self.lines.fraction()
+    }
+
+    fn next_sample(&mut self) -> Result<Option<(ImuSample, usize)>> {
+        let this = &self.fmt;
+        let file = self.lines.name().to_string();
+        let _ = &file;
         let resolve = |names: &[&str], c: &ColumnRef, lineno: usize| -> Result<usize> {
             match c {
                 ColumnRef::Index(i) => Ok(*i as usize - 1),
                 ColumnRef::Name(n) => names.iter().position(|h| h == n).ok_or_else(|| {
                     anyhow!(
-                        "{}: column `{n}` is not in the header of {file}:{lineno} (it has: {})",
-                        self.origin,
-                        names.join(", ")
+                        "{}: column `{}` is not in the header of {file}:{lineno} (it has: {})",
+                        this.origin,
+                        shown(n),
+                        shown(&names.join(", "))
                     )
                 }),
             }
         };
-        for (i, raw_line) in text.lines().enumerate().skip(self.skip_lines) {
-            let lineno = i + 1;
-            let line = raw_line.trim();
-            if line.is_empty() || (!self.comment.is_empty() && line.starts_with(&self.comment)) {
+        loop {
+            let Some(raw_line) = self.lines.next_line()? else {
+                return Ok(None);
+            };
+            if self.skipped < this.skip_lines {
+                self.skipped += 1;
                 continue;
             }
-            let fields = self.split(line);
-            if cols.is_none() {
-                let names: Vec<&str> = if self.header {
+            let lineno = raw_line.no;
+            let line = raw_line.text.trim();
+            if line.is_empty() || (!this.comment.is_empty() && line.starts_with(&this.comment)) {
+                continue;
+            }
+            let fields = this.split(line);
+            if self.cols.is_none() {
+                let names: Vec<&str> = if this.header {
                     fields.clone()
                 } else {
                     Vec::new()
                 };
-                if self.header {
+                if this.header {
                     if names.len() == 1 {
                         if let Some(d) = [',', ';', '\t', '|', ' ']
                             .iter()
@@ -487,8 +523,8 @@ impl ImuFormat {
                             bail!(
                                 "{file}:{lineno}: the header is one field with `{}` in it: is [file] delimiter right in {}? (it reads `{}`)",
                                 d.escape_debug(),
-                                self.origin,
-                                match self.delimiter {
+                                this.origin,
+                                match this.delimiter {
                                     Delimiter::Whitespace => "whitespace".to_string(),
                                     Delimiter::Char(c) => c.escape_debug().to_string(),
                                 }
@@ -500,20 +536,20 @@ impl ImuFormat {
                             bail!(
                                 "{file}:{lineno}: the header names `{}` twice: name the column by its 1-based index in {}",
                                 n.escape_debug(),
-                                self.origin
+                                this.origin
                             );
                         }
                     }
                 }
                 let mut c = [0usize; 7];
                 let all = [
-                    &self.time,
-                    &self.gyro[0],
-                    &self.gyro[1],
-                    &self.gyro[2],
-                    &self.accel[0],
-                    &self.accel[1],
-                    &self.accel[2],
+                    &this.time,
+                    &this.gyro[0],
+                    &this.gyro[1],
+                    &this.gyro[2],
+                    &this.accel[0],
+                    &this.accel[1],
+                    &this.accel[2],
                 ];
                 for (k, r) in all.iter().enumerate() {
                     c[k] = resolve(&names, r, lineno)?;
@@ -522,24 +558,24 @@ impl ImuFormat {
                     if c[..k].contains(&c[k]) {
                         bail!(
                             "{}: column {} is used twice among time, gyro and accel (by name and by index)",
-                            self.origin,
+                            this.origin,
                             c[k] + 1
                         );
                     }
                 }
-                cols = Some(c);
-                if self.header {
-                    width = Some(fields.len());
+                self.cols = Some(c);
+                if this.header {
+                    self.width = Some(fields.len());
                     continue;
                 }
             }
-            let c = cols.unwrap_or([0; 7]);
-            match width {
-                None => width = Some(fields.len()),
+            let c = self.cols.unwrap_or([0; 7]);
+            match self.width {
+                None => self.width = Some(fields.len()),
                 Some(w) if w != fields.len() => bail!(
                     "{file}:{lineno}: {} fields where {} has {w}{}",
                     fields.len(),
-                    if self.header {
+                    if this.header {
                         "the header"
                     } else {
                         "the first row"
@@ -584,23 +620,23 @@ impl ImuFormat {
                 }
                 v[k] = x;
             }
-            let t = v[0] * self.time_to_s;
-            let g = self.axes * Vector3::new(v[1], v[2], v[3]) * self.gyro_to_si;
-            let a = self.axes * Vector3::new(v[4], v[5], v[6]) * self.accel_to_si;
+            let t = v[0] * this.time_to_s;
+            let g = this.axes * Vector3::new(v[1], v[2], v[3]) * this.gyro_to_si;
+            let a = this.axes * Vector3::new(v[4], v[5], v[6]) * this.accel_to_si;
             if !t.is_finite() {
                 bail!(
                     "{file}:{lineno}: the time is not finite after [time] unit in {}",
-                    self.origin
+                    this.origin
                 );
             }
-            if let Some((tp, _, _)) = prev {
+            if let Some((tp, _, _)) = self.prev {
                 if t <= tp {
                     bail!("{file}:{lineno}: time {t} s does not increase (previous {tp} s)");
                 }
             }
             // what any IMU measures: the rate (or increment over the interval) in range
-            let dt_here = prev.map(|p| t - p.0);
-            let (w_rate, f_rate) = match (self.kind, dt_here) {
+            let dt_here = self.prev.map(|p| t - p.0);
+            let (w_rate, f_rate) = match (this.kind, dt_here) {
                 (Kind::Rate, _) => (g.norm(), a.norm()),
                 (Kind::Increment, Some(d)) => (g.norm() / d, a.norm() / d),
                 (Kind::Increment, None) => (0.0, 0.0),
@@ -608,52 +644,41 @@ impl ImuFormat {
             if w_rate.is_nan() || w_rate > MAX_RATE {
                 bail!(
                     "{file}:{lineno}: angular rate {w_rate:.3e} rad/s is beyond any IMU (<= {MAX_RATE} rad/s): check the value, gyro_unit and [time] unit in {}",
-                    self.origin
+                    this.origin
                 );
             }
             if f_rate.is_nan() || f_rate > MAX_FORCE {
                 bail!(
                     "{file}:{lineno}: specific force {f_rate:.3e} m/s^2 is beyond any IMU (<= 2000 g): check the value, accel_unit and [time] unit in {}",
-                    self.origin
+                    this.origin
                 );
             }
-            match self.kind {
-                Kind::Increment => samples.push(ImuSample {
-                    t,
-                    dtheta: g,
-                    dv: a,
-                }),
+            match this.kind {
+                Kind::Increment => {
+                    self.prev = Some((t, g, a));
+                    return Ok(Some((
+                        ImuSample {
+                            t,
+                            dtheta: g,
+                            dv: a,
+                        },
+                        lineno,
+                    )));
+                }
                 Kind::Rate => {
-                    if let Some((tp, gp, ap)) = prev {
+                    if let Some((tp, gp, ap)) = self.prev {
                         let dt = t - tp;
-                        let (dtheta, dv) = match self.integration {
+                        let (dtheta, dv) = match this.integration {
                             Integration::Hold => (g * dt, a * dt),
                             Integration::Trapezoid => ((g + gp) * 0.5 * dt, (a + ap) * 0.5 * dt),
                         };
-                        samples.push(ImuSample { t, dtheta, dv });
+                        self.prev = Some((t, g, a));
+                        return Ok(Some((ImuSample { t, dtheta, dv }, lineno)));
                     }
                 }
             }
-            prev = Some((t, g, a));
+            self.prev = Some((t, g, a));
         }
-        if samples.len() < 2 {
-            bail!(
-                "{file}: fewer than two IMU samples as described by {}",
-                self.origin
-            );
-        }
-        let data = ImuData { samples };
-        let dt = data.interval();
-        if !(INTERVAL_RANGE.0..=INTERVAL_RANGE.1).contains(&dt) {
-            bail!(
-                "{file}: median sample interval {dt:.3e} s ({:.3e} Hz) is not an IMU's ({} .. {} s): check [time] unit in {}",
-                1.0 / dt,
-                INTERVAL_RANGE.0,
-                INTERVAL_RANGE.1,
-                self.origin
-            );
-        }
-        Ok(data)
     }
 }
 

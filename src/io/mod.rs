@@ -7,6 +7,8 @@ pub mod bounds;
 pub mod fixed;
 pub mod imu;
 pub mod imu_format;
+pub mod imu_stream;
+pub mod lines;
 pub mod readers;
 pub mod truth;
 pub mod units;

@@ -51,10 +51,19 @@ pub enum Points {
     Many(Vec<PointSpec>),
 }
 
-/// Reads POINT.json text: one point object, or an array of them; errors name the point.
+/// Most linearisation points in one `--at` file.
+pub const MAX_POINTS: usize = 10_000;
+
+/// Reads POINT.json text: one point object, or an array of at most [`MAX_POINTS`]; errors name
+/// the point.
 pub fn parse_points(text: &str) -> Result<Points> {
     let value: serde_json::Value = serde_json::from_str(text).context("not valid JSON")?;
     Ok(match value {
+        serde_json::Value::Array(items) if items.len() > MAX_POINTS => anyhow::bail!(
+            "{} points, more than the {MAX_POINTS} one run takes (its output would be about {} MB): split the file",
+            items.len(),
+            items.len() / 120
+        ),
         serde_json::Value::Array(items) => Points::Many(
             items
                 .into_iter()

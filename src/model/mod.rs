@@ -104,6 +104,8 @@ fn preset_names() -> String {
 impl Model {
     /// Parses `PRESET[+vertical][+term…]`; added terms go after the preset's, in the order given.
     pub fn parse(text: &str) -> Result<Model, ModelError> {
+        // what messages show of the model text and its parts: short and printable
+        let shown_text = crate::io::lines::shown(text);
         let mut parts = text.split('+').map(str::trim);
         let base = parts.next().unwrap_or("");
         let mut vertical = false;
@@ -112,7 +114,7 @@ impl Model {
             if p.eq_ignore_ascii_case("vertical") {
                 if vertical {
                     return Err(ModelError(format!(
-                        "model `{text}`: `vertical` given twice"
+                        "model `{shown_text}`: `vertical` given twice"
                     )));
                 }
                 vertical = true;
@@ -123,13 +125,15 @@ impl Model {
                 .position(|t| t.name == p)
                 .ok_or_else(|| {
                     ModelError(format!(
-                        "model `{text}`: unknown term `{p}`{} (see `sinsmodel model list`)",
+                        "model `{shown_text}`: unknown term `{}`{} (see `sinsmodel model list`)",
+                        crate::io::lines::shown(p),
                         did_you_mean(p)
                     ))
                 })?;
             if extra.contains(&t) {
                 return Err(ModelError(format!(
-                    "model `{text}`: term `{p}` given twice"
+                    "model `{shown_text}`: term `{}` given twice",
+                    crate::io::lines::shown(p)
                 )));
             }
             extra.push(t);
@@ -139,7 +143,8 @@ impl Model {
             .find(|k| k.name.eq_ignore_ascii_case(base) && !k.vertical)
             .ok_or_else(|| {
                 ModelError(format!(
-                    "model `{text}`: unknown preset `{base}` (presets: {}); write a model as PRESET[+vertical][+term…]",
+                    "model `{shown_text}`: unknown preset `{}` (presets: {}); write a model as PRESET[+vertical][+term…]",
+                    crate::io::lines::shown(base),
                     preset_names()
                 ))
             })?;
@@ -153,7 +158,7 @@ impl Model {
         for &t in &extra {
             if states.contains(&StateRef::Term(t)) {
                 return Err(ModelError(format!(
-                    "model `{text}`: term `{}` is already in {}",
+                    "model `{shown_text}`: term `{}` is already in {}",
                     common::TERMS[t].name,
                     preset.name
                 )));

@@ -35,6 +35,8 @@ pub enum Scale {
     LogLog,
     /// Logarithmic x, linear y (positive x only).
     LogX,
+    /// Linear x, logarithmic y (positive y only).
+    LogY,
 }
 
 /// Draws `series` into a 1000×600 PNG at `path`.
@@ -59,6 +61,7 @@ pub fn line_plot(
                 Scale::Linear => true,
                 Scale::LogLog => x > 0.0 && y > 0.0,
                 Scale::LogX => x > 0.0,
+                Scale::LogY => y > 0.0,
             };
             if x.is_finite() && y.is_finite() && ok {
                 x0 = x0.min(x);
@@ -71,7 +74,11 @@ pub fn line_plot(
             (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
         }
         if y1 - y0 <= 0.0 {
-            y1 = y0 + 1.0;
+            y1 = if scale == Scale::LogY || scale == Scale::LogLog {
+                y0 * 10.0
+            } else {
+                y0 + 1.0
+            };
         }
         let colors = [
             RGBColor(31, 119, 180),
@@ -138,6 +145,9 @@ pub fn line_plot(
                     .build_cartesian_2d((x0..x1).log_scale(), (y0 - pad)..(y1 + pad))
                     .map_err(|e| anyhow!("plot {}: {e}", path.display()))?)
             }
+            Scale::LogY => draw!(builder
+                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                .map_err(|e| anyhow!("plot {}: {e}", path.display()))?),
         }
         root.present()
             .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;

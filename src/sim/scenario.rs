@@ -223,7 +223,7 @@ impl Scenario {
 
     /// Reads and validates a scenario file.
     pub fn load(path: &Path) -> Result<Scenario> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::lines::read_small_text(path, "scenario")
             .with_context(|| format!("cannot read scenario {}", path.display()))?;
         Scenario::parse(&text, &path.display().to_string())
     }
@@ -233,7 +233,7 @@ impl Scenario {
         let raw: RawScenario = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start].lines().count().max(1))
+                .map(|s| crate::io::lines::line_at(text, s.start))
                 .unwrap_or(0);
             anyhow!("{origin}:{line}: {}", e.message().trim())
         })?;

@@ -39,8 +39,39 @@ fn parse_row(l: &str) -> Option<[f64; 7]> {
 
 /// Reads `path` and, for GPST, `path` + `.tag`.
 pub fn read(path: &Path) -> Result<GnssImuLog> {
+    read_with(path, None)
+}
+
+/// Reads `path` with the clock offset [s] added to its times when given (`--clock-offset`: a
+/// log without its `.tag`, or another clock), else from the `.tag` file beside it.
+pub fn read_with(path: &Path, given_offset: Option<f64>) -> Result<GnssImuLog> {
+    let meta = std::fs::metadata(path)
+        .with_context(|| format!("cannot read IMU log {}", path.display()))?;
+    if !meta.is_file() {
+        bail!("{}: not a regular file", path.display());
+    }
     let bytes =
         std::fs::read(path).with_context(|| format!("cannot read IMU log {}", path.display()))?;
+    // the same text rules as every reader (crate::io::lines): NUL bytes, non-UTF-8 text and
+    // over-long lines refused with file:line; a byte-order mark is kept in the byte count (the
+    // tag counts it) but not in the first row
+    let mut lineno = 0usize;
+    for l in bytes.split(|&b| b == b'\n') {
+        lineno += 1;
+        let what = if l.len() > crate::io::lines::MAX_LINE_BYTES {
+            "a line longer than 1 MiB"
+        } else if l.contains(&0) {
+            "NUL bytes in the line"
+        } else if std::str::from_utf8(l).is_err() {
+            "not UTF-8 text"
+        } else {
+            continue;
+        };
+        bail!(
+            "{}:{lineno}: {what}: not a GNSS_IMU csv (binary data, or a truncated write)",
+            path.display()
+        );
+    }
     let text = String::from_utf8_lossy(&bytes);
     let lines: Vec<&str> = text.split('\n').collect();
     let n_lines = lines
@@ -51,8 +82,16 @@ pub fn read(path: &Path) -> Result<GnssImuLog> {
     // The tag's file positions count the bytes as logged; this file was stored with LF line ends
     // where the logger wrote CR LF when the last tag position lies beyond the file's end.
     let tag_path = path.with_extension("csv.tag");
-    let tag = read_tag(&tag_path)?;
-    let last_pos = tag.records.last().map(|r| r.1).unwrap_or(0);
+    let clock = match given_offset {
+        Some(o) => Clock::Given(o),
+        None => Clock::Tag(read_tag(&tag_path).with_context(|| {
+            "without its .tag file, give the clock offset with --clock-offset SECONDS (GPST - IMU clock; 0 keeps the IMU's own clock)"
+        })?),
+    };
+    let last_pos = match &clock {
+        Clock::Tag(t) => t.records.last().map(|r| r.1).unwrap_or(0),
+        Clock::Given(_) => 0,
+    };
     let line_end_bytes = if last_pos > bytes.len() { 2 } else { 1 };
     let mut rows: Vec<([f64; 7], usize)> = Vec::new(); // (row, byte offset of the line end)
     let mut skipped = Vec::new();
@@ -60,28 +99,33 @@ pub fn read(path: &Path) -> Result<GnssImuLog> {
     for (i, line) in lines.iter().enumerate().take(n_lines) {
         let line = line.trim_end_matches('\r');
         offset += line.len() + line_end_bytes;
-        let l = line.trim();
+        let l = line.trim().trim_start_matches('\u{feff}');
         match parse_row(l) {
             Some(r) => rows.push((r, offset)),
             None if i == 0 || i + 1 == n_lines => {
                 eprintln!(
-                    "warning: {}:{}: partial or malformed line skipped: `{l}`",
+                    "warning: {}:{}: partial or malformed line skipped: `{}`",
                     path.display(),
-                    i + 1
+                    i + 1,
+                    crate::io::lines::shown(l)
                 );
                 skipped.push(i + 1);
             }
             None => bail!(
-                "{}:{}: malformed row `{l}` (expected 7 comma-separated numbers)",
+                "{}:{}: malformed row `{}` (expected 7 comma-separated numbers)",
                 path.display(),
-                i + 1
+                i + 1,
+                crate::io::lines::shown(l)
             ),
         }
     }
     if rows.len() < 2 {
         bail!("{}: fewer than two valid rows", path.display());
     }
-    let clock_offset = clock_offset(&tag, &tag_path, &rows)?;
+    let clock_offset = match &clock {
+        Clock::Given(o) => *o,
+        Clock::Tag(tag) => clock_offset(tag, &tag_path, &rows)?,
+    };
     let d2r = std::f64::consts::PI / 180.0;
     let mut samples = Vec::with_capacity(rows.len());
     for (k, w) in rows.windows(2).enumerate() {
@@ -107,6 +151,14 @@ pub fn read(path: &Path) -> Result<GnssImuLog> {
         clock_offset,
         skipped,
     })
+}
+
+/// Where the GPST − IMU clock offset comes from.
+enum Clock {
+    /// Given by the user [s].
+    Given(f64),
+    /// The RTKLIB time-tag file.
+    Tag(Tag),
 }
 
 /// The parsed time-tag file: GPST start [s since 1970] and (tick [ms], file position) records.

@@ -1,7 +1,8 @@
 //! RTKLIB `.pos` solutions: `%` header lines, then `YYYY/MM/DD HH:MM:SS.sss lat lon h Q ns
 //! sdn sde sdu sdne sdeu sdun age ratio [vn ve vu sdvn sdve sdvu sdvne sdveu sdvun]` in GPST.
 
-use anyhow::{bail, Context, Result};
+use crate::io::lines::{shown, Lines};
+use anyhow::{bail, Result};
 use std::path::Path;
 
 /// One RTKLIB epoch.
@@ -21,6 +22,8 @@ pub struct PosEpoch {
     pub sigma_neu: [f64; 3],
     /// NED velocity [m/s] when the file has it.
     pub v_ned: Option<[f64; 3]>,
+    /// 1-σ of the north and east velocity [m/s] when the file has them.
+    pub sigma_v_ne: Option<[f64; 2]>,
 }
 
 /// Days since 1970-01-01 of a proleptic Gregorian date.
@@ -35,15 +38,15 @@ pub fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
 
 /// Reads a `.pos` file.
 pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read RTKLIB solution {}", path.display()))?;
+    let mut lines = Lines::open(path, "RTKLIB solution")?;
     let mut out: Vec<PosEpoch> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let l = line.trim();
+    while let Some(line) = lines.next_line()? {
+        let l = line.text.trim();
         if l.is_empty() || l.starts_with('%') {
             continue;
         }
-        let at = || format!("{}:{}", path.display(), i + 1);
+        let (file, no) = (line.file, line.no);
+        let at = || format!("{file}:{no}");
         let f: Vec<&str> = l.split_whitespace().collect();
         if f.len() < 14 {
             bail!("{}: expected at least 14 columns, found {}", at(), f.len());
@@ -52,6 +55,7 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         let time: Vec<f64> = f[1].split(':').filter_map(|x| x.parse().ok()).collect();
         if date.len() != 3
             || time.len() != 3
+            || !(1980..=2200).contains(&date[0])
             || !(1..=12).contains(&date[1])
             || !(1..=31).contains(&date[2])
             || !(0.0..24.0).contains(&time[0])
@@ -59,10 +63,10 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
             || !(0.0..61.0).contains(&time[2])
         {
             bail!(
-                "{}: bad GPST date/time `{} {}` (expected YYYY/MM/DD HH:MM:SS.SSS)",
+                "{}: bad GPST date/time `{} {}` (expected YYYY/MM/DD HH:MM:SS.SSS, year 1980 to 2200)",
                 at(),
-                f[0].escape_debug(),
-                f[1].escape_debug()
+                shown(f[0]),
+                shown(f[1])
             );
         }
         let num = |k: usize| -> Result<f64> {
@@ -70,7 +74,12 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
-                    anyhow::anyhow!("{}: column {}: `{}` is not a number", at(), k + 1, f[k])
+                    anyhow::anyhow!(
+                        "{}: column {}: `{}` is not a finite number",
+                        at(),
+                        k + 1,
+                        shown(f[k])
+                    )
                 })
         };
         let t = days_from_civil(date[0], date[1], date[2]) as f64 * 86400.0
@@ -87,7 +96,13 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         } else {
             None
         };
+        let sigma_v_ne = if f.len() >= 21 {
+            Some([num(18)?, num(19)?])
+        } else {
+            None
+        };
         let e = PosEpoch {
+            sigma_v_ne,
             t,
             lat_deg: num(2)?,
             lon_deg: num(3)?,
@@ -110,6 +125,11 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
                 e.v_ned
                     .is_some_and(|v| v.iter().any(|x| x.abs() > 1e4))
                     .then(|| "a velocity beyond ±1e4 m/s".to_string())
+            })
+            .or_else(|| {
+                e.sigma_v_ne
+                    .is_some_and(|s| s.iter().any(|x| !(0.0..=1e3).contains(x)))
+                    .then(|| "a velocity sigma outside 0 .. 1e3 m/s".to_string())
             });
         if let Some(b) = bad {
             bail!("{}: {b}", at());

@@ -1,0 +1,265 @@
+//! `filter`'s navigation solution, `nav.txt`: the navigator corrected by the filter's error
+//! estimate, with 1-σ from its covariance, written as the samples come (DESIGN §9's truth layout
+//! first), and `nav.png` (the track and the σ envelopes).
+
+use sinsmodel::estimate::filter::Observer;
+use sinsmodel::io::atomic_file::AtomicFile;
+use sinsmodel::io::truth::{write_row, TruthRow};
+use sinsmodel::model::Model;
+use sinsmodel::nav::earth;
+use sinsmodel::nav::strapdown::NavState;
+use std::io::Write;
+
+/// Most points kept per plotted curve (older points thinned as the run grows).
+const PLOT_POINTS: usize = 4000;
+
+/// Points kept for a plot, thinned by two whenever full, so memory stays bounded.
+struct Thinned {
+    points: Vec<(f64, f64)>,
+    stride: u64,
+    seen: u64,
+}
+
+impl Thinned {
+    fn new() -> Self {
+        Thinned {
+            points: Vec::new(),
+            stride: 1,
+            seen: 0,
+        }
+    }
+    fn push(&mut self, p: (f64, f64)) {
+        if self.seen.is_multiple_of(self.stride) {
+            self.points.push(p);
+            if self.points.len() >= PLOT_POINTS {
+                self.points = self.points.iter().step_by(2).copied().collect();
+                self.stride *= 2;
+            }
+        }
+        self.seen += 1;
+    }
+}
+
+/// Writes `nav.txt` rows from the filter's [`Observer::nav_sample`].
+pub struct NavWriter {
+    file: AtomicFile,
+    every: u64,
+    k: u64,
+    idx: [Option<usize>; 9],
+    n: usize,
+    origin: Option<(f64, f64)>,
+    track: Thinned,
+    sigma: [Thinned; 3],
+    /// The first write error or non-finite value met (checked after the run).
+    pub error: Option<String>,
+    /// Rows written.
+    pub rows: u64,
+}
+
+/// State names in nav.txt's σ order: position, velocity, attitude.
+const STATES: [&str; 9] = [
+    "dlat", "dlon", "dh", "dv_n", "dv_e", "dv_d", "phi_n", "phi_e", "phi_d",
+];
+
+impl NavWriter {
+    /// Starts `path` (atomic) with its header; a row every `every` IMU samples.
+    pub fn create(
+        path: &std::path::Path,
+        model: &Model,
+        every: u64,
+        provenance: &str,
+    ) -> anyhow::Result<NavWriter> {
+        let mut file = AtomicFile::create(path)?;
+        let idx = STATES.map(|s| model.index_of(s));
+        let w = file.writer();
+        writeln!(w, "# {provenance}")?;
+        writeln!(
+            w,
+            "# navigation solution: the navigator corrected by the filter's estimate ({} states), a row every {every} IMU sample(s)",
+            model.name
+        )?;
+        let mut cols = String::from(
+            "# t[s] lat lon [deg] h[m] v_n v_e v_d [m/s] roll pitch yaw [deg] (NED, FRD; DESIGN §9 truth layout)",
+        );
+        let names = [
+            "sigma_n[m]",
+            "sigma_e[m]",
+            "sigma_h[m]",
+            "sigma_vn[m/s]",
+            "sigma_ve[m/s]",
+            "sigma_vd[m/s]",
+            "sigma_tilt_n[deg]",
+            "sigma_tilt_e[deg]",
+            "sigma_tilt_d[deg]",
+        ];
+        for (k, n) in names.iter().enumerate() {
+            if idx[k].is_some() {
+                cols.push(' ');
+                cols.push_str(n);
+            }
+        }
+        writeln!(w, "{cols}")?;
+        if idx[2].is_none() {
+            writeln!(
+                w,
+                "# no sigma_h / sigma_vd: the model's vertical channel is fixed, not estimated (use +vertical)"
+            )?;
+        }
+        writeln!(
+            w,
+            "# attitude sigmas are the tilt errors about north, east, down (= roll, pitch, yaw near level)"
+        )?;
+        Ok(NavWriter {
+            file,
+            every: every.max(1),
+            k: 0,
+            idx,
+            n: model.n(),
+            origin: None,
+            track: Thinned::new(),
+            sigma: [Thinned::new(), Thinned::new(), Thinned::new()],
+            error: None,
+            rows: 0,
+        })
+    }
+
+    /// Flushes and moves the file into place; draws `png`.
+    pub fn finish(self, png: &std::path::Path) -> anyhow::Result<()> {
+        if let Some(e) = self.error {
+            anyhow::bail!("{e}");
+        }
+        self.file.commit()?;
+        use sinsmodel::report::plot::{line_plot, Scale, Series};
+        let dir = png.parent().unwrap_or(std::path::Path::new("."));
+        let stem = png.file_stem().and_then(|s| s.to_str()).unwrap_or("nav");
+        line_plot(
+            &dir.join(format!("{stem}_track.png")),
+            "filter: navigation solution, track",
+            "east of the start [m]",
+            "north of the start [m]",
+            &[Series {
+                label: "track".into(),
+                points: self.track.points,
+            }],
+            Scale::Linear,
+        )?;
+        let [sn, se, sh] = self.sigma;
+        let mut series = vec![
+            Series {
+                label: "sigma north".into(),
+                points: sn.points,
+            },
+            Series {
+                label: "sigma east".into(),
+                points: se.points,
+            },
+        ];
+        if !sh.points.is_empty() {
+            series.push(Series {
+                label: "sigma height".into(),
+                points: sh.points,
+            });
+        }
+        line_plot(
+            &dir.join(format!("{stem}_sigma.png")),
+            "filter: 1-sigma of the position (envelopes)",
+            "time [s]",
+            "1-sigma [m] (log scale)",
+            &series,
+            Scale::LogY,
+        )
+    }
+
+    fn row(&mut self, s: &NavState, x: &[f64], p: &[f64]) -> Result<(), String> {
+        let get = |k: usize| self.idx[k].map(|i| x[i]).unwrap_or(0.0);
+        let var = |k: usize| self.idx[k].map(|i| p[i * self.n + i]);
+        let phi = nalgebra::Vector3::new(get(6), get(7), get(8));
+        let q = nalgebra::UnitQuaternion::from_scaled_axis(phi) * s.q;
+        let corrected = NavState {
+            t: s.t,
+            lat: s.lat - get(0),
+            lon: s.lon - get(1),
+            h: s.h - get(2),
+            v: s.v - nalgebra::Vector3::new(get(3), get(4), get(5)),
+            q,
+        };
+        let rm = earth::radius_meridian(corrected.lat) + corrected.h;
+        let rn = (earth::radius_transverse(corrected.lat) + corrected.h) * corrected.lat.cos();
+        let scale = [
+            rm,
+            rn,
+            1.0,
+            1.0,
+            1.0,
+            1.0,
+            180.0 / std::f64::consts::PI,
+            180.0 / std::f64::consts::PI,
+            180.0 / std::f64::consts::PI,
+        ];
+        let mut sig = Vec::with_capacity(9);
+        for (k, sc) in scale.iter().enumerate() {
+            if let Some(v) = var(k) {
+                let sd = v.max(0.0).sqrt() * sc;
+                if !(sd.is_finite() && v > -1e-12) {
+                    return Err(format!(
+                        "nav.txt: the variance of {} is not finite or negative at t = {:.3} s",
+                        STATES[k], s.t
+                    ));
+                }
+                sig.push(sd);
+            }
+        }
+        let row = TruthRow {
+            t: corrected.t,
+            lat: corrected.lat,
+            lon: corrected.lon,
+            h: corrected.h,
+            v: corrected.v,
+            euler: corrected.euler(),
+        };
+        let finite = [row.lat, row.lon, row.h, row.v.x, row.v.y, row.v.z]
+            .iter()
+            .chain(row.euler.iter())
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(format!(
+                "nav.txt: the navigation solution is not finite at t = {:.3} s",
+                s.t
+            ));
+        }
+        let (lat0, lon0) = *self.origin.get_or_insert((row.lat, row.lon));
+        self.track
+            .push(((row.lon - lon0) * rn, (row.lat - lat0) * rm));
+        self.sigma[0].push((row.t, sig[0]));
+        self.sigma[1].push((row.t, sig[1]));
+        if self.idx[2].is_some() {
+            self.sigma[2].push((row.t, sig[2]));
+        }
+        let w = self.file.writer();
+        // the truth layout (same digits), then the sigmas
+        let mut line = Vec::with_capacity(200);
+        write_row(&mut line, &row).map_err(|e| e.to_string())?;
+        line.pop(); // its newline
+        w.write_all(&line).map_err(|e| e.to_string())?;
+        for v in &sig {
+            write!(w, " {v:.4e}").map_err(|e| e.to_string())?;
+        }
+        writeln!(w).map_err(|e| e.to_string())?;
+        self.rows += 1;
+        Ok(())
+    }
+}
+
+impl Observer for NavWriter {
+    fn nav_sample(&mut self, s: &NavState, x: &[f64], p: &[f64]) {
+        // rows at the every-th sample (t = k·every·dt), as navigate writes them
+        self.k += 1;
+        let due = self.k.is_multiple_of(self.every);
+        if !due || self.error.is_some() {
+            return;
+        }
+        if let Err(e) = self.row(s, x, p) {
+            self.error = Some(e);
+        }
+    }
+}

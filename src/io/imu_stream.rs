@@ -1,0 +1,439 @@
+//! IMU samples read one at a time, whatever the file's format, through one validated path:
+//! every sample that leaves [`ImuStream`] has a finite, strictly increasing time, no gap longer
+//! than 5 sample intervals, and an angular rate and specific force within what any IMU measures.
+//! `navigate` and `filter` run on the stream, so their memory does not grow with the file; the
+//! commands that need all samples at once (align, allan, imu-check, explain) [`ImuStream::collect`]
+//! them.
+//!
+//! The stream reads ahead the first [`HEAD_SECONDS`] (at most [`HEAD_MAX_SAMPLES`] samples): the
+//! median sample interval comes from them, and so does what is judged on the first seconds
+//! (imu-check's plausibility, the start time).
+
+use crate::io::imu::{ImuData, ImuSample, TableRows};
+use crate::io::units::STANDARD_GRAVITY;
+use anyhow::{bail, Context, Result};
+use nalgebra::Vector3;
+use std::collections::VecDeque;
+use std::path::Path;
+
+/// Seconds of data read ahead when a stream opens [s].
+pub const HEAD_SECONDS: f64 = 10.0;
+/// Most samples read ahead when a stream opens.
+pub const HEAD_MAX_SAMPLES: usize = 200_000;
+/// Largest angular rate any IMU measures [rad/s].
+pub const MAX_RATE: f64 = 100.0;
+/// Largest specific force any IMU measures [m/s²] (2000 g).
+pub const MAX_FORCE: f64 = 2000.0 * STANDARD_GRAVITY;
+/// Plausible median sample interval of an IMU [s]: 10 µs to 10 s.
+pub const INTERVAL_RANGE: (f64, f64) = (1e-5, 10.0);
+/// Largest gap between two samples, in median sample intervals.
+pub const MAX_GAP_INTERVALS: f64 = 5.0;
+
+/// A reader of one IMU format that hands out samples in file order.
+pub trait SampleSource {
+    /// The next sample and the file line it came from (0 when it has no line of its own), or
+    /// None at the end.
+    fn next_sample(&mut self) -> Result<Option<(ImuSample, usize)>>;
+    /// Fraction of the input read so far (for progress; 0 when unknown).
+    fn fraction(&self) -> f64;
+}
+
+/// Samples already in memory (formats read whole, tests, simulated data).
+struct MemorySource {
+    samples: std::vec::IntoIter<ImuSample>,
+    total: usize,
+    taken: usize,
+}
+
+impl SampleSource for MemorySource {
+    fn next_sample(&mut self) -> Result<Option<(ImuSample, usize)>> {
+        self.taken += 1;
+        Ok(self.samples.next().map(|s| (s, 0)))
+    }
+    fn fraction(&self) -> f64 {
+        self.taken as f64 / self.total.max(1) as f64
+    }
+}
+
+/// The project's text format (`t dθx dθy dθz dvx dvy dvz`, FRD increments).
+struct TextSource {
+    rows: TableRows<std::io::BufReader<std::fs::File>>,
+}
+
+impl SampleSource for TextSource {
+    fn next_sample(&mut self) -> Result<Option<(ImuSample, usize)>> {
+        Ok(self.rows.next_row()?.map(|(line, v)| {
+            (
+                ImuSample {
+                    t: v[0],
+                    dtheta: Vector3::new(v[1], v[2], v[3]),
+                    dv: Vector3::new(v[4], v[5], v[6]),
+                },
+                line,
+            )
+        }))
+    }
+    fn fraction(&self) -> f64 {
+        self.rows.fraction()
+    }
+}
+
+/// IMU samples of one file, read and validated one at a time (see the module docs).
+pub struct ImuStream {
+    src: Box<dyn SampleSource>,
+    name: String,
+    head: VecDeque<(ImuSample, usize)>,
+    head_copy: Vec<ImuSample>,
+    interval: f64,
+    prev_t: Option<f64>,
+    delivered: u64,
+    last_t: f64,
+}
+
+impl ImuStream {
+    /// A stream over `src`; `name` is the file's name in messages. Reads the head ahead and
+    /// checks it: at least two samples and a plausible median interval.
+    pub fn new(src: Box<dyn SampleSource>, name: &str) -> Result<ImuStream> {
+        ImuStream::with_hint(src, name, "the time column and its unit")
+    }
+
+    /// [`ImuStream::new`], with the words that say where the clock's unit is set (for a wrong
+    /// median interval).
+    pub fn with_hint(
+        mut src: Box<dyn SampleSource>,
+        name: &str,
+        clock_hint: &str,
+    ) -> Result<ImuStream> {
+        let mut head: VecDeque<(ImuSample, usize)> = VecDeque::new();
+        while head.len() < HEAD_MAX_SAMPLES {
+            let Some((s, line)) = src.next_sample()? else {
+                break;
+            };
+            let at = |line: usize| at(name, line, head.len() + 1);
+            if !s.t.is_finite() {
+                bail!("{}: the time is not finite", at(line));
+            }
+            if let Some((p, _)) = head.back() {
+                if s.t <= p.t {
+                    bail!(
+                        "{}: time {} does not increase (previous {})",
+                        at(line),
+                        s.t,
+                        p.t
+                    );
+                }
+            }
+            let span = head.front().map(|f| s.t - f.0.t).unwrap_or(0.0);
+            head.push_back((s, line));
+            if span >= HEAD_SECONDS {
+                break;
+            }
+        }
+        if head.len() < 2 {
+            bail!("{name}: fewer than two IMU samples");
+        }
+        let mut d: Vec<f64> = head
+            .iter()
+            .zip(head.iter().skip(1))
+            .map(|(a, b)| b.0.t - a.0.t)
+            .collect();
+        d.sort_by(f64::total_cmp);
+        let interval = d[d.len() / 2];
+        if !(INTERVAL_RANGE.0..=INTERVAL_RANGE.1).contains(&interval) {
+            bail!(
+                "{name}: median sample interval {interval:.3e} s ({:.3e} Hz) is not an IMU's ({} .. {} s): check {clock_hint}",
+                1.0 / interval,
+                INTERVAL_RANGE.0,
+                INTERVAL_RANGE.1
+            );
+        }
+        let mut stream = ImuStream {
+            src,
+            name: name.to_string(),
+            head_copy: Vec::new(),
+            head: VecDeque::new(),
+            interval,
+            prev_t: None,
+            delivered: 0,
+            last_t: f64::NAN,
+        };
+        // validate the head in order, as every later sample will be
+        let mut checked = VecDeque::with_capacity(head.len());
+        for (s, line) in head {
+            stream.check(&s, line, checked.len() as u64 + 1)?;
+            checked.push_back((s, line));
+        }
+        stream.prev_t = None;
+        stream.head_copy = checked.iter().map(|x| x.0).collect();
+        stream.head = checked;
+        Ok(stream)
+    }
+
+    /// Opens an IMU file as `format` describes it (`--imu-format`), else as the description
+    /// beside it (`FILE.format.toml`), else by extension (`.imu` PSINS, `.csv` GNSS_IMU with its
+    /// `.tag`, anything else the project's text); also returns the words saying which was used.
+    pub fn open(path: &Path, format: Option<&Path>) -> Result<(ImuStream, String)> {
+        ImuStream::open_with(path, format, None)
+    }
+
+    /// [`ImuStream::open`] with a GPST − IMU clock offset [s] for a GNSS_IMU csv
+    /// (`--clock-offset`, instead of its `.tag` file); refused for other formats.
+    pub fn open_with(
+        path: &Path,
+        format: Option<&Path>,
+        clock_offset: Option<f64>,
+    ) -> Result<(ImuStream, String)> {
+        if let Some(o) = clock_offset {
+            if !(o.is_finite() && o.abs() <= 1e10) {
+                bail!("--clock-offset {o}: expected seconds within ±1e10");
+            }
+            let csv = format.is_none()
+                && crate::io::imu_format::beside(path).is_none()
+                && path.extension().is_some_and(|e| e == "csv");
+            if !csv {
+                bail!("--clock-offset applies to a GNSS_IMU .csv read by its extension (a format description sets its own [time] column and unit)");
+            }
+        }
+        use crate::io::imu_format::{beside, ImuFormat};
+        use crate::io::readers::{gnss_imu, psins};
+        let name = path.display().to_string();
+        if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+            bail!(
+                "--imu {name}: cannot read IMU file (missing, or not a regular file: a directory, device or pipe)"
+            );
+        }
+        if let Some(f) = format {
+            let fmt = ImuFormat::load(f)?;
+            return Ok((
+                fmt.stream(path)?,
+                format!("as described by {}", f.display()),
+            ));
+        }
+        if let Some(f) = beside(path) {
+            let fmt = ImuFormat::load(&f)?;
+            return Ok((
+                fmt.stream(path)?,
+                format!("as described by {} (found beside it)", f.display()),
+            ));
+        }
+        let other = "--imu-format FILE.toml describes any other layout (docs/formats.md)";
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("imu") => {
+                let how = "as a PSINS .imu log (chosen by its extension)";
+                let (_, src) =
+                    psins::open(path).with_context(|| format!("reading {name} {how}; {other}"))?;
+                Ok((
+                    ImuStream::new(Box::new(src), &name)
+                        .with_context(|| format!("reading {name} {how}; {other}"))?,
+                    format!("{how}; {other}"),
+                ))
+            }
+            Some("csv") => {
+                let how = match clock_offset {
+                    None => "as a GNSS_IMU csv on GPST with its .tag file (chosen by its extension)".to_string(),
+                    Some(o) => format!("as a GNSS_IMU csv, clock offset {o} s from --clock-offset (chosen by its extension)"),
+                };
+                let log = gnss_imu::read_with(path, clock_offset).with_context(|| {
+                    format!("reading {name} {how}; {other} (formats/gnss-imu-csv.toml reads it without the .tag)")
+                })?;
+                Ok((
+                    ImuStream::from_data(log.imu, &name)?,
+                    format!("{how}; {other}"),
+                ))
+            }
+            _ => Ok((
+                ImuStream::text(path)?,
+                format!("as sinsmodel IMU text (t dtheta_xyz [rad] dv_xyz [m/s], FRD); {other}"),
+            )),
+        }
+    }
+
+    /// The project's text IMU format, streamed.
+    pub fn text(path: &Path) -> Result<ImuStream> {
+        let rows = TableRows::open(path, 7, "IMU file")?;
+        ImuStream::new(Box::new(TextSource { rows }), &path.display().to_string())
+    }
+
+    /// Samples already in memory, validated like a file's.
+    pub fn from_data(data: ImuData, name: &str) -> Result<ImuStream> {
+        let total = data.samples.len();
+        ImuStream::new(
+            Box::new(MemorySource {
+                samples: data.samples.into_iter(),
+                total,
+                taken: 0,
+            }),
+            name,
+        )
+    }
+
+    /// Checks one sample against the previous one: time, gap, rate and force.
+    fn check(&mut self, s: &ImuSample, line: usize, index: u64) -> Result<()> {
+        let here = || at(&self.name, line, index as usize);
+        if !s.t.is_finite() {
+            bail!("{}: the time is not finite", here());
+        }
+        let dt = match self.prev_t {
+            Some(p) => {
+                let d = s.t - p;
+                if d <= 0.0 {
+                    bail!("{}: time {} does not increase (previous {p})", here(), s.t);
+                }
+                if d > MAX_GAP_INTERVALS * self.interval {
+                    bail!(
+                        "{}: gap of {d:.4} s after t = {p} (more than {MAX_GAP_INTERVALS} sample intervals of {:.4} s)",
+                        here(),
+                        self.interval
+                    );
+                }
+                d
+            }
+            None => self.interval,
+        };
+        let (w, f) = (s.dtheta.norm() / dt, s.dv.norm() / dt);
+        if w.is_nan() || w > MAX_RATE {
+            bail!(
+                "{}: angular rate {w:.3e} rad/s (increment over {dt:.3e} s) is beyond any IMU (<= {MAX_RATE} rad/s): check the values, their unit and the clock",
+                here()
+            );
+        }
+        if f.is_nan() || f > MAX_FORCE {
+            bail!(
+                "{}: specific force {f:.3e} m/s^2 (increment over {dt:.3e} s) is beyond any IMU (<= 2000 g): check the values, their unit and the clock",
+                here()
+            );
+        }
+        self.prev_t = Some(s.t);
+        Ok(())
+    }
+
+    /// The next validated sample, or None at the end of the file.
+    #[allow(clippy::should_implement_trait)]
+    pub fn next(&mut self) -> Result<Option<ImuSample>> {
+        let s = if let Some((s, _)) = self.head.pop_front() {
+            // validated when the stream opened
+            self.prev_t = Some(s.t);
+            s
+        } else {
+            let Some((s, line)) = self.src.next_sample()? else {
+                return Ok(None);
+            };
+            self.check(&s, line, self.delivered + 1)?;
+            s
+        };
+        self.delivered += 1;
+        self.last_t = s.t;
+        Ok(Some(s))
+    }
+
+    /// The samples read ahead when the stream opened (the first [`HEAD_SECONDS`]).
+    pub fn head(&self) -> &[ImuSample] {
+        &self.head_copy
+    }
+
+    /// Median sample interval of the head [s].
+    pub fn interval(&self) -> f64 {
+        self.interval
+    }
+
+    /// Time of the first sample [s].
+    pub fn first_t(&self) -> f64 {
+        self.head_copy[0].t
+    }
+
+    /// Time of the last sample handed out [s] (NaN before the first).
+    pub fn last_t(&self) -> f64 {
+        self.last_t
+    }
+
+    /// Number of samples handed out so far.
+    pub fn count(&self) -> u64 {
+        self.delivered
+    }
+
+    /// Fraction of the input read so far.
+    pub fn fraction(&self) -> f64 {
+        self.src.fraction()
+    }
+
+    /// The file's name as messages show it.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The same samples, all read into memory first (the pre-streaming path: a baseline for
+    /// `sinsmodel bench`).
+    pub fn into_memory(self) -> Result<ImuStream> {
+        let name = self.name.clone();
+        ImuStream::from_data(self.collect()?, &name)
+    }
+
+    /// Reads every remaining sample into memory.
+    pub fn collect(mut self) -> Result<ImuData> {
+        let mut samples = Vec::new();
+        while let Some(s) = self.next()? {
+            samples.push(s);
+        }
+        Ok(ImuData { samples })
+    }
+}
+
+/// `file:line` where the sample has a line, else `file: sample N`.
+fn at(name: &str, line: usize, index: usize) -> String {
+    if line > 0 {
+        format!("{name}:{line}")
+    } else {
+        format!("{name}: sample {index}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn data(ts: &[f64], w: f64) -> ImuData {
+        ImuData {
+            samples: ts
+                .iter()
+                .map(|&t| ImuSample {
+                    t,
+                    dtheta: Vector3::new(w * 0.01, 0.0, 0.0),
+                    dv: Vector3::new(0.0, 0.0, -0.098),
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn streams_validate_every_sample() {
+        let ts: Vec<f64> = (1..=3000).map(|k| k as f64 * 0.01).collect();
+        let s = ImuStream::from_data(data(&ts, 0.1), "mem").unwrap();
+        assert!((s.interval() - 0.01).abs() < 1e-12);
+        assert_eq!(s.head().len(), 1001);
+        assert_eq!(s.collect().unwrap().samples.len(), 3000);
+        // a gap beyond the head
+        let mut ts2 = ts.clone();
+        for t in ts2.iter_mut().skip(2000) {
+            *t += 1.0;
+        }
+        let e = ImuStream::from_data(data(&ts2, 0.1), "mem")
+            .unwrap()
+            .collect()
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("mem: sample 2001: gap of 1.0100 s"), "{e}");
+        // an absurd rate (1e308 finite in the file)
+        let e = ImuStream::from_data(data(&ts, 1e308), "mem")
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("beyond any IMU"), "{e}");
+        // a clock in ms read as s
+        let ms: Vec<f64> = (1..50).map(|k| k as f64 * 20.0).collect();
+        let e = ImuStream::from_data(data(&ms, 0.0), "mem")
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("median sample interval"), "{e}");
+    }
+}
