@@ -359,6 +359,32 @@ impl Scenario {
                 "sine" | "random" | "angular" => {}
                 other => bail!("{where_}: unknown kind `{other}` (sine, random, angular)"),
             }
+            // a key of another kind would be ignored without a word (and went unchecked: a
+            // random source took `freq_hz = nan`)
+            let foreign = if v.kind == "random" {
+                [
+                    (v.amplitude.is_some(), "amplitude"),
+                    (v.freq_hz != 0.0, "freq_hz"),
+                    (v.phase_deg != 0.0, "phase_deg"),
+                ]
+            } else {
+                [
+                    (v.psd.is_some(), "psd"),
+                    (v.band_hz.is_some(), "band_hz"),
+                    (v.components.is_some(), "components"),
+                ]
+            };
+            if let Some((_, key)) = foreign.iter().find(|(set, _)| *set) {
+                let uses = if v.kind == "random" {
+                    "psd, band_hz, components"
+                } else {
+                    "amplitude, freq_hz, phase_deg"
+                };
+                bail!(
+                    "{where_}: `{key}` does not apply to a `{}` vibration (it takes {uses}, schedule)",
+                    v.kind
+                );
+            }
             match v.kind.as_str() {
                 "sine" => {
                     let a = v
