@@ -51,6 +51,18 @@ pub fn run(args: &AllanArgs) -> Result<()> {
         args.src.check_output("--json", j)?;
     }
     if let Some(p) = prefix_shown(args) {
+        // the prefix names files in a directory: not a device or a special path
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        if dir.starts_with("/dev") || dir.starts_with("/proc") || dir.starts_with("/sys") {
+            anyhow::bail!(
+                "--plot {}: the plots would go into {}, not a place for files",
+                p.display(),
+                dir.display()
+            );
+        }
         for suffix in ["gyro", "accel"] {
             let png = PathBuf::from(format!("{}_{suffix}.png", p.display()));
             args.src.check_output("--plot", &png)?;

@@ -56,6 +56,22 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         if j.is_dir() {
             bail!("--json {}: is a directory; give a file name", j.display());
         }
+        // inside --out it would be a file the run's directory did not list (explain.json is
+        // there already)
+        let inside = |dir: &Path| {
+            let parent = j
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            same_file(parent, dir)
+        };
+        if inside(&args.out) {
+            bail!(
+                "--json {}: inside --out {} (which holds explain.json already); give a path outside it",
+                j.display(),
+                args.out.display()
+            );
+        }
         for inp in args.data.input_paths() {
             if same_file(j, inp) {
                 bail!(

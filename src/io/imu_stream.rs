@@ -291,13 +291,21 @@ impl ImuStream {
             None => self.interval,
         };
         let (w, f) = (s.dtheta.norm() / dt, s.dv.norm() / dt);
-        if w.is_nan() || w > MAX_RATE {
+        if !(w.is_finite() && f.is_finite()) {
+            bail!(
+                "{}: increments |dtheta| {:.3e} rad, |dv| {:.3e} m/s over an interval of {dt:.3e} s: no rate or force an IMU measures (check the values and the clock)",
+                here(),
+                s.dtheta.norm(),
+                s.dv.norm()
+            );
+        }
+        if w > MAX_RATE {
             bail!(
                 "{}: angular rate {w:.3e} rad/s (increment over {dt:.3e} s) is beyond any IMU (<= {MAX_RATE} rad/s): check the values, their unit and the clock",
                 here()
             );
         }
-        if f.is_nan() || f > MAX_FORCE {
+        if f > MAX_FORCE {
             bail!(
                 "{}: specific force {f:.3e} m/s^2 (increment over {dt:.3e} s) is beyond any IMU (<= 2000 g): check the values, their unit and the clock",
                 here()
