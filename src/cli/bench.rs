@@ -147,9 +147,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             args.memory_seconds
         );
     }
-    if args.explain_seconds > 0.0 && args.explain_seconds < 60.0 {
+    if args.explain_seconds > 0.0 && args.explain_seconds < 10.0 {
         anyhow::bail!(
-            "--explain-seconds {}: expected 0 (skip) or 60 to 86400 s",
+            "--explain-seconds {}: expected 0 (skip) or 10 to 86400 s",
             args.explain_seconds
         );
     }
