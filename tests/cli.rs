@@ -98,10 +98,8 @@ fn jacobian_rejects_bad_input_with_a_clear_message() {
     assert!(!ok && err.contains("unknown preset `P32`"), "{err}");
 }
 
-/// `--outage START,DURATION`: the fixes inside are dropped and the drift at the first fix after
-/// it is reported (terminal table and outages.json), finite and growing with the outage.
-#[test]
-fn filter_outages_drop_aiding_and_report_the_drift() {
+/// scenarios/drive.toml simulated into a temporary directory: (the directory, the run's folder).
+fn simulated_drive() -> (tempfile::TempDir, std::path::PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let sim = dir.path().join("drive");
@@ -112,6 +110,14 @@ fn filter_outages_drop_aiding_and_report_the_drift() {
         sim.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
+    (dir, sim)
+}
+
+/// `--outage START,DURATION`: the fixes inside are dropped and the drift at the first fix after
+/// it is reported (terminal table and outages.json), finite and growing with the outage.
+#[test]
+fn filter_outages_drop_aiding_and_report_the_drift() {
+    let (dir, sim) = simulated_drive();
     let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
     let run = |outages: &[&str], out: &str| {
         let mut a = vec![
@@ -179,16 +185,7 @@ fn filter_outages_drop_aiding_and_report_the_drift() {
 /// and as close in closed loop; plots written.
 #[test]
 fn filter_writes_a_navigation_solution_with_sigmas() {
-    let dir = tempfile::tempdir().unwrap();
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sim = dir.path().join("drive");
-    let (ok, _, err) = sinsmodel(&[
-        "simulate",
-        root.join("scenarios/drive.toml").to_str().unwrap(),
-        "--out",
-        sim.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let (dir, sim) = simulated_drive();
     let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
     let read = |p: &std::path::Path| -> Vec<Vec<f64>> {
         std::fs::read_to_string(p)
@@ -270,16 +267,7 @@ fn filter_writes_a_navigation_solution_with_sigmas() {
 /// vel_ne updates with its σ; `--aid-use` chooses; asking for velocities a file lacks is refused.
 #[test]
 fn filter_uses_gnss_velocities_when_the_file_has_them() {
-    let dir = tempfile::tempdir().unwrap();
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sim = dir.path().join("drive");
-    let (ok, _, err) = sinsmodel(&[
-        "simulate",
-        root.join("scenarios/drive.toml").to_str().unwrap(),
-        "--out",
-        sim.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let (dir, sim) = simulated_drive();
     // velocities from the truth at the fix times, σ 0.05 m/s
     let truth: Vec<Vec<f64>> = std::fs::read_to_string(sim.join("truth.txt"))
         .unwrap()
@@ -340,7 +328,8 @@ fn filter_uses_gnss_velocities_when_the_file_has_them() {
     let ((ok, _, err), _, _) = filter(aid11.to_str().unwrap(), &["--zupt", "0.1"], "zupt");
     assert!(!ok && err.contains("--zupt and GNSS velocity"), "{err}");
     // the shared RTKLIB solution carries velocities and their sigma
-    let pos = root.join("../shared/data/gnss-imu-drive/gnss_1934_sf.pos");
+    let pos = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/gnss-imu-drive/gnss_1934_sf.pos");
     let e = sinsmodel::io::readers::rtklib::read(&pos).unwrap();
     assert!(e
         .iter()
