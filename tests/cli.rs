@@ -335,3 +335,74 @@ fn filter_uses_gnss_velocities_when_the_file_has_them() {
         .iter()
         .all(|p| p.v_ned.is_some() && p.sigma_v_ne.is_some()));
 }
+
+/// `--grade`: the priors and noise of a sensor grade for every state, said on stderr; --prior
+/// overrides single values; without it the run says it assumes the spec's navigation grade.
+#[test]
+fn filter_grade_sets_every_prior_and_says_so() {
+    let (dir, sim) = simulated_drive();
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let run = |extra: &[&str], out: &str| {
+        let o = dir.path().join(out);
+        let (imu, aid, truth) = (s("imu.txt"), s("gnss.txt"), s("truth.txt"));
+        let mut a = vec![
+            "filter",
+            "--model",
+            "P28",
+            "--imu",
+            &imu,
+            "--aid",
+            &aid,
+            "--truth",
+            &truth,
+            "--out",
+            o.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        let (ok, _, err) = sinsmodel(&a);
+        let states = std::fs::read_to_string(o.join("states.txt")).unwrap_or_default();
+        let header: Vec<String> = states
+            .lines()
+            .find(|l| l.starts_with("# t "))
+            .map(|l| l[2..].split_whitespace().map(String::from).collect())
+            .unwrap_or_default();
+        let first: Vec<f64> = states
+            .lines()
+            .find(|l| !l.starts_with('#'))
+            .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+            .unwrap_or_default();
+        let sigma = move |name: &str| {
+            let k = header
+                .iter()
+                .position(|h| h == &format!("sigma_{name}"))
+                .unwrap();
+            first[k]
+        };
+        (ok, err, sigma)
+    };
+    let (ok, err, sigma) = run(&[], "nav");
+    assert!(ok && err.contains("navigation grade"), "{err}");
+    let nav_kg = sigma("kg_11");
+    let (ok, err, sigma) = run(&["--grade", "mems", "--prior", "nabla_x=20 mg"], "mems");
+    assert!(ok && err.contains("--grade mems"), "{err}");
+    // the first epoch, 1 s in: unobserved terms keep their prior
+    assert!(
+        (sigma("kg_11") / 1e-2 - 1.0).abs() < 0.05,
+        "{}",
+        sigma("kg_11")
+    );
+    assert!(sigma("kg_11") > 100.0 * nav_kg);
+    let g = 9.80665;
+    assert!(
+        (sigma("nabla_x") / (20e-3 * g) - 1.0).abs() < 0.2,
+        "{}",
+        sigma("nabla_x")
+    );
+    assert!(
+        (sigma("nabla_y") / (50e-3 * g) - 1.0).abs() < 0.2,
+        "{}",
+        sigma("nabla_y")
+    );
+    let (ok, err, _) = run(&["--grade", "consumer"], "bad");
+    assert!(!ok && err.contains("--grade `consumer`"), "{err}");
+}

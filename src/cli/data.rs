@@ -112,6 +112,10 @@ pub struct DataArgs {
     /// Run even when the initial roll and pitch contradict the measured gravity direction.
     #[arg(long)]
     force: bool,
+    /// Sensor grade the priors and noise assume: navigation (the spec's defaults), tactical or
+    /// mems; --prior and --noise override single values.
+    #[arg(long)]
+    grade: Option<String>,
     /// A GNSS outage: START,DURATION [s], START counted from the first IMU sample; the aiding
     /// epochs inside are dropped and the drift at its end is reported (repeatable).
     #[arg(long, allow_hyphen_values = true)]
@@ -125,6 +129,73 @@ pub struct Outage {
     pub start_s: f64,
     /// End of the window [s].
     pub end_s: f64,
+}
+
+/// Priors by state-name prefix and the white noise (ARW, VRW) of a sensor grade, in the
+/// project's units; `navigation` is the spec's own defaults (the paper's laser-gyro INS).
+const GRADES: [(&str, &[(&str, &str)], &str, &str); 2] = [
+    (
+        "tactical",
+        &[
+            ("phi_n", "0.1 deg"),
+            ("phi_e", "0.1 deg"),
+            ("phi_d", "1 deg"),
+            ("eps_", "1 deg/h"),
+            ("nabla_", "1 mg"),
+            ("kg_", "300 ppm"),
+            ("ka_", "500 ppm"),
+            ("kas_", "500 ppm"),
+            ("d_", "100 ug/g^2"),
+            ("kaq_", "100 ug/g^2"),
+            ("kao_", "100 ug/g^2"),
+            ("kgf_", "1 deg/h/g"),
+            ("kgq_", "0.1 deg/h/g^2"),
+        ],
+        "0.1 deg/sqrt(h)",
+        "50 ug/sqrt(Hz)",
+    ),
+    (
+        "mems",
+        &[
+            ("phi_n", "2 deg"),
+            ("phi_e", "2 deg"),
+            ("phi_d", "10 deg"),
+            ("eps_", "0.5 deg/s"),
+            ("nabla_", "50 mg"),
+            ("kg_", "10000 ppm"),
+            ("ka_", "10000 ppm"),
+            ("kas_", "10000 ppm"),
+            ("d_", "5000 ug/g^2"),
+            ("kaq_", "5000 ug/g^2"),
+            ("kao_", "5000 ug/g^2"),
+            ("kgf_", "0.1 deg/s/g"),
+            ("kgq_", "0.01 deg/s/g^2"),
+        ],
+        "0.5 deg/sqrt(h)",
+        "150 ug/sqrt(Hz)",
+    ),
+];
+
+/// The table of `--grade` (None for navigation, the spec's defaults).
+fn grade_table(
+    grade: Option<&str>,
+) -> Result<
+    Option<&'static (
+        &'static str,
+        &'static [(&'static str, &'static str)],
+        &'static str,
+        &'static str,
+    )>,
+> {
+    match grade {
+        None | Some("navigation") => Ok(None),
+        Some(g) => GRADES.iter().find(|x| x.0 == g).map(Some).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--grade `{}`: expected navigation, tactical or mems",
+                sinsmodel::io::lines::shown(g)
+            )
+        }),
+    }
 }
 
 /// What the data options load for a command that passes over the data more than once: the IMU
@@ -260,6 +331,7 @@ impl DataArgs {
             || self.init.is_some()
             || self.zupt.is_some()
             || self.force
+            || self.grade.is_some()
             || !self.outage.is_empty()
     }
 
@@ -278,8 +350,20 @@ impl DataArgs {
         .collect()
     }
 
-    /// Prints the sensor noise `--noise` gives, if any (once per run).
+    /// Prints the sensor noise `--noise` gives, if any, and the grade the priors assume (once per
+    /// run).
     pub fn print_noise(&self) -> Result<()> {
+        match grade_table(self.grade.as_deref())? {
+            None => eprintln!(
+                "priors and noise: {} (the spec's defaults, a navigation-grade laser-gyro INS); --grade tactical|mems for other sensors{}",
+                if self.grade.is_some() { "--grade navigation" } else { "navigation grade" },
+                if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
+            ),
+            Some((g, _, arw, vrw)) => eprintln!(
+                "priors and noise: --grade {g} (ARW {arw}, VRW {vrw}; the priors of the README's --grade table){}",
+                if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
+            ),
+        }
         if let Some(path) = &self.noise {
             let (arw, vrw) = noise_from_allan(path)?;
             eprintln!(
@@ -315,6 +399,18 @@ impl DataArgs {
     pub fn term_priors(&self) -> Result<Vec<(usize, f64)>> {
         use sinsmodel::model::generated::common;
         let mut out: Vec<(usize, f64)> = Vec::new();
+        if let Some((_, priors, _, _)) = grade_table(self.grade.as_deref())? {
+            for (prefix, q) in priors.iter() {
+                for (t, info) in common::TERMS.iter().enumerate() {
+                    if info.name.starts_with(prefix) {
+                        let si = sinsmodel::io::units::parse_quantity_as(q, info.unit)
+                            .map_err(|e| anyhow::anyhow!("--grade: {prefix}: {e}"))?;
+                        out.retain(|x| x.0 != t);
+                        out.push((t, si));
+                    }
+                }
+            }
+        }
         for spec in &self.prior {
             let (name, value) = spec
                 .split_once('=')
@@ -670,6 +766,22 @@ impl DataArgs {
     pub fn config(&self, model: &Model, lenient_priors: bool) -> Result<FilterConfig> {
         let args = self;
         let mut cfg = FilterConfig::new(model);
+        if let Some((_, priors, arw, vrw)) = grade_table(args.grade.as_deref())? {
+            for (prefix, q) in priors.iter() {
+                for i in 0..model.n() {
+                    if model.names[i].starts_with(prefix) {
+                        cfg.prior_sigma[i] =
+                            sinsmodel::io::units::parse_quantity_as(q, model.unit(i))
+                                .map_err(|e| anyhow::anyhow!("--grade: {prefix}: {e}"))?;
+                    }
+                }
+            }
+            let arw = sinsmodel::io::units::parse_quantity_as(arw, "rad/sqrt(s)")
+                .map_err(|e| anyhow::anyhow!("--grade: ARW: {e}"))?;
+            let vrw = sinsmodel::io::units::parse_quantity_as(vrw, "m/s/sqrt(s)")
+                .map_err(|e| anyhow::anyhow!("--grade: VRW: {e}"))?;
+            cfg = cfg.with_sensor_noise(model, arw, vrw);
+        }
         cfg.mode = match args.mode.as_str() {
             "open" => Mode::OpenLoop,
             "closed" => Mode::ClosedLoop,
