@@ -131,9 +131,17 @@ pub struct Outage {
     pub end_s: f64,
 }
 
+/// A sensor grade: name, priors by state-name prefix, ARW, VRW (the project's units).
+type Grade = (
+    &'static str,
+    &'static [(&'static str, &'static str)],
+    &'static str,
+    &'static str,
+);
+
 /// Priors by state-name prefix and the white noise (ARW, VRW) of a sensor grade, in the
 /// project's units; `navigation` is the spec's own defaults (the paper's laser-gyro INS).
-const GRADES: [(&str, &[(&str, &str)], &str, &str); 2] = [
+const GRADES: [Grade; 2] = [
     (
         "tactical",
         &[
