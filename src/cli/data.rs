@@ -186,6 +186,36 @@ const GRADES: [Grade; 2] = [
 
 /// The table of `--grade` (None for navigation, the spec's defaults).
 fn grade_table(grade: Option<&str>) -> Result<Option<&'static Grade>> {
+    match grade {
+        None | Some("navigation") => Ok(None),
+        Some(g) => GRADES.iter().find(|x| x.0 == g).map(Some).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--grade `{}`: expected navigation, tactical or mems",
+                sinsmodel::io::lines::shown(g)
+            )
+        }),
+    }
+}
+
+/// What the data options load for a command that passes over the data more than once: the IMU
+/// file (read again on every pass), aiding epochs, truth, the initial state.
+pub struct Inputs {
+    /// The IMU file.
+    pub imu: PathBuf,
+    /// Its format description, when given.
+    pub imu_format: Option<PathBuf>,
+    /// `--clock-offset` [s], when given.
+    pub clock_offset: Option<f64>,
+    /// Aiding epochs after the start.
+    pub aid: Vec<AidingEpoch>,
+    /// Truth rows, when given.
+    pub truth: Option<Vec<TruthRow>>,
+    /// Initial navigation state.
+    pub start: NavState,
+}
+
+/// The data options opened for one streamed pass.
+pub struct Opened {
     /// IMU samples, validated as they are read.
     pub imu: sinsmodel::io::imu_stream::ImuStream,
     /// Aiding epochs after the start.
