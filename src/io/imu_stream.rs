@@ -291,24 +291,33 @@ impl ImuStream {
             None => self.interval,
         };
         let (w, f) = (s.dtheta.norm() / dt, s.dv.norm() / dt);
-        if !(w.is_finite() && f.is_finite()) {
+        // an increment over a tiny interval (or one whose square overflows) is beyond any IMU
+        // too: said in words, never printed as inf
+        let num = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.3e}")
+            } else {
+                "too large to represent".to_string()
+            }
+        };
+        if w.is_nan() || f.is_nan() {
             bail!(
-                "{}: increments |dtheta| {:.3e} rad, |dv| {:.3e} m/s over an interval of {dt:.3e} s: no rate or force an IMU measures (check the values and the clock)",
-                here(),
-                s.dtheta.norm(),
-                s.dv.norm()
+                "{}: the increments over an interval of {dt:.3e} s give no rate or force (check the values and the clock)",
+                here()
             );
         }
         if w > MAX_RATE {
             bail!(
-                "{}: angular rate {w:.3e} rad/s (increment over {dt:.3e} s) is beyond any IMU (<= {MAX_RATE} rad/s): check the values, their unit and the clock",
-                here()
+                "{}: angular rate {} rad/s (increment over {dt:.3e} s) is beyond any IMU (<= {MAX_RATE} rad/s): check the values, their unit and the clock",
+                here(),
+                num(w)
             );
         }
         if f > MAX_FORCE {
             bail!(
-                "{}: specific force {f:.3e} m/s^2 (increment over {dt:.3e} s) is beyond any IMU (<= 2000 g): check the values, their unit and the clock",
-                here()
+                "{}: specific force {} m/s^2 (increment over {dt:.3e} s) is beyond any IMU (<= 2000 g): check the values, their unit and the clock",
+                here(),
+                num(f)
             );
         }
         self.prev_t = Some(s.t);
