@@ -150,6 +150,22 @@ fn small_campaign_structure_behaviour_broken_selector_and_merge() {
         tmp("twice").to_str().unwrap(),
     ]);
     assert!(!ok && stderr.contains("appears twice"), "{stderr}");
+    // a stored campaign with settings explain-eval never writes is refused
+    let edited = tmp("edited");
+    std::fs::create_dir_all(&edited).unwrap();
+    let text = std::fs::read_to_string(h2.join("cases.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["spec"]["alpha"] = serde_json::json!(0.7);
+    std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+    let (ok, stderr) = sinsmodel(&[
+        "explain-eval",
+        "--merge",
+        edited.to_str().unwrap(),
+        "--out",
+        tmp("edited_out").to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("campaign settings"), "{stderr}");
+    std::fs::remove_dir_all(&edited).unwrap();
     for d in [whole, broken, h1, h2, merged] {
         std::fs::remove_dir_all(d).unwrap();
     }

@@ -156,6 +156,22 @@ fn merge(args: &EvalArgs) -> Result<()> {
                 path.display()
             )
         })?;
+        // a stored campaign is input like any other: its numbers checked before they are used
+        let sp = &stored.spec;
+        let plausible = sp.seconds.is_finite()
+            && sp.seconds > 0.0
+            && sp.seconds <= 86_400.0
+            && (0.0..=1.0).contains(&sp.null_fraction)
+            && sp.lambda.iter().all(|l| l.is_finite() && *l > 0.0)
+            && sp.lambda[0] <= sp.lambda[1]
+            && sp.alpha > 0.0
+            && sp.alpha <= 0.5;
+        if !plausible {
+            bail!(
+                "--merge: {}: its campaign settings are not ones explain-eval writes (seconds in (0, 86400], null fraction in [0, 1], 0 < lambda_lo <= lambda_hi, alpha in (0, 0.5])",
+                path.display()
+            );
+        }
         match &spec {
             None => spec = Some(stored.spec),
             Some(s) => {
