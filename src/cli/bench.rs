@@ -328,8 +328,22 @@ fn run_child(args: &[&std::ffi::OsStr]) -> Result<(f64, f64)> {
 fn memory_job(seconds: f64) -> Result<()> {
     use std::ffi::OsStr;
     let dir = tempfile_dir()?.join("memory");
-    let scenario = include_str!("../../scenarios/sine.toml")
-        .replace("duration_s = 600.0", &format!("duration_s = {seconds}"));
+    // the README's sine case (scenarios/sine.toml): 6 g, 90 Hz on N, E, D at 2 kHz, the paper's
+    // sensor errors, 1 Hz GNSS
+    let vib: String = ["n", "e", "d"]
+        .iter()
+        .map(|a| {
+            format!(
+                "[[vibration]]\nkind = \"sine\"\naxis = \"{a}\"\namplitude = \"6 g\"\nfreq_hz = 90.0\n"
+            )
+        })
+        .collect();
+    let scenario = format!(
+        "name = \"bench-memory\"\nimu_rate_hz = 2000.0\ntruth_rate_hz = 1.0\nseed = 1\n[start]\nlat_deg = 28.22\nlon_deg = 112.99\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = {seconds}\n{vib}{}{}\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+        reproduce::PAPER_ERRORS,
+        reproduce::PAPER_NOISE
+    );
     std::fs::create_dir_all(&dir)?;
     let sc = dir.join("scenario.toml");
     std::fs::write(&sc, scenario)?;
