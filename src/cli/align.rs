@@ -63,7 +63,6 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         args.src.check_output("--json", j)?;
     }
     let data = args.src.read()?;
-    data.check_time(&args.src.imu.display().to_string(), 5.0)?;
     let d = std::f64::consts::PI / 180.0;
     let a = align::align(
         &data,

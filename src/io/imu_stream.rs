@@ -13,7 +13,6 @@ use crate::io::imu::{ImuData, ImuSample, TableRows};
 use crate::io::units::STANDARD_GRAVITY;
 use anyhow::{bail, Context, Result};
 use nalgebra::Vector3;
-use std::collections::VecDeque;
 use std::path::Path;
 
 /// Seconds of data read ahead when a stream opens [s].
@@ -82,8 +81,10 @@ impl SampleSource for TextSource {
 pub struct ImuStream {
     src: Box<dyn SampleSource>,
     name: String,
-    head: VecDeque<(ImuSample, usize)>,
-    head_copy: Vec<ImuSample>,
+    /// The samples read ahead (validated), handed out first.
+    head: Vec<ImuSample>,
+    /// Index of the next head sample to hand out.
+    head_next: usize,
     interval: f64,
     prev_t: Option<f64>,
     delivered: u64,
@@ -104,7 +105,7 @@ impl ImuStream {
         name: &str,
         clock_hint: &str,
     ) -> Result<ImuStream> {
-        let mut head: VecDeque<(ImuSample, usize)> = VecDeque::new();
+        let mut head: Vec<(ImuSample, usize)> = Vec::new();
         while head.len() < HEAD_MAX_SAMPLES {
             let Some((s, line)) = src.next_sample()? else {
                 break;
@@ -113,7 +114,7 @@ impl ImuStream {
             if !s.t.is_finite() {
                 bail!("{}: the time is not finite", at(line));
             }
-            if let Some((p, _)) = head.back() {
+            if let Some((p, _)) = head.last() {
                 if s.t <= p.t {
                     bail!(
                         "{}: time {} does not increase (previous {})",
@@ -123,8 +124,8 @@ impl ImuStream {
                     );
                 }
             }
-            let span = head.front().map(|f| s.t - f.0.t).unwrap_or(0.0);
-            head.push_back((s, line));
+            let span = head.first().map(|f| s.t - f.0.t).unwrap_or(0.0);
+            head.push((s, line));
             if span >= HEAD_SECONDS {
                 break;
             }
@@ -150,22 +151,19 @@ impl ImuStream {
         let mut stream = ImuStream {
             src,
             name: name.to_string(),
-            head_copy: Vec::new(),
-            head: VecDeque::new(),
+            head: Vec::with_capacity(head.len()),
+            head_next: 0,
             interval,
             prev_t: None,
             delivered: 0,
             last_t: f64::NAN,
         };
-        // validate the head in order, as every later sample will be
-        let mut checked = VecDeque::with_capacity(head.len());
+        // validate the head in order, as every later sample will be (prev_t then stands at the
+        // last head sample, where the samples after the head continue)
         for (s, line) in head {
-            stream.check(&s, line, checked.len() as u64 + 1)?;
-            checked.push_back((s, line));
+            stream.check(&s, line, stream.head.len() as u64 + 1)?;
+            stream.head.push(s);
         }
-        stream.prev_t = None;
-        stream.head_copy = checked.iter().map(|x| x.0).collect();
-        stream.head = checked;
         Ok(stream)
     }
 
@@ -327,9 +325,9 @@ impl ImuStream {
     /// The next validated sample, or None at the end of the file.
     #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> Result<Option<ImuSample>> {
-        let s = if let Some((s, _)) = self.head.pop_front() {
+        let s = if let Some(&s) = self.head.get(self.head_next) {
             // validated when the stream opened
-            self.prev_t = Some(s.t);
+            self.head_next += 1;
             s
         } else {
             let Some((s, line)) = self.src.next_sample()? else {
@@ -345,7 +343,7 @@ impl ImuStream {
 
     /// The samples read ahead when the stream opened (the first [`HEAD_SECONDS`]).
     pub fn head(&self) -> &[ImuSample] {
-        &self.head_copy
+        &self.head
     }
 
     /// Median sample interval of the head [s].
@@ -355,7 +353,7 @@ impl ImuStream {
 
     /// Time of the first sample [s].
     pub fn first_t(&self) -> f64 {
-        self.head_copy[0].t
+        self.head[0].t
     }
 
     /// Time of the last sample handed out [s] (NaN before the first).

@@ -149,7 +149,6 @@ pub struct Lines<R> {
     reader: R,
     name: String,
     buf: Vec<u8>,
-    line: String,
     lineno: usize,
     bytes_read: u64,
     total_bytes: u64,
@@ -184,7 +183,6 @@ impl<R: BufRead> Lines<R> {
             reader,
             name: name.to_string(),
             buf: Vec::new(),
-            line: String::new(),
             lineno: 0,
             bytes_read: 0,
             total_bytes,
@@ -234,10 +232,12 @@ impl<R: BufRead> Lines<R> {
         while matches!(self.buf.last(), Some(b'\n' | b'\r')) {
             self.buf.pop();
         }
-        let mut bytes = &self.buf[..];
-        if self.lineno == 1 {
-            bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-        }
+        let start = if self.lineno == 1 && self.buf.starts_with(b"\xEF\xBB\xBF") {
+            3
+        } else {
+            0
+        };
+        let bytes = &self.buf[start..];
         if bytes.contains(&0) {
             bail!(
                 "{}:{}: NUL bytes in the line: not a text data file (binary data, or a truncated write)",
@@ -245,16 +245,13 @@ impl<R: BufRead> Lines<R> {
                 self.lineno
             );
         }
+        // borrowed from the read buffer: no copy per line
         match std::str::from_utf8(bytes) {
-            Ok(s) => {
-                self.line.clear();
-                self.line.push_str(s);
-                Ok(Some(Line {
-                    text: &self.line,
-                    no: self.lineno,
-                    file: &self.name,
-                }))
-            }
+            Ok(text) => Ok(Some(Line {
+                text,
+                no: self.lineno,
+                file: &self.name,
+            })),
             Err(e) => bail!(
                 "{}:{}: not UTF-8 text at byte {} of the line (a binary file?)",
                 self.name,

@@ -53,7 +53,12 @@ pub fn create(path: &Path, header: &str) -> Result<AtomicFile> {
 pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
     let d = 180.0 / std::f64::consts::PI;
     // longitude written in [-180, 180) whatever the navigator accumulated
-    let lon_deg = (r.lon * d + 180.0).rem_euclid(360.0) - 180.0;
+    let lon_deg = r.lon * d;
+    let lon_deg = if (-180.0..180.0).contains(&lon_deg) {
+        lon_deg // unchanged to the last bit
+    } else {
+        (lon_deg + 180.0).rem_euclid(360.0) - 180.0
+    };
     let cols: [(f64, usize); 10] = [
         (r.t, 4),
         (r.lat * d, 11),
