@@ -17,7 +17,7 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 /// Names of the targets, as `fuzz/fuzz_targets/NAME.rs` and `fuzz/corpus/NAME/` use them.
-pub const TARGETS: [&str; 11] = [
+pub const TARGETS: [&str; 12] = [
     "spec",
     "units",
     "scenario",
@@ -29,6 +29,7 @@ pub const TARGETS: [&str; 11] = [
     "rtklib_pos",
     "aiding",
     "truth",
+    "matlab",
 ];
 
 /// The target function of a name in [`TARGETS`].
@@ -45,6 +46,7 @@ pub fn target(name: &str) -> Option<fn(&[u8])> {
         "rtklib_pos" => Some(rtklib_pos),
         "aiding" => Some(aiding),
         "truth" => Some(truth),
+        "matlab" => Some(matlab),
         _ => None,
     }
 }
@@ -444,6 +446,31 @@ pub fn truth(data: &[u8]) {
                 Ok(None) => {}
                 Err(_) => break,
             }
+        }
+    }
+}
+
+/// A MATLAB `.mat` file: as an IMU array through [`ImuStream::open`] (checked like every
+/// stream) and as a reference `avp` array (accepted rows finite, angles in radians' range).
+pub fn matlab(data: &[u8]) {
+    let p = files(&[("log.mat", data)]);
+    if let Ok((s, _)) = crate::io::imu_stream::ImuStream::open(&p[0], None) {
+        check_imu(s);
+    }
+    if let Ok(rows) = crate::io::truth::read(&p[0]) {
+        for r in &rows {
+            for v in [r.t, r.lat, r.lon, r.h]
+                .iter()
+                .chain(r.v.iter())
+                .chain(r.euler.iter())
+            {
+                finite(*v, "avp value");
+            }
+            assert!(
+                r.lat.abs() <= std::f64::consts::FRAC_PI_2,
+                "accepted latitude {}",
+                r.lat
+            );
         }
     }
 }

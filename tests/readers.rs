@@ -3,6 +3,8 @@
 use sinsmodel::io::readers::{gnss_imu, psins, rtklib};
 use std::path::PathBuf;
 
+mod common;
+
 fn data(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/data")
@@ -136,4 +138,106 @@ fn gnss_imu_csv_without_tag_takes_a_clock_offset() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// A PSINS user's MATLAB file: the drive scenario simulated by the project, its increments
+/// turned into PSINS `[wm vm t]` (right-forward-up) and its truth into `avp`, written as a
+/// level-5 `.mat`; `filter --imu FILE.mat:imu --truth FILE.mat:avp` gives the same navigation
+/// solution, number for number, as the same data in the project's text files.
+#[test]
+fn matlab_file_reads_like_the_text_it_came_from() {
+    use sinsmodel::io::readers::matlab;
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sim = dir.path().join("drive");
+    let (ok, _, err) = common::sinsmodel(&[
+        "simulate",
+        root.join("scenarios/drive.toml").to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let imu = sinsmodel::io::imu::read_text(&sim.join("imu.txt")).unwrap();
+    let truth = sinsmodel::io::truth::read(&sim.join("truth.txt")).unwrap();
+    let mut wm_vm_t = Vec::new();
+    for s in &imu.samples {
+        // FRD → PSINS X right, Y forward, Z up
+        wm_vm_t.extend_from_slice(&[s.dtheta.y, s.dtheta.x, -s.dtheta.z]);
+        wm_vm_t.extend_from_slice(&[s.dv.y, s.dv.x, -s.dv.z, s.t]);
+    }
+    let mut avp = Vec::new();
+    for r in &truth {
+        // [pitch roll yaw] with yaw west of north, [vE vN vU], [lat lon h], t
+        avp.extend_from_slice(&[r.euler.y, r.euler.x, -r.euler.z, r.v.y, r.v.x, -r.v.z]);
+        avp.extend_from_slice(&[r.lat, r.lon, r.h, r.t]);
+    }
+    let mat = dir.path().join("drive.mat");
+    matlab::write(&mat, &[("imu", &wm_vm_t, 7), ("avp", &avp, 10)]).unwrap();
+    let run = |imu: String, truth: String, out: &str| {
+        let out = dir.path().join(out);
+        let (ok, _, err) = common::sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            &imu,
+            "--truth",
+            &truth,
+            "--aid",
+            sim.join("gnss.txt").to_str().unwrap(),
+            "--nav-rate",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        let rows = |name: &str| -> Vec<String> {
+            std::fs::read_to_string(out.join(name))
+                .unwrap()
+                .lines()
+                .filter(|l| !l.starts_with('#'))
+                .map(String::from)
+                .collect()
+        };
+        (rows("nav.txt"), rows("states.txt"), err)
+    };
+    let m = mat.to_str().unwrap();
+    let (nav_mat, states_mat, err) = run(format!("{m}:imu"), format!("{m}:avp"), "mat");
+    assert!(
+        err.contains("MATLAB variable") && err.contains("right-forward-up"),
+        "{err}"
+    );
+    let (nav_txt, states_txt, _) = run(
+        sim.join("imu.txt").to_str().unwrap().into(),
+        sim.join("truth.txt").to_str().unwrap().into(),
+        "txt",
+    );
+    assert!(nav_mat.len() > 100, "{}", nav_mat.len());
+    assert_eq!(nav_mat, nav_txt);
+    assert_eq!(states_mat, states_txt);
+    // the variable can be left out when one array has the columns; a wrong one is named
+    let (ok, _, err) = common::sinsmodel(&["imu-check", "--imu", m]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = common::sinsmodel(&["imu-check", "--imu", &format!("{m}:wm")]);
+    assert!(
+        !ok && err.contains("no numeric array `wm`")
+            && err.contains("imu (")
+            && err.contains("avp ("),
+        "{err}"
+    );
+    // an output is never written over the .mat it reads
+    let (ok, _, err) = common::sinsmodel(&[
+        "navigate",
+        "--imu",
+        &format!("{m}:imu"),
+        "--lat",
+        "30",
+        "--lon",
+        "114",
+        "--att",
+        "0,0,0",
+        "--out",
+        m,
+    ]);
+    assert!(!ok && err.contains("input"), "{err}");
 }

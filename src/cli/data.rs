@@ -47,7 +47,7 @@ impl ImuSource {
 
     /// The input files (so outputs never land on them).
     pub fn paths(&self) -> Vec<PathBuf> {
-        let mut v = vec![self.imu.clone()];
+        let mut v = vec![sinsmodel::io::readers::matlab::file_of(&self.imu)];
         v.extend(self.imu_format.clone());
         v.extend(sinsmodel::io::imu_format::beside(&self.imu));
         v
@@ -335,7 +335,7 @@ impl DataArgs {
     }
 
     /// The input files named by the options (so outputs never land on them).
-    pub fn input_paths(&self) -> Vec<&std::path::Path> {
+    pub fn input_paths(&self) -> Vec<PathBuf> {
         [
             &self.imu,
             &self.imu_format,
@@ -345,7 +345,7 @@ impl DataArgs {
         ]
         .into_iter()
         .flatten()
-        .map(|p| p.as_path())
+        .map(|p| sinsmodel::io::readers::matlab::file_of(p))
         .collect()
     }
 

@@ -73,7 +73,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
             );
         }
         for inp in args.data.input_paths() {
-            if same_file(j, inp) {
+            if same_file(j, &inp) {
                 bail!(
                     "--json {}: that is an input file; choose another",
                     j.display()
@@ -100,7 +100,9 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         args.data.config(&baseline, true)?;
         let mut opts = opts.clone();
         opts.candidate_sigma = args.data.term_priors()?;
-        let out = OutputDir::create(&args.out, &args.data.input_paths())?;
+        let inputs = args.data.input_paths();
+        let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+        let out = OutputDir::create(&args.out, &refs)?;
         args.data.print_noise()?;
         let inputs = args.data.load_for_passes()?;
         let data = ExplainData {

@@ -38,7 +38,9 @@ pub struct FilterArgs {
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
     let cfg = args.data.config(&model, false)?;
-    let out = OutputDir::create(&args.out, &args.data.input_paths())?;
+    let inputs = args.data.input_paths();
+    let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let out = OutputDir::create(&args.out, &refs)?;
     args.data.print_noise()?;
     let mut inputs = args.data.open()?;
     if args.in_memory {

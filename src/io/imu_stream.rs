@@ -193,7 +193,17 @@ impl ImuStream {
             }
         }
         use crate::io::imu_format::{beside, ImuFormat};
-        use crate::io::readers::{gnss_imu, psins};
+        use crate::io::readers::{gnss_imu, matlab, psins};
+        if let Some((file, var)) = matlab::split(path) {
+            if format.is_some() {
+                bail!("--imu-format describes text layouts; a .mat file is read as a PSINS [wm vm t] array");
+            }
+            let (data, name) = matlab::read_imu(&file, var.as_deref())?;
+            let how = format!(
+                "as a PSINS [wm(3) vm(3) t] array of increments, right-forward-up, from MATLAB variable {name} (chosen by its extension)"
+            );
+            return Ok((ImuStream::from_data(data, &name)?, how));
+        }
         let name = path.display().to_string();
         if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
             bail!(

@@ -141,16 +141,26 @@ impl TruthLookup for TruthSlice<'_> {
 
 /// A truth file read as the lookups advance: memory does not grow with the file.
 pub struct TruthReader {
-    rows: TableRows<std::io::BufReader<std::fs::File>>,
+    rows: Option<TableRows<std::io::BufReader<std::fs::File>>>,
+    /// Rows of a `.mat` reference array (read whole).
+    mem: std::vec::IntoIter<TruthRow>,
     cur: Option<TruthRow>,
 }
 
 impl TruthReader {
     /// Opens a truth file; refuses one without data rows.
     pub fn open(path: &Path) -> Result<TruthReader> {
-        let mut r = TruthReader {
-            rows: TableRows::open(path, 10, "truth file")?,
-            cur: None,
+        let mut r = match crate::io::readers::matlab::split(path) {
+            Some((file, var)) => TruthReader {
+                rows: None,
+                mem: crate::io::readers::matlab::read_avp(&file, var.as_deref())?.into_iter(),
+                cur: None,
+            },
+            None => TruthReader {
+                rows: Some(TableRows::open(path, 10, "truth file")?),
+                mem: Vec::new().into_iter(),
+                cur: None,
+            },
         };
         r.cur = r.read_row()?;
         if r.cur.is_none() {
@@ -160,8 +170,11 @@ impl TruthReader {
     }
 
     fn read_row(&mut self) -> Result<Option<TruthRow>> {
-        let name = self.rows.name().to_string();
-        match self.rows.next_row()? {
+        let Some(rows) = self.rows.as_mut() else {
+            return Ok(self.mem.next());
+        };
+        let name = rows.name().to_string();
+        match rows.next_row()? {
             Some((line, v)) => Ok(Some(row_from(&name, line, v)?)),
             None => Ok(None),
         }
@@ -190,6 +203,9 @@ impl TruthLookup for TruthReader {
 
 /// Reads a truth file whole (errors name file and line; time must increase).
 pub fn read(path: &Path) -> Result<Vec<TruthRow>> {
+    if let Some((file, var)) = crate::io::readers::matlab::split(path) {
+        return crate::io::readers::matlab::read_avp(&file, var.as_deref());
+    }
     let mut t = TableRows::open(path, 10, "truth file")?;
     let name = t.name().to_string();
     let mut rows = Vec::new();

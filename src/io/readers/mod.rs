@@ -2,6 +2,7 @@
 //! (FRD body increments, NED, SI).
 
 pub mod gnss_imu;
+pub mod matlab;
 pub mod psins;
 pub mod rtklib;
 
