@@ -262,9 +262,9 @@ pub fn read_avp(path: &Path, var: Option<&str>) -> Result<Vec<TruthRow>> {
                 );
             }
         }
-        for c in 3..6 {
-            if v[c].abs() > 1e4 {
-                bail!("{}: velocity {} m/s is beyond ±1e4 m/s", at(c), v[c]);
+        for (c, x) in v.iter().enumerate().take(6).skip(3) {
+            if x.abs() > 1e4 {
+                bail!("{}: velocity {x} m/s is beyond ±1e4 m/s", at(c));
             }
         }
         if let Some(p) = crate::io::bounds::height_m(v[8]) {
@@ -308,7 +308,7 @@ pub fn write(path: &Path, arrays: &[(&str, &[f64], usize)]) -> Result<()> {
     out.extend_from_slice(&0x0100u16.to_le_bytes());
     out.extend_from_slice(b"IM");
     let pad8 = |v: &mut Vec<u8>| {
-        while v.len() % 8 != 0 {
+        while !v.len().is_multiple_of(8) {
             v.push(0);
         }
     };
