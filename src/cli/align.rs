@@ -89,18 +89,22 @@ pub fn run(args: &AlignArgs) -> Result<()> {
     if let Some(n) = &a.heading_note {
         println!("{n}");
     }
-    match args.lat {
-        Some(_) => println!("latitude {:.4} deg (given)", a.lat_deg),
-        None if a.lat_sigma_deg > 0.0 => println!(
-            "latitude {:.4} deg (estimated from the Earth-rate and gravity directions, 1-sigma {:.4} deg)",
-            a.lat_deg, a.lat_sigma_deg
+    match (args.lat, a.lat_deg) {
+        (Some(_), Some(l)) => println!("latitude {l:.4} deg (given)"),
+        (_, None) => println!(
+            "latitude: not determined (it comes from the Earth rate's direction, which the gyro bias hides); pass --lat"
         ),
-        None => println!(
-            "latitude {:.4} deg (estimated from one window only: no spread to give a sigma; pass --lat if known)",
-            a.lat_deg
+        (None, Some(l)) if a.lat_sigma_deg > 0.0 => println!(
+            "latitude {l:.4} deg (estimated from the Earth-rate and gravity directions, 1-sigma {:.4} deg)",
+            a.lat_sigma_deg
+        ),
+        (None, Some(l)) => println!(
+            "latitude {l:.4} deg (estimated from one window only: no spread to give a sigma; pass --lat if known)"
         ),
     }
-    if a.heading_windows_deg.is_empty() {
+    if a.heading_deg.is_none() {
+        // no coarse heading either: the same gyros
+    } else if a.heading_windows_deg.is_empty() {
         println!("coarse heading: no complete one-minute window in the static data");
     } else {
         let (lo, hi) = a

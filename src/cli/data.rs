@@ -97,9 +97,15 @@ pub struct DataArgs {
     /// Truth file (t lat lon h vn ve vd roll pitch yaw): adds the true φ and the model error.
     #[arg(long)]
     truth: Option<PathBuf>,
-    /// Initial lat,lon [deg],h [m],roll,pitch,yaw [deg][,vn,ve,vd m/s]; default: the first truth row.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    init: Option<Vec<f64>>,
+    /// Initial lat,lon [deg],h [m],roll,pitch,yaw [deg][,vn,ve,vd m/s], or `auto`: level from
+    /// the first seconds at rest, heading by gyrocompassing (when the grade allows) or from the
+    /// GNSS course of the drive-off, or from the course at a moving start (docs/real-data.md);
+    /// default: the first truth row.
+    #[arg(long, allow_hyphen_values = true)]
+    init: Option<String>,
+    /// With `--init auto`: the GNSS speed [m/s] above which the course gives the heading.
+    #[arg(long)]
+    init_speed: Option<f64>,
     /// open (errors estimated only) or closed (fed back).
     #[arg(long, default_value = "open")]
     mode: String,
@@ -197,6 +203,26 @@ fn grade_table(grade: Option<&str>) -> Result<Option<&'static Grade>> {
     }
 }
 
+/// Raises the attitude priors of `cfg` to what `--init auto` found: tilt 1-σ for phi_n and
+/// phi_e, heading 1-σ for phi_d [rad] (a prior already wider is kept).
+pub fn widen_attitude_priors(
+    cfg: &mut FilterConfig,
+    model: &Model,
+    init_sigma: Option<(f64, f64)>,
+) {
+    let Some((tilt, yaw)) = init_sigma else {
+        return;
+    };
+    for (i, name) in model.names.iter().enumerate() {
+        let s = match *name {
+            "phi_n" | "phi_e" => tilt,
+            "phi_d" => yaw,
+            _ => continue,
+        };
+        cfg.prior_sigma[i] = cfg.prior_sigma[i].max(s);
+    }
+}
+
 /// What the data options load for a command that passes over the data more than once: the IMU
 /// file (read again on every pass), aiding epochs, truth, the initial state.
 pub struct Inputs {
@@ -212,6 +238,8 @@ pub struct Inputs {
     pub truth: Option<Vec<TruthRow>>,
     /// Initial navigation state.
     pub start: NavState,
+    /// With `--init auto`: 1-σ of the found tilt and heading [rad].
+    pub init_sigma: Option<(f64, f64)>,
 }
 
 /// The data options opened for one streamed pass.
@@ -226,6 +254,8 @@ pub struct Opened {
     pub start: NavState,
     /// GNSS outages (aiding dropped inside).
     pub outages: Vec<Outage>,
+    /// With `--init auto`: 1-σ of the found tilt and heading [rad], for the attitude priors.
+    pub init_sigma: Option<(f64, f64)>,
 }
 
 /// Where the aiding epochs come from.
@@ -474,6 +504,7 @@ impl DataArgs {
             .collect();
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
         Ok(Inputs {
+            init_sigma: opened.init_sigma,
             imu: self.imu.clone().context("--imu FILE is required")?,
             imu_format: self.imu_format.clone(),
             clock_offset: self.clock_offset,
@@ -492,7 +523,7 @@ impl DataArgs {
             bail!("--step {}: expected a filter step in (0, 10] s", args.step);
         }
         let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
-        let (imu, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
+        let (mut imu, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
             imu_path,
             args.imu_format.as_deref(),
             args.clock_offset,
@@ -610,7 +641,42 @@ impl DataArgs {
             );
         }
         let d = std::f64::consts::PI / 180.0;
-        let start = match (&args.init, &mut truth_reader) {
+        let init_values: Option<Vec<f64>> = match args.init.as_deref() {
+            None | Some("auto") => None,
+            Some(text) => Some(
+                text.split(',')
+                    .map(|x| x.trim().parse::<f64>())
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| {
+                        anyhow::anyhow!(
+                            "--init `{}`: expected auto or lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (numbers, deg, m, m/s)",
+                            sinsmodel::io::lines::shown(text)
+                        )
+                    })?,
+            ),
+        };
+        let auto = args.init.as_deref() == Some("auto");
+        if args.init_speed.is_some() && !auto {
+            bail!("--init-speed applies to --init auto");
+        }
+        let mut init_sigma = None;
+        let start = match (&init_values, &mut truth_reader) {
+            _ if auto => {
+                let found = self.auto_init(&fixes)?;
+                for line in &found.report {
+                    eprintln!("init auto: {line}");
+                }
+                init_sigma = Some((found.sigma_tilt, found.sigma_yaw));
+                // the run starts after the start's sample
+                let skipped = imu.skip_through(found.state.t + 1e-9)?;
+                if skipped > 0 {
+                    eprintln!(
+                        "init auto: {skipped} IMU samples before {:.3} s skipped",
+                        found.state.t
+                    );
+                }
+                found.state
+            }
             (Some(v), _) => {
                 if v.len() != 6 && v.len() != 9 {
                     bail!(
@@ -672,6 +738,7 @@ impl DataArgs {
             }
             (None, None) => bail!("give --init or --truth for the initial state"),
         };
+        let t0 = start.t;
         let e = start.euler();
         let (roll, pitch) = (e.x, e.y);
         let head = sinsmodel::io::imu::ImuData {
@@ -679,6 +746,7 @@ impl DataArgs {
         };
         if let Some(p) =
             sinsmodel::estimate::align::attitude_contradicts_gravity(&head, roll, pitch)
+                .filter(|_| !auto)
         {
             if args.force {
                 eprintln!("warning: {p} (--force given)");
@@ -756,7 +824,80 @@ impl DataArgs {
             truth: truth_reader,
             start,
             outages,
+            init_sigma,
         })
+    }
+
+    /// `--init auto`: reads the IMU file from its start (a second pass, memory bounded by
+    /// quarter-second means) until [`init::find`] decides.
+    fn auto_init(&self, plan: &AidPlan) -> Result<sinsmodel::estimate::init::AutoInit> {
+        use sinsmodel::estimate::init::{self, Blocks, Fix, Found, Priors};
+        let speed = self.init_speed.unwrap_or(init::DEFAULT_SPEED);
+        if !(speed.is_finite() && (0.5..=100.0).contains(&speed)) {
+            bail!("--init-speed {speed}: expected a speed in [0.5, 100] m/s");
+        }
+        // the bias priors the run will use (grade, --prior)
+        let m = Model::parse("P28")?;
+        let cfg = self.config(&m, true)?;
+        let prior = |name: &str| {
+            m.names
+                .iter()
+                .position(|n| *n == name)
+                .map(|i| cfg.prior_sigma[i])
+        };
+        let priors = Priors {
+            gyro_bias: prior("eps_x").context("P28 has eps_x")?,
+            accel_bias: prior("nabla_x").context("P28 has nabla_x")?,
+            speed,
+        };
+        let (mut fixes, static_pos) = match plan {
+            AidPlan::Fixes(list, _, _) => (
+                list.iter()
+                    .map(|(p, v)| Fix {
+                        t: p.t,
+                        pos: [p.lat, p.lon, p.h],
+                        v: v.map(|v| Vector3::from(v.v_ned)),
+                        sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
+                    })
+                    .collect::<Vec<_>>(),
+                None,
+            ),
+            AidPlan::Static { fix, .. } => (Vec::new(), Some([fix.lat, fix.lon, fix.h])),
+        };
+        let sigma_pos = match plan {
+            AidPlan::Fixes(list, _, _) => list
+                .iter()
+                .map(|f| f.0.sigma[0].max(f.0.sigma[1]))
+                .fold(0.0, f64::max),
+            AidPlan::Static { .. } => 0.1,
+        };
+        init::velocities_from_positions(&mut fixes, sigma_pos);
+        let imu_path = self.imu.as_ref().context("--imu FILE is required")?;
+        let (mut stream, _) = sinsmodel::io::imu_stream::ImuStream::open_with(
+            imu_path,
+            self.imu_format.as_deref(),
+            self.clock_offset,
+        )?;
+        let dt = stream.interval();
+        let mut blocks = Blocks::default();
+        let mut next_look = 10.0;
+        loop {
+            let s = stream.next()?;
+            if let Some(s) = &s {
+                blocks.push(s, dt);
+                if blocks.seconds() < next_look {
+                    continue;
+                }
+                next_look = blocks.seconds() + 10.0;
+            }
+            match init::find(&blocks.blocks, &fixes, static_pos, priors, s.is_none())? {
+                Found::Done(a) => return Ok(*a),
+                Found::NeedMore if s.is_none() => {
+                    bail!("--init auto: the IMU data end before a start is found")
+                }
+                Found::NeedMore => {}
+            }
+        }
     }
 
     /// The filter configuration for `model`: mode, step, vertical channel, `--prior` and

@@ -110,12 +110,17 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
                 path: &inputs.imu,
                 format: inputs.imu_format.as_deref(),
                 clock_offset: inputs.clock_offset,
+                skip_through: inputs.start.t + 1e-9,
             },
             aid: &inputs.aid,
             truth: inputs.truth.as_deref(),
             start: inputs.start,
         };
-        let config_for = |m: &Model| args.data.config(m, true);
+        let config_for = |m: &Model| {
+            let mut c = args.data.config(m, true)?;
+            super::data::widen_attitude_priors(&mut c, m, inputs.init_sigma);
+            Ok(c)
+        };
         let e = run_explain(&baseline, &cands, &data, &config_for, &opts)?;
         finish(args, out, &e, &args.data.describe(), &skipped)
     } else {

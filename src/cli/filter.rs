@@ -37,7 +37,7 @@ pub struct FilterArgs {
 /// and the directory appears only when the run succeeded.
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
-    let cfg = args.data.config(&model, false)?;
+    let mut cfg = args.data.config(&model, false)?;
     let inputs = args.data.input_paths();
     let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     let out = OutputDir::create(&args.out, &refs)?;
@@ -47,6 +47,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         inputs.imu = inputs.imu.into_memory()?;
     }
     let start = inputs.start;
+    super::data::widen_attitude_priors(&mut cfg, &model, inputs.init_sigma);
     let provenance = super::command_line();
     let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
 

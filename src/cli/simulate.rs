@@ -84,17 +84,35 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     imu::write_text(&out.file("imu.txt"), &sim.imu, &header)?;
     truth::write(&out.file("truth.txt"), &sim.truth, &header)?;
     if !sim.gnss.is_empty() {
-        aiding::write(&out.file("gnss.txt"), &sim.gnss, &header)?;
+        aiding::write_with_velocity(
+            &out.file("gnss.txt"),
+            &sim.gnss,
+            sim.gnss_velocity.as_deref(),
+            &header,
+        )?;
     }
     atomic_file::write_text(&out.file("scenario.toml"), &sc.text)?;
     out.commit()?;
     eprintln!(
-        "simulated {} IMU samples ({:.1} s at {} Hz), {} truth rows, {} GNSS fixes into {}",
+        "simulated {} IMU samples ({:.1} s at {} Hz{}), {} truth rows, {} GNSS fixes{} into {}",
         sim.imu.samples.len(),
         sim.imu.duration(),
         sc.imu_rate_hz,
+        if sc.clock_jitter_periods > 1 {
+            format!(
+                ", a jittered clock: each sample spans 1 to {} periods",
+                sc.clock_jitter_periods
+            )
+        } else {
+            String::new()
+        },
         sim.truth.len(),
         sim.gnss.len(),
+        if sim.gnss_velocity.is_some() {
+            " with velocities"
+        } else {
+            ""
+        },
         args.out.display()
     );
     Ok(())

@@ -196,16 +196,19 @@ pub struct Alignment {
     /// Gyro-bias 1-σ used in the fine alignment [deg/h]: the given prior, widened to the bias
     /// the data show at rest when that is larger.
     pub gyro_bias_sigma_used_deg_h: f64,
-    /// Latitude: given, or estimated [deg].
-    pub lat_deg: f64,
-    /// 1-σ of the estimated latitude [deg] (0 when given).
+    /// Latitude: given, or estimated [deg]; None when the gyro bias hides the Earth rate (the
+    /// latitude comes from its direction) and none was given.
+    pub lat_deg: Option<f64>,
+    /// 1-σ of the estimated latitude [deg]: the scatter of one-minute estimates and the gyro
+    /// bias against the Earth rate (0 when given).
     pub lat_sigma_deg: f64,
     /// Seconds skipped as disturbed at the start.
     pub skipped_s: f64,
-    /// Coarse heading per window of the used data [deg] (evidence of stability).
+    /// Coarse heading per window of the used data [deg] (evidence of stability); empty when
+    /// the gyros cannot find north.
     pub heading_windows_deg: Vec<f64>,
-    /// Coarse latitude estimate [deg].
-    pub coarse_lat_deg: f64,
+    /// Coarse latitude estimate [deg]; None when the gyros cannot see the Earth rate.
+    pub coarse_lat_deg: Option<f64>,
     /// Estimated gyro biases after fine alignment [deg/h].
     pub gyro_bias_deg_h: [f64; 3],
 }
@@ -411,15 +414,24 @@ pub fn align(
         heading_sigma_deg: (!no_heading).then(|| last.sigma[i_phid] * deg),
         heading_note,
         gyro_bias_sigma_used_deg_h: bias_sigma * deg_h,
-        lat_deg: lat_used * deg,
-        lat_sigma_deg: if lat.is_some() { 0.0 } else { lat_sigma * deg },
+        lat_deg: (lat.is_some() || !no_heading).then_some(lat_used * deg),
+        // the bias tilts the measured Earth rate by up to σ_b / Ω
+        lat_sigma_deg: if lat.is_some() {
+            0.0
+        } else {
+            lat_sigma.hypot(bias_sigma / crate::nav::earth::OMEGA) * deg
+        },
         // rounded to the microsecond: q0·dt carries the interval's binary rounding
         skipped_s: (q0 as f64 * dt * 1e6).round() / 1e6,
-        heading_windows_deg: windows
-            .iter()
-            .map(|x| (x.euler.z * deg).rem_euclid(360.0))
-            .collect(),
-        coarse_lat_deg: c.lat * deg,
+        heading_windows_deg: if no_heading {
+            Vec::new()
+        } else {
+            windows
+                .iter()
+                .map(|x| (x.euler.z * deg).rem_euclid(360.0))
+                .collect()
+        },
+        coarse_lat_deg: (!no_heading).then_some(c.lat * deg),
         gyro_bias_deg_h: [eps[0], eps[1], eps[2]],
     })
 }

@@ -97,6 +97,9 @@ pub enum ImuInput<'a> {
         format: Option<&'a std::path::Path>,
         /// GPST − IMU clock offset [s] (`--clock-offset`), when given.
         clock_offset: Option<f64>,
+        /// Samples at or before this time [s] are skipped (a run that starts later than the
+        /// file, `--init auto`).
+        skip_through: f64,
     },
 }
 
@@ -109,8 +112,12 @@ impl ImuInput<'_> {
                 path,
                 format,
                 clock_offset,
+                skip_through,
             } => {
-                Box::new(crate::io::imu_stream::ImuStream::open_with(path, format, clock_offset)?.0)
+                let mut s =
+                    crate::io::imu_stream::ImuStream::open_with(path, format, clock_offset)?.0;
+                s.skip_through(skip_through)?;
+                Box::new(s)
             }
         })
     }

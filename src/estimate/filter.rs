@@ -808,6 +808,10 @@ pub fn run_stream(
     let mut prev_t = start.t;
     let mut k = 0u64;
     let mut next = io.samples.next_sample()?;
+    // a run that starts after the first samples (`--init auto`) skips them
+    while next.is_some_and(|s| s.t <= start.t + 1e-9) {
+        next = io.samples.next_sample()?;
+    }
     let mut diverged = None;
     while let Some(smp) = next {
         next = io.samples.next_sample()?;

@@ -7,5 +7,6 @@ pub mod explain;
 pub mod explain_eval;
 pub mod filter;
 pub mod imu_check;
+pub mod init;
 pub mod mounting;
 pub mod stats;

@@ -34,14 +34,35 @@ pub struct VelocityFix {
 
 /// Writes fixes atomically.
 pub fn write(path: &Path, rows: &[PositionFix], header: &str) -> Result<()> {
+    write_with_velocity(path, rows, None, header)
+}
+
+/// Writes fixes atomically, with a velocity per fix (11 columns: `… v_n v_e v_d sigma_v`) when
+/// `velocities` is given (one per fix).
+pub fn write_with_velocity(
+    path: &Path,
+    rows: &[PositionFix],
+    velocities: Option<&[VelocityFix]>,
+    header: &str,
+) -> Result<()> {
+    if velocities.is_some_and(|v| v.len() != rows.len()) {
+        anyhow::bail!("{}: one velocity per fix is needed", path.display());
+    }
     let mut f = AtomicFile::create(path)?;
     let w = f.writer();
     for l in header.lines() {
         writeln!(w, "# {l}")?;
     }
-    writeln!(w, "# t[s] lat lon [deg] h[m] sigma_n sigma_e sigma_d [m]")?;
-    for r in rows {
+    if velocities.is_some() {
         writeln!(
+            w,
+            "# t[s] lat lon [deg] h[m] sigma_n sigma_e sigma_d [m] v_n v_e v_d sigma_v [m/s]"
+        )?;
+    } else {
+        writeln!(w, "# t[s] lat lon [deg] h[m] sigma_n sigma_e sigma_d [m]")?;
+    }
+    for (k, r) in rows.iter().enumerate() {
+        write!(
             w,
             "{:.4} {:.11} {:.11} {:.4} {:.4} {:.4} {:.4}",
             r.t,
@@ -52,6 +73,14 @@ pub fn write(path: &Path, rows: &[PositionFix], header: &str) -> Result<()> {
             r.sigma[1],
             r.sigma[2]
         )?;
+        if let Some(v) = velocities.map(|v| &v[k]) {
+            write!(
+                w,
+                " {:.4} {:.4} {:.4} {:.4}",
+                v.v_ned[0], v.v_ned[1], v.v_ned[2], v.sigma
+            )?;
+        }
+        writeln!(w)?;
     }
     f.commit()
 }

@@ -89,6 +89,8 @@ pub struct ImuStream {
     prev_t: Option<f64>,
     delivered: u64,
     last_t: f64,
+    /// A sample read by [`ImuStream::skip_through`] past its time, handed out next.
+    pending: Option<ImuSample>,
 }
 
 impl ImuStream {
@@ -157,6 +159,7 @@ impl ImuStream {
             prev_t: None,
             delivered: 0,
             last_t: f64::NAN,
+            pending: None,
         };
         // validate the head in order, as every later sample will be (prev_t then stands at the
         // last head sample, where the samples after the head continue)
@@ -335,6 +338,9 @@ impl ImuStream {
     /// The next validated sample, or None at the end of the file.
     #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> Result<Option<ImuSample>> {
+        if let Some(s) = self.pending.take() {
+            return Ok(Some(s));
+        }
         let s = if let Some(&s) = self.head.get(self.head_next) {
             // validated when the stream opened
             self.head_next += 1;
@@ -349,6 +355,20 @@ impl ImuStream {
         self.delivered += 1;
         self.last_t = s.t;
         Ok(Some(s))
+    }
+
+    /// Reads and drops the samples whose time is at or before `t` [s] (a run that starts at
+    /// `t`); returns how many.
+    pub fn skip_through(&mut self, t: f64) -> Result<u64> {
+        let mut n = 0;
+        while let Some(s) = self.next()? {
+            if s.t > t {
+                self.pending = Some(s);
+                break;
+            }
+            n += 1;
+        }
+        Ok(n)
     }
 
     /// The samples read ahead when the stream opened (the first [`HEAD_SECONDS`]).

@@ -89,6 +89,9 @@ pub struct GnssSpec {
     /// Add Gaussian noise with those σ (default true).
     #[serde(default = "yes")]
     pub noisy: bool,
+    /// 1-σ of a GNSS velocity written with each fix (e.g. "0.05 m/s"); none by default.
+    #[serde(default)]
+    pub sigma_v: Option<String>,
 }
 
 fn default_sigma_ne() -> String {
@@ -139,6 +142,8 @@ struct RawScenario {
     noise: NoiseSpec,
     #[serde(default)]
     gnss: Option<GnssSpec>,
+    #[serde(default)]
+    clock_jitter_periods: Option<u32>,
 }
 
 fn default_truth_rate() -> f64 {
@@ -168,6 +173,11 @@ pub struct Scenario {
     pub noise: NoiseSi,
     /// GNSS aiding (rate [Hz], σ_ne [m], σ_d [m], noisy).
     pub gnss: Option<(f64, f64, f64, bool)>,
+    /// GNSS velocity 1-σ [m/s] when the fixes carry a velocity.
+    pub gnss_sigma_v: Option<f64>,
+    /// A jittered IMU clock: each output sample spans 1 to this many periods of `imu_rate_hz`
+    /// at random (1: a uniform clock).
+    pub clock_jitter_periods: u32,
     /// Remarks that are not errors (vibration above the IMU's Nyquist frequency).
     pub warnings: Vec<String>,
     /// The scenario text, for provenance.
@@ -525,6 +535,24 @@ impl Scenario {
             }
             None => None,
         };
+        let gnss_sigma_v = match raw.gnss.as_ref().and_then(|g| g.sigma_v.as_ref()) {
+            Some(v) => {
+                let sv = units::parse_quantity_as(v, "m/s")
+                    .map_err(|e| anyhow!("{}: [gnss] sigma_v: {e}", at("sigma_v")))?;
+                if !(sv > 0.0 && sv <= 100.0) {
+                    bail!("{}: [gnss] sigma_v must be in (0, 100] m/s", at("sigma_v"));
+                }
+                Some(sv)
+            }
+            None => None,
+        };
+        let clock_jitter_periods = raw.clock_jitter_periods.unwrap_or(1);
+        if !(1..=4).contains(&clock_jitter_periods) {
+            bail!(
+                "{}: clock_jitter_periods = {clock_jitter_periods} must be 1 (a uniform clock) to 4 (samples spanning 1 to 4 periods; the readers refuse gaps over 5 median intervals)",
+                at("clock_jitter_periods")
+            );
+        }
         Ok(Scenario {
             name: raw.name,
             imu_rate_hz,
@@ -536,6 +564,8 @@ impl Scenario {
             errors,
             noise,
             gnss,
+            gnss_sigma_v,
+            clock_jitter_periods,
             text: text.to_string(),
             warnings,
         })

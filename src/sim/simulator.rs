@@ -24,6 +24,8 @@ pub struct SimOutput {
     pub truth: Vec<TruthRow>,
     /// GNSS fixes.
     pub gnss: Vec<PositionFix>,
+    /// GNSS velocities, one per fix, when the scenario's `[gnss]` gives `sigma_v`.
+    pub gnss_velocity: Option<Vec<crate::io::aiding::VelocityFix>>,
     /// True navigation state at t = 0 (to start a navigator).
     pub start: NavState,
 }
@@ -68,6 +70,8 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         })
         .collect();
     let mut rng = Rng::new(sc.seed);
+    // GNSS velocity noise on a stream of its own: adding velocities changes no other draw
+    let mut rng_v = Rng::new(sc.seed ^ 0xbb67_ae85_84ca_a73b);
     let d = std::f64::consts::PI / 180.0;
     let (mut lat, mut lon, mut h) = (sc.start.lat_deg * d, sc.start.lon_deg * d, sc.start.h_m);
     let k0 = traj.at(0.0);
@@ -92,6 +96,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         euler: k0.euler,
     }];
     let mut gnss = Vec::new();
+    let mut gnss_velocity = Vec::new();
     let mut samples = Vec::with_capacity(n);
     let mut gyro_bias = Vector3::zeros();
     let mut accel_bias = Vector3::zeros();
@@ -189,6 +194,18 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                     h: gh,
                     sigma: [sne, sne, sd],
                 });
+                if let Some(sv) = sc.gnss_sigma_v {
+                    let mut v = traj.at(t1).v;
+                    if noisy {
+                        for j in 0..3 {
+                            v[j] += sv * rng_v.normal();
+                        }
+                    }
+                    gnss_velocity.push(crate::io::aiding::VelocityFix {
+                        v_ned: [v.x, v.y, v.z],
+                        sigma: sv,
+                    });
+                }
             }
         }
         if i % report_every == 0 {
@@ -196,10 +213,46 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         }
     }
     progress(1.0);
+    if sc.clock_jitter_periods > 1 {
+        samples = jitter_clock(samples, sc.clock_jitter_periods, sc.seed);
+    }
     SimOutput {
         imu: ImuData { samples },
         truth,
         gnss,
+        gnss_velocity: sc.gnss_sigma_v.map(|_| gnss_velocity),
         start,
     }
+}
+
+/// A jittered IMU clock: consecutive samples merged so that each output sample spans 1 to
+/// `max_periods` base periods at random (its increments the sums over its real interval, as an
+/// IMU whose output timing jitters delivers them). Its own random stream, so the base samples,
+/// truth and GNSS are those of the uniform clock.
+fn jitter_clock(samples: Vec<ImuSample>, max_periods: u32, seed: u64) -> Vec<ImuSample> {
+    let mut rng = Rng::new(seed ^ 0x6a09_e667_f3bc_c908);
+    let mut out = Vec::with_capacity(samples.len());
+    let mut it = samples.into_iter();
+    'outer: loop {
+        let k = 1
+            + (rng.uniform() * max_periods as f64)
+                .floor()
+                .min(max_periods as f64 - 1.0) as u32;
+        let Some(mut s) = it.next() else { break };
+        for _ in 1..k {
+            match it.next() {
+                Some(n) => {
+                    s.t = n.t;
+                    s.dtheta += n.dtheta;
+                    s.dv += n.dv;
+                }
+                None => {
+                    out.push(s);
+                    break 'outer;
+                }
+            }
+        }
+        out.push(s);
+    }
+    out
 }

@@ -1,0 +1,618 @@
+//! `--init auto`: the initial navigation state found in the data, NED/FRD, SI.
+//!
+//! The IMU is reduced to quarter-second means of specific force and angular rate (each
+//! increment over its own interval, so a jittered clock gives the uniform clock's means). Then:
+//!
+//! - **Quiet start** (the first seconds at rest by the absolute tests of
+//!   [`crate::estimate::align::RestEvidence`], before the GNSS shows motion): roll and pitch from
+//!   the mean specific force over the whole quiet stretch; yaw by gyrocompassing when the gyro
+//!   bias prior lets the Earth rate show north to 1° and the stretch lasts 60 s, else from the
+//!   drive-off: the direction of the first acceleration after the stretch, levelled, matched to
+//!   the GNSS course once the speed exceeds the threshold (no assumption on how the IMU is
+//!   mounted in the vehicle: the angle between the IMU's x axis and the direction of travel is
+//!   found, [`crate::estimate::mounting`]'s method). The run starts at the quiet stretch's start,
+//!   at rest.
+//! - **Moving start** (no quiet stretch before the vehicle moves): the run starts at the first
+//!   GNSS fix faster than the threshold; yaw is the GNSS course there (this assumes the IMU's x
+//!   axis points along the direction of travel: the data cannot say otherwise), roll and pitch
+//!   from the mean specific force around it corrected by the GNSS acceleration; position and
+//!   velocity from the GNSS.
+//!
+//! Each found angle comes with a 1-σ the filter starts from.
+
+use crate::estimate::align::{STATIC_F_SPREAD, STATIC_G_ERROR, STATIC_W_SPREAD};
+use crate::io::imu::ImuSample;
+use crate::nav::attitude::{dcm_from_euler, euler_from_dcm};
+use crate::nav::earth;
+use crate::nav::strapdown::NavState;
+use anyhow::{bail, Result};
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+
+/// Length of one block of IMU means [s].
+pub const BLOCK_S: f64 = 0.25;
+/// Shortest quiet stretch that levels the IMU [s].
+pub const MIN_QUIET_S: f64 = 3.0;
+/// Shortest quiet stretch for gyrocompassing [s].
+pub const GYROCOMPASS_S: f64 = 60.0;
+/// Largest heading 1-σ gyrocompassing may give before the drive-off is used instead [rad] (1°).
+pub const GYROCOMPASS_MAX_SIGMA: f64 = std::f64::consts::PI / 180.0;
+/// Default GNSS speed above which the course gives the heading [m/s].
+pub const DEFAULT_SPEED: f64 = 3.0;
+/// Smallest levelled drive-off acceleration whose direction is used [m/s²].
+pub const MIN_DRIVE_OFF_ACCEL: f64 = 0.3;
+/// Seconds of IMU data searched for a start before giving up [s].
+pub const SEARCH_S: f64 = 1800.0;
+/// Heading 1-σ allowed for the vehicle turning during a drive-off, or for a course that is not
+/// the IMU's x axis (side slip) at a moving start [rad] (2°).
+const COURSE_SLACK: f64 = 2.0 * std::f64::consts::PI / 180.0;
+
+/// Mean specific force and angular rate over one block, FRD.
+#[derive(Debug, Clone, Copy)]
+pub struct Block {
+    /// Time of the block's first increment's start [s].
+    pub t_start: f64,
+    /// Time of its last increment's end [s] (a sample time).
+    pub t_end: f64,
+    /// Mean specific force [m/s²].
+    pub f: Vector3<f64>,
+    /// Mean angular rate [rad/s].
+    pub w: Vector3<f64>,
+}
+
+/// Builds [`Block`]s from samples as they come.
+#[derive(Debug, Default)]
+pub struct Blocks {
+    /// The finished blocks.
+    pub blocks: Vec<Block>,
+    prev_t: Option<f64>,
+    start: f64,
+    sum_dv: Vector3<f64>,
+    sum_dth: Vector3<f64>,
+}
+
+impl Blocks {
+    /// Adds one sample; `first_interval` [s] is taken as the first sample's interval.
+    pub fn push(&mut self, s: &ImuSample, first_interval: f64) {
+        if self.prev_t.is_none() {
+            self.start = s.t - first_interval;
+        }
+        self.sum_dv += s.dv;
+        self.sum_dth += s.dtheta;
+        self.prev_t = Some(s.t);
+        let span = s.t - self.start;
+        if span >= BLOCK_S * (1.0 - 1e-9) {
+            self.blocks.push(Block {
+                t_start: self.start,
+                t_end: s.t,
+                f: self.sum_dv / span,
+                w: self.sum_dth / span,
+            });
+            self.start = s.t;
+            self.sum_dv = Vector3::zeros();
+            self.sum_dth = Vector3::zeros();
+        }
+    }
+
+    /// Seconds covered by the finished blocks.
+    pub fn seconds(&self) -> f64 {
+        match (self.blocks.first(), self.blocks.last()) {
+            (Some(a), Some(b)) => b.t_end - a.t_start,
+            _ => 0.0,
+        }
+    }
+}
+
+/// One GNSS fix as `--init auto` uses it.
+#[derive(Debug, Clone, Copy)]
+pub struct Fix {
+    /// Time [s].
+    pub t: f64,
+    /// Latitude, longitude [rad], height [m].
+    pub pos: [f64; 3],
+    /// NED velocity [m/s]: the receiver's, or from the neighbouring positions.
+    pub v: Option<Vector3<f64>>,
+    /// 1-σ of each velocity component [m/s].
+    pub sigma_v: f64,
+}
+
+impl Fix {
+    fn speed(&self) -> f64 {
+        self.v.map(|v| v.x.hypot(v.y)).unwrap_or(0.0)
+    }
+}
+
+/// Fills the velocity of fixes that have none from the neighbouring positions (central
+/// differences over at most 2.5 s; σ from the position σ `sigma_pos` [m]).
+pub fn velocities_from_positions(fixes: &mut [Fix], sigma_pos: f64) {
+    let n = fixes.len();
+    for k in 0..n {
+        if fixes[k].v.is_some() {
+            continue;
+        }
+        let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+        let dt = fixes[b].t - fixes[a].t;
+        if a == b || !(dt > 0.0 && dt <= 2.5) {
+            continue;
+        }
+        let (pa, pb) = (fixes[a].pos, fixes[b].pos);
+        let lat = pa[0];
+        let rm = earth::radius_meridian(lat) + pa[2];
+        let rn = earth::radius_transverse(lat) + pa[2];
+        let v = Vector3::new(
+            (pb[0] - pa[0]) * rm / dt,
+            (pb[1] - pa[1]) * rn * lat.cos() / dt,
+            -(pb[2] - pa[2]) / dt,
+        );
+        fixes[k].v = Some(v);
+        fixes[k].sigma_v = std::f64::consts::SQRT_2 * sigma_pos / dt;
+    }
+}
+
+/// Priors that decide how the heading can be found.
+#[derive(Debug, Clone, Copy)]
+pub struct Priors {
+    /// Gyro bias 1-σ [rad/s].
+    pub gyro_bias: f64,
+    /// Accelerometer bias 1-σ [m/s²].
+    pub accel_bias: f64,
+    /// GNSS speed above which the course is used [m/s].
+    pub speed: f64,
+}
+
+/// What `--init auto` found.
+#[derive(Debug, Clone)]
+pub struct AutoInit {
+    /// The initial state (its time a sample time; the run starts after it).
+    pub state: NavState,
+    /// 1-σ of roll/pitch (tilt about north and east) [rad].
+    pub sigma_tilt: f64,
+    /// 1-σ of the heading [rad].
+    pub sigma_yaw: f64,
+    /// How each part was found, one line each, for the terminal.
+    pub report: Vec<String>,
+    /// Direction of travel from the IMU's x axis, positive to the right [rad], when a drive-off
+    /// showed it (the mounting yaw).
+    pub travel_from_x: Option<f64>,
+}
+
+/// The outcome of looking at the data read so far.
+#[derive(Debug)]
+pub enum Found {
+    /// A start was found.
+    Done(Box<AutoInit>),
+    /// More data are needed to decide.
+    NeedMore,
+}
+
+fn tilt_from(f: Vector3<f64>) -> (f64, f64) {
+    (
+        (-f.y).atan2(-f.z),
+        f.x.atan2((f.y * f.y + f.z * f.z).sqrt()),
+    )
+}
+
+fn mean_of(blocks: &[Block]) -> (Vector3<f64>, Vector3<f64>) {
+    let mut span = 0.0;
+    let (mut f, mut w) = (Vector3::zeros(), Vector3::zeros());
+    for b in blocks {
+        let d = b.t_end - b.t_start;
+        f += b.f * d;
+        w += b.w * d;
+        span += d;
+    }
+    (f / span, w / span)
+}
+
+/// One whole second (4 blocks): its span, mean specific force and rate, and whether it passes
+/// the tests of rest (angular-rate spread, |f| against gravity).
+struct Second {
+    t_start: f64,
+    t_end: f64,
+    f: Vector3<f64>,
+    w: Vector3<f64>,
+    ok: bool,
+}
+
+fn seconds(blocks: &[Block], g: f64) -> Vec<Second> {
+    let per = (1.0 / BLOCK_S).round() as usize;
+    blocks
+        .chunks(per)
+        .filter(|c| c.len() == per)
+        .map(|c| {
+            let (fm, wm) = mean_of(c);
+            let k = c.len() as f64;
+            let ws = (c.iter().map(|b| (b.w - wm).norm_squared()).sum::<f64>() / k).sqrt();
+            Second {
+                t_start: c[0].t_start,
+                t_end: c[per - 1].t_end,
+                f: fm,
+                w: wm,
+                // the specific force's spread is left out: vibration of a parked vehicle with
+                // its engine on spreads quarter-second means without moving it
+                ok: ws <= STATIC_W_SPREAD && (fm.norm() - g).abs() <= STATIC_G_ERROR,
+            }
+        })
+        .collect()
+}
+
+/// The first stretch at rest: from the first second that passes the tests of rest (and the
+/// next one too), on while the seconds pass them (one failing second between two passing ones
+/// is a bump, not motion), their mean force and rate stay within twice the rest spreads of the
+/// stretch's mean (a smooth drive-off changes the mean, not the spread), and the GNSS shows no
+/// motion. Returns (first second, end second, ended) with `ended` false while more data could
+/// extend it.
+fn quiet_stretch(
+    secs: &[Second],
+    motion_t: Option<f64>,
+    at_end: bool,
+    min_s: usize,
+) -> Option<(usize, usize, bool)> {
+    let n = secs.len();
+    let before_motion = |k: usize| motion_t.is_none_or(|tm| secs[k].t_end <= tm - 0.5);
+    let mut k = 0;
+    while k < n {
+        if !(secs[k].ok && before_motion(k)) {
+            if !before_motion(k) {
+                return None;
+            }
+            k += 1;
+            continue;
+        }
+        let (mut fsum, mut wsum) = (secs[k].f, secs[k].w);
+        let mut e = k + 1;
+        let mut ended = false;
+        while e < n {
+            let m = (e - k) as f64;
+            let (fbar, wbar) = (fsum / m, wsum / m);
+            let s = &secs[e];
+            let bump = !s.ok && e + 1 < n && secs[e + 1].ok;
+            let undecided = !s.ok && e + 1 == n && !at_end;
+            if undecided {
+                break;
+            }
+            let steady = (s.f - fbar).norm() <= 2.0 * STATIC_F_SPREAD
+                && (s.w - wbar).norm() <= 2.0 * STATIC_W_SPREAD;
+            if !((s.ok || bump) && steady && before_motion(e)) {
+                ended = true;
+                break;
+            }
+            fsum += s.f;
+            wsum += s.w;
+            e += 1;
+        }
+        if e == n && (at_end || !before_motion(n - 1)) {
+            ended = true;
+        }
+        if e - k >= min_s || !ended {
+            return Some((k, e, ended));
+        }
+        k = e;
+    }
+    None
+}
+
+fn deg(x: f64) -> f64 {
+    x.to_degrees()
+}
+
+/// Looks for a start in the blocks read so far and the GNSS fixes (`at_end`: no more IMU data
+/// will come); `static_pos` is a known position of a static vehicle (no course then).
+pub fn find(
+    blocks: &[Block],
+    fixes: &[Fix],
+    static_pos: Option<[f64; 3]>,
+    priors: Priors,
+    at_end: bool,
+) -> Result<Found> {
+    let Some(first) = blocks.first() else {
+        return if at_end {
+            bail!("--init auto: the IMU file is shorter than {BLOCK_S} s")
+        } else {
+            Ok(Found::NeedMore)
+        };
+    };
+    let t0 = first.t_start;
+    let t_read = blocks.last().map(|b| b.t_end).unwrap_or(t0);
+    let pos0 = match (static_pos, fixes.iter().find(|f| f.t >= t0 - 1.0)) {
+        (Some(p), _) => p,
+        (None, Some(f)) => f.pos,
+        (None, None) => bail!("--init auto: no GNSS fix at or after the IMU start ({t0:.3} s) to take the position from"),
+    };
+    let g = earth::gravity(pos0[0], pos0[2]);
+    let secs = seconds(blocks, g);
+    // the first GNSS fix that shows motion (speed above 0.5 m/s)
+    let first_motion = fixes
+        .iter()
+        .find(|f| f.t >= t0 && f.speed() > 0.5)
+        .map(|f| f.t);
+    let min_q = MIN_QUIET_S.round() as usize;
+    let quiet = quiet_stretch(&secs, first_motion, at_end, min_q);
+    let d = std::f64::consts::PI / 180.0;
+    let sigma_tilt = (priors.accel_bias / g).max(0.01 * d);
+    match quiet {
+        Some((k, e, closed)) if e - k >= min_q || !closed => {
+            if e - k < min_q {
+                return Ok(Found::NeedMore);
+            }
+            let (t_a, t_b) = (secs[k].t_start, secs[e - 1].t_end);
+            let q: Vec<Block> = blocks
+                .iter()
+                .filter(|b| b.t_start >= t_a - 1e-9 && b.t_end <= t_b + 1e-9)
+                .copied()
+                .collect();
+            let (f, w) = mean_of(&q);
+            let (roll, pitch) = tilt_from(f);
+            let t_q = q[0].t_start;
+            let q_s = q.last().unwrap().t_end - t_q;
+            let mut report = vec![format!(
+                "level: roll {:.3} deg, pitch {:.3} deg from {:.1} s at rest from t = {:.3} s (1-sigma {:.3} deg from the accelerometer bias prior)",
+                deg(roll),
+                deg(pitch),
+                q_s,
+                t_q,
+                deg(sigma_tilt)
+            )];
+            // the scatter of the 1-s means at rest: noise and vibration, as the data show them
+            let rest_secs = &secs[k..e];
+            let nsec = rest_secs.len() as f64;
+            let scatter = |v: &dyn Fn(&Second) -> Vector3<f64>, mean: Vector3<f64>| {
+                (rest_secs
+                    .iter()
+                    .map(|x| (v(x) - mean).norm_squared())
+                    .sum::<f64>()
+                    / (nsec - 1.0).max(1.0))
+                .sqrt()
+            };
+            let f_scatter = scatter(&|x| x.f, f);
+            let w_scatter = scatter(&|x| x.w, w);
+            let horiz_rate = earth::OMEGA * pos0[0].cos();
+            // heading 1-σ of gyrocompassing: the bias prior and the noise of the mean rate
+            let gc_bias = priors.gyro_bias / horiz_rate;
+            let gc_sigma = priors.gyro_bias.hypot(w_scatter / nsec.sqrt()) / horiz_rate;
+            let state = |yaw: f64| NavState {
+                t: t_q,
+                lat: pos0[0],
+                lon: pos0[1],
+                h: pos0[2],
+                v: Vector3::zeros(),
+                q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+                    dcm_from_euler(roll, pitch, yaw),
+                )),
+            };
+            let gc_possible = gc_bias <= GYROCOMPASS_MAX_SIGMA;
+            if gc_possible && !closed {
+                // a longer rest may still bring the noise down
+                return Ok(Found::NeedMore);
+            }
+            if gc_possible && q_s >= GYROCOMPASS_S && gc_sigma <= GYROCOMPASS_MAX_SIGMA {
+                let wl = dcm_from_euler(roll, pitch, 0.0) * w;
+                let yaw = (-wl.y).atan2(wl.x);
+                report.push(format!(
+                    "heading: {:.3} deg by gyrocompassing {:.1} s at rest (1-sigma {:.3} deg: gyro bias prior {:.4} deg/h and the scatter of the mean rate, against the Earth rate)",
+                    deg(yaw.rem_euclid(2.0 * std::f64::consts::PI)),
+                    q_s,
+                    deg(gc_sigma),
+                    priors.gyro_bias.to_degrees() * 3600.0
+                ));
+                return Ok(Found::Done(Box::new(AutoInit {
+                    state: state(yaw),
+                    sigma_tilt,
+                    sigma_yaw: gc_sigma,
+                    report,
+                    travel_from_x: None,
+                })));
+            }
+            let gc_ok = gc_possible;
+            // the drive-off after the quiet stretch
+            let t_b = q.last().unwrap().t_end;
+            let Some(fx) = fixes.iter().find(|f| f.t > t_b && f.speed() > priors.speed) else {
+                if at_end || static_pos.is_some() {
+                    bail!(
+                        "--init auto: no heading: {} and the GNSS speed never exceeds {} m/s after the {:.1} s at rest (to take the course of a drive-off); give the heading with --init LAT,LON,H,ROLL,PITCH,YAW",
+                        if gc_ok {
+                            format!(
+                                "gyrocompassing the {q_s:.0} s at rest gives a heading 1-sigma of {:.2} deg (used at 1 deg or better, over at least {GYROCOMPASS_S:.0} s)",
+                                deg(gc_sigma)
+                            )
+                        } else {
+                            format!(
+                                "the gyros cannot find north (their bias prior {:.3} deg/h gives a gyrocompass heading 1-sigma of {:.1} deg)",
+                                priors.gyro_bias.to_degrees() * 3600.0,
+                                deg(gc_sigma)
+                            )
+                        },
+                        priors.speed,
+                        q_s
+                    );
+                }
+                if t_read - t_b > SEARCH_S {
+                    bail!("--init auto: no heading within {SEARCH_S:.0} s of the end of the stretch at rest: the GNSS speed never exceeds {} m/s", priors.speed);
+                }
+                return Ok(Found::NeedMore);
+            };
+            if t_read < fx.t {
+                return Ok(Found::NeedMore);
+            }
+            // the acceleration: from the end of rest (at most 2 s before the GNSS shows motion)
+            // for at most 5 s, not past the fix
+            let t_m = first_motion.unwrap_or(t_b).max(t_b);
+            let (w0, w1) = ((t_m - 2.0).max(t_b), fx.t.min(t_m + 3.0));
+            let acc: Vec<Block> = blocks
+                .iter()
+                .filter(|b| b.t_start >= w0 - 1e-9 && b.t_end <= w1 + 1e-9)
+                .copied()
+                .collect();
+            if acc.is_empty() {
+                bail!("--init auto: no IMU data between the end of rest ({t_b:.3} s) and the fix at {:.3} s", fx.t);
+            }
+            let (fa, _) = mean_of(&acc);
+            let a_level = dcm_from_euler(roll, pitch, 0.0) * (fa - f);
+            let a_h = a_level.x.hypot(a_level.y);
+            if a_h < MIN_DRIVE_OFF_ACCEL {
+                bail!(
+                    "--init auto: the drive-off after {t_b:.3} s accelerates only {a_h:.3} m/s^2 horizontally (at least {MIN_DRIVE_OFF_ACCEL} needed to see its direction); give the heading with --init LAT,LON,H,ROLL,PITCH,YAW"
+                );
+            }
+            let v = fx.v.unwrap();
+            let course = v.y.atan2(v.x);
+            let travel = a_level.y.atan2(a_level.x);
+            let yaw = course - travel;
+            // the accelerometer bias is in both means and cancels; their noise does not
+            let acc_s = acc.last().unwrap().t_end - w0;
+            let sigma_a = f_scatter * (1.0 / nsec + 1.0 / acc_s.max(BLOCK_S)).sqrt();
+            let sigma_yaw = ((sigma_a / a_h).powi(2)
+                + (fx.sigma_v / fx.speed()).powi(2)
+                + COURSE_SLACK.powi(2))
+            .sqrt();
+            report.push(format!(
+                "heading: {:.3} deg from the drive-off: acceleration {:.2} m/s^2 at {:.1} deg from the IMU x axis over {:.2} s after t = {:.3} s, GNSS course {:.2} deg at {:.3} s ({:.1} m/s); 1-sigma {:.2} deg (accelerometer noise, course noise, {:.0} deg for a turn during the drive-off)",
+                deg(yaw.rem_euclid(2.0 * std::f64::consts::PI)),
+                a_h,
+                deg(travel),
+                acc.last().unwrap().t_end - w0,
+                w0,
+                deg(course.rem_euclid(2.0 * std::f64::consts::PI)),
+                fx.t,
+                fx.speed(),
+                deg(sigma_yaw),
+                deg(COURSE_SLACK)
+            ));
+            report.push(format!(
+                "mounting: the direction of travel is {:.1} deg {} of the IMU x axis (roll {:.2} deg, pitch {:.2} deg of the IMU at rest)",
+                deg(travel.abs()),
+                if travel >= 0.0 { "right" } else { "left" },
+                deg(roll),
+                deg(pitch)
+            ));
+            Ok(Found::Done(Box::new(AutoInit {
+                state: state(yaw),
+                sigma_tilt,
+                sigma_yaw,
+                report,
+                travel_from_x: Some(travel),
+            })))
+        }
+        _ => {
+            // no quiet stretch before the motion: a moving start
+            if first_motion.is_none() {
+                if at_end || static_pos.is_some() {
+                    bail!(
+                        "--init auto: the IMU is never at rest for {MIN_QUIET_S:.0} s (by the absolute tests of `align`) and the GNSS never shows motion: nothing to level or head by; give --init LAT,LON,H,ROLL,PITCH,YAW"
+                    );
+                }
+                if t_read - t0 > SEARCH_S {
+                    bail!("--init auto: neither rest nor GNSS motion in the first {SEARCH_S:.0} s");
+                }
+                return Ok(Found::NeedMore);
+            }
+            // the first fast fix with neighbours for the acceleration and IMU data around it
+            let fast = (1..fixes.len().saturating_sub(1)).find(|&k| {
+                let f = &fixes[k];
+                f.t >= t0 + 0.5
+                    && f.speed() > priors.speed
+                    && fixes[k - 1].v.is_some()
+                    && fixes[k + 1].v.is_some()
+                    && fixes[k + 1].t - fixes[k - 1].t <= 5.0
+            });
+            let Some(k) = fast else {
+                if at_end {
+                    bail!(
+                        "--init auto: the data start moving, and the GNSS speed never exceeds {} m/s (with fixes either side) to take a heading from the course; give --init LAT,LON,H,ROLL,PITCH,YAW",
+                        priors.speed
+                    );
+                }
+                return Ok(Found::NeedMore);
+            };
+            let fx = fixes[k];
+            if t_read < fx.t + 0.5 {
+                return if at_end {
+                    bail!(
+                        "--init auto: the IMU data end at the first fast GNSS fix ({:.3} s)",
+                        fx.t
+                    )
+                } else {
+                    Ok(Found::NeedMore)
+                };
+            }
+            let around: Vec<Block> = blocks
+                .iter()
+                .filter(|b| b.t_start >= fx.t - 0.5 - 1e-9 && b.t_end <= fx.t + 0.5 + 1e-9)
+                .copied()
+                .collect();
+            if around.is_empty() {
+                bail!(
+                    "--init auto: no IMU data around the GNSS fix at {:.3} s",
+                    fx.t
+                );
+            }
+            let (f, _) = mean_of(&around);
+            let (va, vb) = (fixes[k - 1].v.unwrap(), fixes[k + 1].v.unwrap());
+            let a_n = (vb - va) / (fixes[k + 1].t - fixes[k - 1].t);
+            let v = fx.v.unwrap();
+            let yaw = v.y.atan2(v.x);
+            // f_b = C_n^b (a_n − g_n): the tilt that turns f_b into a_n − g_n, the heading the course
+            let (r0, p0) = tilt_from(f);
+            let u = dcm_from_euler(0.0, 0.0, yaw).transpose() * (a_n - Vector3::new(0.0, 0.0, g));
+            let level_f = dcm_from_euler(r0, p0, 0.0) * f;
+            let tilt =
+                Rotation3::rotation_between(&level_f, &u).unwrap_or_else(Rotation3::identity);
+            let e = euler_from_dcm(&(tilt.matrix() * dcm_from_euler(r0, p0, 0.0)));
+            let (roll, pitch) = (e.x, e.y);
+            // the start: the last block end at or before the fix, position moved back to it
+            let t_s = blocks
+                .iter()
+                .map(|b| b.t_end)
+                .filter(|t| *t <= fx.t + 1e-9)
+                .fold(t0, f64::max);
+            let back = fx.t - t_s;
+            let rm = earth::radius_meridian(fx.pos[0]) + fx.pos[2];
+            let rn = earth::radius_transverse(fx.pos[0]) + fx.pos[2];
+            let pos = [
+                fx.pos[0] - v.x * back / rm,
+                fx.pos[1] - v.y * back / (rn * fx.pos[0].cos()),
+                fx.pos[2] + v.z * back,
+            ];
+            let v_s = v - a_n * back;
+            let sigma_tilt = (sigma_tilt.powi(2) + (0.05 / g).powi(2)).sqrt();
+            let sigma_yaw = ((fx.sigma_v / fx.speed()).powi(2) + COURSE_SLACK.powi(2)).sqrt();
+            let report = vec![
+                format!(
+                    "the data start moving (no {MIN_QUIET_S:.0} s at rest before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s",
+                    first_motion.unwrap(),
+                    t_s,
+                    priors.speed
+                ),
+                format!(
+                    "heading: {:.3} deg = the GNSS course at {:.3} s ({:.1} m/s; this assumes the IMU x axis points along the direction of travel); 1-sigma {:.2} deg",
+                    deg(yaw.rem_euclid(2.0 * std::f64::consts::PI)),
+                    fx.t,
+                    fx.speed(),
+                    deg(sigma_yaw)
+                ),
+                format!(
+                    "level: roll {:.3} deg, pitch {:.3} deg from the specific force over 1 s around it less the GNSS acceleration ({:.2} m/s^2); 1-sigma {:.3} deg",
+                    deg(roll),
+                    deg(pitch),
+                    a_n.norm(),
+                    deg(sigma_tilt)
+                ),
+            ];
+            Ok(Found::Done(Box::new(AutoInit {
+                state: NavState {
+                    t: t_s,
+                    lat: pos[0],
+                    lon: pos[1],
+                    h: pos[2],
+                    v: v_s,
+                    q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+                        dcm_from_euler(roll, pitch, yaw),
+                    )),
+                },
+                sigma_tilt,
+                sigma_yaw,
+                report,
+                travel_from_x: None,
+            })))
+        }
+    }
+}
