@@ -1,0 +1,351 @@
+//! `--init auto` and the real-data case of issue 12, on data the project simulates: a quiet start
+//! with a drive-off (tactical grade: heading from the drive-off; an IMU mounted askew: the
+//! mounting found), a navigation-grade long rest (gyrocompassing), a MEMS IMU on a jittered clock
+//! that starts moving (`scenarios/mems_moving.toml`: align, allan, filter with velocity aiding and
+//! an outage), and the refusals.
+
+mod common;
+use common::sinsmodel;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Simulates `scenario` (a file) into `dir/name`.
+fn simulate(scenario: &Path, dir: &Path, name: &str) -> PathBuf {
+    let out = dir.join(name);
+    let (ok, _, err) = sinsmodel(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    out
+}
+
+/// A number after `key` in `text` (the first one).
+fn number_after(text: &str, key: &str) -> f64 {
+    let i = text
+        .find(key)
+        .unwrap_or_else(|| panic!("`{key}` not in {text}"))
+        + key.len();
+    text[i..]
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .trim_end_matches([',', ')', ';'])
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after `{key}` in {text}"))
+}
+
+fn filter(args: &[&str]) -> (bool, String) {
+    let mut a = vec!["filter"];
+    a.extend_from_slice(args);
+    let (ok, _, err) = sinsmodel(&a);
+    (ok, err)
+}
+
+/// Mean NIS of each channel line (`  pos_n  220 updates  mean NIS  1.08 …`).
+fn mean_nis(err: &str) -> Vec<f64> {
+    err.lines()
+        .filter(|l| l.contains(" updates ") && l.contains("mean NIS"))
+        .map(|l| number_after(l, "mean NIS"))
+        .collect()
+}
+
+/// The drive scenario (60 s at rest, then a 1.5 m/s² drive-off at heading 30°): a tactical grade
+/// cannot gyrocompass, so the heading comes from the drive-off, within its σ of the truth; the
+/// filter started there is consistent. With the IMU turned 20° in the vehicle, the heading found
+/// is the IMU's (50°) and the mounting line says the travel is 20° left of its x axis.
+#[test]
+fn quiet_start_heading_from_the_drive_off_and_the_mounting() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(&root().join("scenarios/drive.toml"), dir.path(), "drive");
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let out = dir.path().join("f");
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--grade",
+        "tactical",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--truth",
+        &s("truth.txt"),
+        "--init",
+        "auto",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("init auto: level:") && err.contains("from 60.0 s at rest"),
+        "{err}"
+    );
+    let yaw = number_after(&err, "heading: ");
+    let sigma = number_after(&err, "; 1-sigma ");
+    assert!(err.contains("from the drive-off"), "{err}");
+    assert!(
+        (yaw - 30.0).abs() < 3.0 * sigma && sigma < 3.0,
+        "heading {yaw} ± {sigma}"
+    );
+    for nis in mean_nis(&err) {
+        assert!(
+            nis > 0.7 && nis < 1.5,
+            "started from the found attitude: {err}"
+        );
+    }
+    // the IMU turned 20° right in the vehicle: x_s = (cos 20°, sin 20°, 0) in the vehicle's FRD
+    let mut imu = sinsmodel::io::imu::read_text(&sim.join("imu.txt")).unwrap();
+    let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), 20f64.to_radians());
+    for x in &mut imu.samples {
+        x.dtheta = r.transpose() * x.dtheta;
+        x.dv = r.transpose() * x.dv;
+    }
+    let turned = dir.path().join("turned.txt");
+    sinsmodel::io::imu::write_text(&turned, &imu, "the drive, IMU turned 20 deg about z").unwrap();
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--grade",
+        "tactical",
+        "--imu",
+        turned.to_str().unwrap(),
+        "--aid",
+        &s("gnss.txt"),
+        "--init",
+        "auto",
+        "--out",
+        dir.path().join("g").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let yaw = number_after(&err, "heading: ");
+    assert!((yaw - 50.0).abs() < 3.0 * sigma, "IMU heading {yaw}");
+    let travel = number_after(&err, "the direction of travel is ");
+    assert!(
+        (travel - 20.0).abs() < 1.0 && err.contains("deg left of the IMU x axis"),
+        "{err}"
+    );
+}
+
+/// A navigation-grade IMU standing 120 s before it drives off: north by gyrocompassing, to
+/// within its σ; with MEMS priors on the same data the drive-off is used instead.
+#[test]
+fn navigation_grade_rest_gyrocompasses() {
+    let dir = tempfile::tempdir().unwrap();
+    let scen = dir.path().join("nav.toml");
+    std::fs::write(
+        &scen,
+        "name = \"nav\"\nimu_rate_hz = 100.0\nseed = 21\n[start]\nlat_deg = 30.0\nlon_deg = 7.0\neuler_deg = [0.3, -0.2, 130.0]\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 120.0\n\
+         [[segment]]\nkind = \"accelerate\"\nduration_s = 8.0\naccel_mps2 = 1.0\n\
+         [[segment]]\nkind = \"cruise\"\nduration_s = 60.0\n\
+         [noise]\narw = \"0.001 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n\
+         [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.02 m\"\nsigma_d = \"0.05 m\"\n",
+    )
+    .unwrap();
+    let sim = simulate(&scen, dir.path(), "nav");
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--init",
+        "auto",
+        "--out",
+        dir.path().join("f").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("by gyrocompassing 120.0 s at rest"), "{err}");
+    let yaw = number_after(&err, "heading: ");
+    let sigma = number_after(&err, "(1-sigma ");
+    assert!(
+        (yaw - 130.0).abs() < 3.0 * sigma && sigma < 1.0,
+        "{yaw} ± {sigma}"
+    );
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--grade",
+        "mems",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--init",
+        "auto",
+        "--out",
+        dir.path().join("g").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("from the drive-off"), "{err}");
+}
+
+/// Issue 12's case: a MEMS IMU on a jittered clock, already moving when the log starts, GNSS
+/// positions and velocities; it stands 600 s at the end. `align` gives roll and pitch but no
+/// heading and no latitude, and says why; `allan` on the rest matches the uniform clock's noise
+/// within 2 %; `filter --init auto` starts from the GNSS course with velocity aiding, stays
+/// consistent and reports the drift of an outage.
+#[test]
+fn jittered_moving_mems_case_through_align_allan_and_filter() {
+    let dir = tempfile::tempdir().unwrap();
+    let scen = root().join("scenarios/mems_moving.toml");
+    let sim = simulate(&scen, dir.path(), "jittered");
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let imu = sinsmodel::io::imu::read_text(&sim.join("imu.txt")).unwrap();
+    assert!(imu.jitter_rms() > 0.2 * imu.interval(), "the clock jitters");
+
+    // align: honest about what MEMS gyros cannot give
+    let (ok, out, err) = sinsmodel(&["align", "--imu", &s("imu.txt")]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("heading: not determined") && out.contains("no heading: the gyro bias"),
+        "{out}"
+    );
+    assert!(out.contains("latitude: not determined"), "{out}");
+    let roll = number_after(&out, "roll ");
+    let pitch = number_after(&out, "pitch ");
+    // truth 0.5, -1.0; the accelerometer biases (up to 5 mg) tilt the level by up to 0.3°
+    assert!(
+        (roll - 0.5).abs() < 0.4 && (pitch + 1.0).abs() < 0.4,
+        "{out}"
+    );
+
+    // allan on the rest: the same base samples on a uniform clock
+    let text = std::fs::read_to_string(&scen)
+        .unwrap()
+        .replace("clock_jitter_periods = 2", "clock_jitter_periods = 1");
+    let uniform_scen = dir.path().join("uniform.toml");
+    std::fs::write(&uniform_scen, text).unwrap();
+    let uni = simulate(&uniform_scen, dir.path(), "uniform");
+    let allan = |d: &Path| -> serde_json::Value {
+        let j = d.join("allan.json");
+        let (ok, _, err) = sinsmodel(&[
+            "allan",
+            "--imu",
+            d.join("imu.txt").to_str().unwrap(),
+            "--skip",
+            "160",
+            "--json",
+            j.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        serde_json::from_str(&std::fs::read_to_string(j).unwrap()).unwrap()
+    };
+    let (aj, au) = (allan(&sim), allan(&uni));
+    let axes = [
+        "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+    ];
+    for axis in axes {
+        // white noise: ARW [rad/√s] of the gyros, VRW [m/s/√s] of the accelerometers
+        let (j, u) = (
+            aj["fit"][axis]["white"].as_f64().unwrap(),
+            au["fit"][axis]["white"].as_f64().unwrap(),
+        );
+        assert!(
+            (j / u - 1.0).abs() < 0.02,
+            "{axis}: jittered {j} vs uniform {u}"
+        );
+    }
+
+    // filter from a moving start, velocity aiding, one outage
+    let out_dir = dir.path().join("f");
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--mode",
+        "closed",
+        "--grade",
+        "mems",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--truth",
+        &s("truth.txt"),
+        "--init",
+        "auto",
+        "--outage",
+        "100,20",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("the data start moving"), "{err}");
+    let yaw = number_after(&err, "heading: ");
+    assert!((yaw - 60.0).abs() < 3.0, "GNSS course at the start: {yaw}");
+    assert!(
+        err.contains("vel_n") && err.contains("pos_n"),
+        "velocity and position aiding: {err}"
+    );
+    for nis in mean_nis(&err) {
+        assert!(nis > 0.7 && nis < 1.5, "{err}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("outages.json")).unwrap())
+            .unwrap();
+    let drift = json["outages"][0]["drift_horizontal_m"].as_f64().unwrap();
+    assert!(
+        drift > 0.0 && drift < 5.0,
+        "20 s outage on MEMS with a calibrated filter: {drift} m"
+    );
+    assert!(err.contains("GNSS outages: drift"), "{err}");
+}
+
+/// What `--init auto` cannot do, it says: a static MEMS log has no heading; `--init-speed`
+/// alone or out of range is refused; a wrong word for `--init` is named.
+#[test]
+fn init_auto_refusals() {
+    let dir = tempfile::tempdir().unwrap();
+    let scen = dir.path().join("still.toml");
+    std::fs::write(
+        &scen,
+        "name = \"still\"\nimu_rate_hz = 100.0\nseed = 3\n[start]\nlat_deg = 30.0\nlon_deg = 7.0\neuler_deg = [0.0, 0.0, 10.0]\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 90.0\n\
+         [errors]\neps_x = \"0.1 deg/s\"\n[noise]\narw = \"0.3 deg/sqrt(h)\"\nvrw = \"100 ug/sqrt(Hz)\"\n",
+    )
+    .unwrap();
+    let sim = simulate(&scen, dir.path(), "still");
+    let imu = sim.join("imu.txt");
+    let o = dir.path().join("f");
+    let base = [
+        "--model",
+        "P13",
+        "--imu",
+        imu.to_str().unwrap(),
+        "--static-aid",
+        "30,7,0",
+        "--out",
+        o.to_str().unwrap(),
+    ];
+    let run = |extra: &[&str]| {
+        let mut a: Vec<&str> = base.to_vec();
+        a.extend_from_slice(extra);
+        filter(&a)
+    };
+    let (ok, err) = run(&["--grade", "mems", "--init", "auto"]);
+    assert!(
+        !ok && err.contains("no heading") && err.contains("cannot find north"),
+        "{err}"
+    );
+    assert!(!o.exists(), "no output on a refusal");
+    let (ok, err) = run(&["--init-speed", "5", "--init", "30,7,0,0,0,10"]);
+    assert!(
+        !ok && err.contains("--init-speed applies to --init auto"),
+        "{err}"
+    );
+    let (ok, err) = run(&["--init", "auto", "--init-speed", "nan"]);
+    assert!(!ok && err.contains("--init-speed"), "{err}");
+    let (ok, err) = run(&["--init", "automatic"]);
+    assert!(
+        !ok && err.contains("--init `automatic`: expected auto or"),
+        "{err}"
+    );
+}
