@@ -16,7 +16,8 @@ use std::path::PathBuf;
 /// The IMU file and how to read it: the options of `navigate`, `align`, `allan`, `imu-check`.
 #[derive(Args, Clone, Debug)]
 pub struct ImuSource {
-    /// IMU file (text, PSINS .imu, GNSS_IMU .csv, or any layout --imu-format describes).
+    /// IMU file (text, PSINS .imu, FILE.mat:VARIABLE of PSINS [wm vm t], GNSS_IMU .csv, or any
+    /// layout --imu-format describes).
     #[arg(long)]
     pub imu: PathBuf,
     /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
@@ -64,7 +65,8 @@ impl ImuSource {
 /// The data options of `filter` and `explain`.
 #[derive(Args, Clone, Debug)]
 pub struct DataArgs {
-    /// IMU file (text, PSINS .imu, GNSS_IMU .csv, or any layout --imu-format describes).
+    /// IMU file (text, PSINS .imu, FILE.mat:VARIABLE of PSINS [wm vm t], GNSS_IMU .csv, or any
+    /// layout --imu-format describes).
     #[arg(long)]
     imu: Option<PathBuf>,
     /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
@@ -94,7 +96,8 @@ pub struct DataArgs {
     /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`.
     #[arg(long)]
     noise: Option<PathBuf>,
-    /// Truth file (t lat lon h vn ve vd roll pitch yaw): adds the true φ and the model error.
+    /// Truth file (t lat lon h vn ve vd roll pitch yaw), or a PSINS reference FILE.mat:avp: adds
+    /// the true φ and the model error.
     #[arg(long)]
     truth: Option<PathBuf>,
     /// Initial lat,lon [deg],h [m],roll,pitch,yaw [deg][,vn,ve,vd m/s], or `auto`: level from

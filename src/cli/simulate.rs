@@ -1,4 +1,4 @@
-//! `sinsmodel simulate SCENARIO.toml --out DIR [--force]`.
+//! `sinsmodel simulate SCENARIO.toml --out DIR [--force] [--mat]`.
 
 use anyhow::{bail, Result};
 use clap::Args;
@@ -21,6 +21,10 @@ pub struct SimulateArgs {
     /// Simulate even when the run would exceed the size limit (memory or output size).
     #[arg(long)]
     force: bool,
+    /// Also write data.mat as PSINS users keep data: `imu` = [wm(3) vm(3) t] increments,
+    /// right-forward-up, and `avp` = the truth (MATLAB level 5; read as --imu DIR/data.mat:imu).
+    #[arg(long)]
+    mat: bool,
 }
 
 /// Bytes of memory per IMU sample while simulating, and of text per sample in imu.txt
@@ -89,6 +93,24 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             &sim.gnss,
             sim.gnss_velocity.as_deref(),
             &header,
+        )?;
+    }
+    if args.mat {
+        use sinsmodel::io::readers::matlab;
+        let bytes = (sim.imu.samples.len() * matlab::IMU_COLUMNS
+            + sim.truth.len() * matlab::AVP_COLUMNS)
+            * 8;
+        if bytes as u64 > matlab::MAX_MAT_BYTES || sim.imu.samples.len() > i32::MAX as usize {
+            bail!("--mat: {bytes} bytes of arrays exceed the {} bytes a .mat is read with here; shorten the scenario", matlab::MAX_MAT_BYTES);
+        }
+        let imu_rows = matlab::psins_imu_rows(&sim.imu);
+        let avp_rows = matlab::psins_avp_rows(&sim.truth);
+        matlab::write(
+            &out.file("data.mat"),
+            &[
+                ("imu", &imu_rows, matlab::IMU_COLUMNS),
+                ("avp", &avp_rows, matlab::AVP_COLUMNS),
+            ],
         )?;
     }
     atomic_file::write_text(&out.file("scenario.toml"), &sc.text)?;

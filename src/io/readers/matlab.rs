@@ -292,6 +292,27 @@ pub fn read_avp(path: &Path, var: Option<&str>) -> Result<Vec<TruthRow>> {
     Ok(out)
 }
 
+/// IMU samples (FRD) as the rows of a PSINS `[wm(3) vm(3) t]` array (right-forward-up).
+pub fn psins_imu_rows(imu: &ImuData) -> Vec<f64> {
+    let mut rows = Vec::with_capacity(imu.samples.len() * IMU_COLUMNS);
+    for s in &imu.samples {
+        rows.extend_from_slice(&[s.dtheta.y, s.dtheta.x, -s.dtheta.z]);
+        rows.extend_from_slice(&[s.dv.y, s.dv.x, -s.dv.z, s.t]);
+    }
+    rows
+}
+
+/// Truth rows (NED/FRD) as the rows of a PSINS `avp` array
+/// `[pitch roll yaw (yaw west of north) vE vN vU lat lon h t]`, radians.
+pub fn psins_avp_rows(truth: &[TruthRow]) -> Vec<f64> {
+    let mut rows = Vec::with_capacity(truth.len() * AVP_COLUMNS);
+    for r in truth {
+        rows.extend_from_slice(&[r.euler.y, r.euler.x, -r.euler.z, r.v.y, r.v.x, -r.v.z]);
+        rows.extend_from_slice(&[r.lat, r.lon, r.h, r.t]);
+    }
+    rows
+}
+
 /// Writes arrays as a MATLAB level-5 `.mat` file (uncompressed, little-endian doubles): what the
 /// tests and `simulate --mat` use to make files PSINS users would have. Each array is given row
 /// after row with its column count.
