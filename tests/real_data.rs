@@ -1,14 +1,13 @@
-//! The MEMS drive end to end: mounting found from the data, the filter with RTK positions and
+//! The MEMS drive end to end: mounting found from the data (as `--init auto` finds it), the filter with RTK positions and
 //! the vertical channel, with the spec's default noise and with the noise identified by Allan
 //! deviation on the static start.
 
-use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 use sinsmodel::estimate::allan::{fit, oadev, uniform_rates};
 use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig, Mode};
 use sinsmodel::io::readers::{gnss_imu, rtklib};
 use sinsmodel::model::Model;
-use sinsmodel::nav::attitude::dcm_from_euler;
-use sinsmodel::nav::strapdown::{NavState, Vertical};
+use sinsmodel::nav::strapdown::Vertical;
 use std::path::PathBuf;
 
 #[test]
@@ -16,18 +15,40 @@ fn mems_drive_mounting_and_noise_identification() {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
     let log = gnss_imu::read(&d.join("imu_1934.csv")).unwrap();
     let pos = rtklib::read(&d.join("gnss_1934_sf.pos")).unwrap();
-    let m = sinsmodel::estimate::mounting::from_drive_off(&log.imu, &pos, 30.0).unwrap();
-    // sensor z points up (gravity reaction along +z) and the car drives off along sensor -x
-    assert!(m.f_static.z > 9.5, "{:?}", m.f_static);
-    assert!(m.forward_sensor.x < -0.9, "{:?}", m.forward_sensor);
-    eprintln!(
-        "mounting: euler {:?} deg, static |f| = {:.3} m/s^2",
-        m.euler.map(f64::to_degrees),
-        m.f_static.norm()
+    // the mounting, as `--init auto` finds it: level at rest, heading from the drive-off
+    use sinsmodel::estimate::init::{self, Blocks, Fix, Found, Priors};
+    let mut blocks = Blocks::default();
+    for s in &log.imu.samples {
+        blocks.push(s, log.imu.interval());
+    }
+    let fixes: Vec<Fix> = pos
+        .iter()
+        .map(|p| Fix {
+            t: p.t,
+            pos: [p.lat_deg.to_radians(), p.lon_deg.to_radians(), p.h],
+            v: p.v_ned.map(Vector3::from),
+            sigma_v: p.sigma_v_ne.map(|s| s[0].max(s[1])).unwrap_or(0.1),
+        })
+        .collect();
+    let priors = Priors {
+        gyro_bias: 0.5f64.to_radians(),
+        accel_bias: 0.5,
+        speed: init::DEFAULT_SPEED,
+    };
+    let Found::Done(m) = init::find(&blocks.blocks, &fixes, None, priors, true).unwrap() else {
+        panic!("no start found")
+    };
+    let e = m.state.euler().map(f64::to_degrees);
+    // sensor z points up (roll near 180°) and the car drives off along sensor -x
+    assert!(e.x.abs() > 170.0, "{e:?}");
+    let travel = m.travel_from_x.unwrap().to_degrees();
+    assert!(
+        travel.abs() > 150.0,
+        "travel {travel} deg from the sensor x axis"
     );
+    eprintln!("mounting: euler {e:?} deg, travel {travel:.1} deg from the sensor x axis");
 
     // Allan on the static start: white-noise densities for q
-    let dt = log.imu.interval();
     let t0 = log.imu.samples[0].t;
     let stat: Vec<_> = log.imu.samples.iter().filter(|s| s.t < t0 + 30.0).collect();
     // the clock jitters (8–11 ms): increments resampled in time, as `sinsmodel allan` does
@@ -44,22 +65,10 @@ fn mems_drive_mounting_and_noise_identification() {
     let vrw = ((3..6).map(|c| dens(c).powi(2)).sum::<f64>() / 3.0).sqrt();
 
     let model = Model::parse("P13+vertical").unwrap();
-    let p0 = pos
-        .iter()
-        .min_by(|a, b| (a.t - (t0 - dt)).abs().total_cmp(&(b.t - (t0 - dt)).abs()))
-        .unwrap();
-    let c = dcm_from_euler(m.euler.x, m.euler.y, m.euler.z);
-    let start = NavState {
-        t: t0 - dt,
-        lat: p0.lat_deg.to_radians(),
-        lon: p0.lon_deg.to_radians(),
-        h: p0.h,
-        v: Vector3::zeros(),
-        q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
-    };
+    let start = m.state;
     let aid: Vec<AidingEpoch> = pos
         .iter()
-        .filter(|p| p.t > t0)
+        .filter(|p| p.t > start.t)
         .map(|p| AidingEpoch {
             t: p.t,
             vel: None,

@@ -1,5 +1,6 @@
 //! Estimation on IMU data: the error-state Kalman filter over any model, static alignment,
-//! Allan deviation and noise identification, IMU mounting from the data, IMU log plausibility.
+//! Allan deviation and noise identification, the initial state and IMU mounting from the data
+//! (`--init auto`), IMU log plausibility.
 
 pub mod align;
 pub mod allan;
@@ -8,5 +9,4 @@ pub mod explain_eval;
 pub mod filter;
 pub mod imu_check;
 pub mod init;
-pub mod mounting;
 pub mod stats;
