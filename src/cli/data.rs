@@ -896,7 +896,17 @@ impl DataArgs {
             match init::find(&blocks.blocks, &fixes, static_pos, priors, s.is_none())? {
                 Found::Done(a) => return Ok(*a),
                 Found::NeedMore if s.is_none() => {
-                    bail!("--init auto: the IMU data end before a start is found")
+                    let imu_span = match (blocks.blocks.first(), blocks.blocks.last()) {
+                        (Some(a), Some(b)) => format!("{:.3} .. {:.3} s", a.t_start, b.t_end),
+                        _ => "none".to_string(),
+                    };
+                    let fix_span = match (fixes.first(), fixes.last()) {
+                        (Some(a), Some(b)) => format!("{:.3} .. {:.3} s", a.t, b.t),
+                        _ => "none".to_string(),
+                    };
+                    bail!(
+                        "--init auto: the IMU data end before a start is found (IMU {imu_span}, GNSS fixes {fix_span}: on the same clock?)"
+                    )
                 }
                 Found::NeedMore => {}
             }

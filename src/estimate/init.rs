@@ -616,3 +616,79 @@ pub fn find(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(t: f64, dt: f64, f: Vector3<f64>, w: Vector3<f64>) -> ImuSample {
+        ImuSample {
+            t,
+            dtheta: w * dt,
+            dv: f * dt,
+        }
+    }
+
+    /// Quarter-second means weight each increment by its own interval: a clock whose samples
+    /// span 1 or 2 periods gives the uniform clock's means.
+    #[test]
+    fn blocks_of_a_jittered_clock_match_the_uniform_ones() {
+        let f = |t: f64| Vector3::new(0.1 * t.sin(), 0.2, -9.8);
+        let w = |t: f64| Vector3::new(1e-4, -2e-4 * t.cos(), 5e-5);
+        let dt = 0.005;
+        let (mut uni, mut jit) = (Blocks::default(), Blocks::default());
+        let mut pending: Option<(Vector3<f64>, Vector3<f64>)> = None;
+        for k in 1..=2000 {
+            let t = k as f64 * dt;
+            let (fk, wk) = (f(t - dt / 2.0), w(t - dt / 2.0));
+            uni.push(&sample(t, dt, fk, wk), dt);
+            // merge every 3rd and 4th sample of each four
+            match (k % 4, pending.take()) {
+                (3, _) => pending = Some((fk * dt, wk * dt)),
+                (0, Some((dv, dth))) => {
+                    jit.push(
+                        &ImuSample {
+                            t,
+                            dtheta: dth + wk * dt,
+                            dv: dv + fk * dt,
+                        },
+                        dt,
+                    );
+                }
+                _ => jit.push(&sample(t, dt, fk, wk), dt),
+            }
+        }
+        assert_eq!(uni.blocks.len(), jit.blocks.len());
+        for (a, b) in uni.blocks.iter().zip(&jit.blocks) {
+            assert!((a.t_end - b.t_end).abs() < 1e-12);
+            assert!(
+                (a.f - b.f).norm() < 1e-9 && (a.w - b.w).norm() < 1e-12,
+                "{a:?} {b:?}"
+            );
+        }
+    }
+
+    /// Velocities from positions: central differences, east scaled by cos(lat).
+    #[test]
+    fn velocities_from_positions_are_central_differences() {
+        let lat = 0.5f64;
+        let rm = earth::radius_meridian(lat) + 100.0;
+        let rn = earth::radius_transverse(lat) + 100.0;
+        let mut fixes: Vec<Fix> = (0..3)
+            .map(|k| Fix {
+                t: k as f64,
+                pos: [
+                    lat + 3.0 * k as f64 / rm,
+                    1.0 + 4.0 * k as f64 / (rn * lat.cos()),
+                    100.0 - k as f64,
+                ],
+                v: None,
+                sigma_v: 0.0,
+            })
+            .collect();
+        velocities_from_positions(&mut fixes, 0.1);
+        let v = fixes[1].v.unwrap();
+        assert!((v - Vector3::new(3.0, 4.0, 1.0)).norm() < 1e-3, "{v}");
+        assert!((fixes[1].sigma_v - 0.1 * std::f64::consts::SQRT_2 / 2.0).abs() < 1e-12);
+    }
+}
