@@ -424,20 +424,25 @@ pub fn aiding(data: &[u8]) {
     }
 }
 
+/// Panics naming `what` unless every value of every row is finite.
+fn finite_rows(rows: &[crate::io::truth::TruthRow], what: &str) {
+    for r in rows {
+        for v in [r.t, r.lat, r.lon, r.h]
+            .iter()
+            .chain(r.v.iter())
+            .chain(r.euler.iter())
+        {
+            finite(*v, what);
+        }
+    }
+}
+
 /// A truth file, read whole and as the filter reads it ([`crate::io::truth::TruthReader`]).
 pub fn truth(data: &[u8]) {
     use crate::io::truth::TruthLookup;
     let p = files(&[("truth.txt", data)]);
     if let Ok(rows) = crate::io::truth::read(&p[0]) {
-        for r in &rows {
-            for v in [r.t, r.lat, r.lon, r.h]
-                .iter()
-                .chain(r.v.iter())
-                .chain(r.euler.iter())
-            {
-                finite(*v, "truth value");
-            }
-        }
+        finite_rows(&rows, "truth value");
     }
     if let Ok(mut reader) = crate::io::truth::TruthReader::open(&p[0]) {
         for k in 0..50 {
@@ -458,14 +463,8 @@ pub fn matlab(data: &[u8]) {
         check_imu(s);
     }
     if let Ok(rows) = crate::io::truth::read(&p[0]) {
+        finite_rows(&rows, "avp value");
         for r in &rows {
-            for v in [r.t, r.lat, r.lon, r.h]
-                .iter()
-                .chain(r.v.iter())
-                .chain(r.euler.iter())
-            {
-                finite(*v, "avp value");
-            }
             assert!(
                 r.lat.abs() <= std::f64::consts::FRAC_PI_2,
                 "accepted latitude {}",
