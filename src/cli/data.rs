@@ -106,7 +106,8 @@ pub struct DataArgs {
     /// default: the first truth row.
     #[arg(long, allow_hyphen_values = true)]
     init: Option<String>,
-    /// With `--init auto`: the GNSS speed [m/s] above which the course gives the heading.
+    /// With `--init auto`: the GNSS speed [m/s] above which the course gives the heading
+    /// [default: 3].
     #[arg(long)]
     init_speed: Option<f64>,
     /// open (errors estimated only) or closed (fed back).
@@ -259,6 +260,8 @@ pub struct Opened {
     pub outages: Vec<Outage>,
     /// With `--init auto`: 1-σ of the found tilt and heading [rad], for the attitude priors.
     pub init_sigma: Option<(f64, f64)>,
+    /// IMU samples read before the start (`--init auto` at a later sample) and not filtered.
+    pub skipped_samples: u64,
 }
 
 /// Where the aiding epochs come from.
@@ -398,11 +401,15 @@ impl DataArgs {
         }
         if let Some(path) = &self.noise {
             let (arw, vrw) = noise_from_allan(path)?;
+            // rad/√s → deg/√h: × 180/π × 60; m/s/√s → µg/√Hz: ÷ g × 1e6
             eprintln!(
-                "noise from {}: ARW {:.3e} rad/sqrt(s), VRW {:.3e} m/s/sqrt(s)",
+                "noise from {} (used{}): ARW {:.3e} rad/sqrt(s) = {:.3} deg/sqrt(h), VRW {:.3e} m/s/sqrt(s) = {:.0} ug/sqrt(Hz)",
                 path.display(),
+                if self.grade.is_some() { " instead of the grade's" } else { "" },
                 arw,
-                vrw
+                arw.to_degrees() * 60.0,
+                vrw,
+                vrw / sinsmodel::io::units::STANDARD_GRAVITY * 1e6
             );
         }
         Ok(())
@@ -663,6 +670,7 @@ impl DataArgs {
             bail!("--init-speed applies to --init auto");
         }
         let mut init_sigma = None;
+        let mut skipped = 0u64;
         let start = match (&init_values, &mut truth_reader) {
             _ if auto => {
                 let found = self.auto_init(&fixes)?;
@@ -671,7 +679,7 @@ impl DataArgs {
                 }
                 init_sigma = Some((found.sigma_tilt, found.sigma_yaw));
                 // the run starts after the start's sample
-                let skipped = imu.skip_through(found.state.t + 1e-9)?;
+                skipped = imu.skip_through(found.state.t + 1e-9)?;
                 if skipped > 0 {
                     eprintln!(
                         "init auto: {skipped} IMU samples before {:.3} s skipped",
@@ -828,6 +836,7 @@ impl DataArgs {
             start,
             outages,
             init_sigma,
+            skipped_samples: skipped,
         })
     }
 

@@ -179,7 +179,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     let nav_rows = nav.rows;
     nav.finish(&out.file("nav.png"))?;
-    let outage_rows = outage_drifts(&inputs.outages, &run, t_last)?;
+    let outage_rows = outage_drifts(&inputs.outages, &run, t_first, t_last)?;
     if !outage_rows.is_empty() {
         sinsmodel::io::atomic_file::write_text(
             &out.file("outages.json"),
@@ -193,8 +193,13 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     out.commit()?;
     eprintln!(
         "filtered {} samples ({:.1} s) with {} ({} states, {} loop): {} scalar updates",
-        inputs.imu.count(),
-        t_last - t_first,
+        inputs.imu.count() - inputs.skipped_samples,
+        t_last
+            - if inputs.skipped_samples > 0 {
+                start.t
+            } else {
+                t_first
+            },
         model.name,
         model.n(),
         cfg.mode.word(),
@@ -262,6 +267,11 @@ pub fn run(args: &FilterArgs) -> Result<()> {
 /// The drift at the end of one GNSS outage.
 #[derive(Debug, Clone, serde::Serialize)]
 struct OutageDrift {
+    /// START of `--outage START,DURATION`: seconds from the first IMU sample.
+    start_from_first_sample_s: f64,
+    /// DURATION [s].
+    duration_s: f64,
+    /// The window on the data's clock [s].
     start_s: f64,
     end_s: f64,
     /// Time of the first aiding fix after the outage [s].
@@ -276,6 +286,7 @@ struct OutageDrift {
 fn outage_drifts(
     outages: &[super::data::Outage],
     run: &filter::FilterRun,
+    t_first: f64,
     t_last: f64,
 ) -> Result<Vec<OutageDrift>> {
     let mut out = Vec::new();
@@ -292,6 +303,8 @@ fn outage_drifts(
             );
         };
         out.push(OutageDrift {
+            start_from_first_sample_s: o.start_s - t_first,
+            duration_s: o.end_s - o.start_s,
             start_s: o.start_s,
             end_s: o.end_s,
             fix_t_s: n.t,

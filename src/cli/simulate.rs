@@ -116,7 +116,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     atomic_file::write_text(&out.file("scenario.toml"), &sc.text)?;
     out.commit()?;
     eprintln!(
-        "simulated {} IMU samples ({:.1} s at {} Hz{}), {} truth rows, {} GNSS fixes{} into {}",
+        "simulated {} IMU samples ({:.1} s at {} Hz{}), {} truth rows, {} GNSS fixes{} into {}{}",
         sim.imu.samples.len(),
         sim.imu.duration(),
         sc.imu_rate_hz,
@@ -135,7 +135,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         } else {
             ""
         },
-        args.out.display()
+        args.out.display(),
+        if args.mat {
+            " (and data.mat: arrays imu and avp)"
+        } else {
+            ""
+        }
     );
     Ok(())
 }

@@ -251,7 +251,13 @@ pub fn align(
             _ => {}
         }
     }
-    let rest_s = (best.1 - best.0) as f64 * w10 as f64 * dt;
+    // from the sample times: on a jittered clock a window of w10 samples is not 10 s
+    let rest_s = if best.1 > best.0 {
+        let (a, b) = (best.0 * w10, (best.1 * w10).min(data.samples.len()) - 1);
+        data.samples[b].t - data.samples[a].t + dt
+    } else {
+        0.0
+    };
     if rest_s < 60.0 {
         let moving: Vec<&RestEvidence> = evidence.iter().filter(|e| !e.at_rest()).collect();
         let worst =
@@ -349,13 +355,20 @@ pub fn align(
     // σ_ψ ≈ σ_b / (Ω cos L): beyond ~20° the gyros do not find north
     let no_heading = bias_sigma / omega_h > 20f64.to_radians();
     if no_heading {
+        // without a given latitude the estimated one is as hidden as north: compare with the
+        // whole Earth rate (its horizontal part is at most that)
+        let (rate, which) = match lat {
+            Some(_) => (omega_h, "the horizontal Earth rate"),
+            None => (crate::nav::earth::OMEGA, "the Earth rate"),
+        };
         heading_note = Some(format!(
-            "no heading: the gyro bias ({:.3} deg/h at rest{}) is {:.1}x the horizontal Earth rate ({:.3} deg/h at this latitude), \
+            "no heading: the gyro bias ({:.3} deg/h at rest{}) is {:.1}x {which} ({:.3} deg/h{}), \
              so gyrocompassing cannot find north (sigma would exceed 20 deg); give the heading with --init / --att, or align on a GNSS course once moving",
             bias_sigma * deg_h,
             if bias_sigma > gyro_bias_sigma { ", seen in the data" } else { ", the --gyro-bias-sigma prior" },
-            bias_sigma / omega_h,
-            omega_h * deg_h
+            bias_sigma / rate,
+            rate * deg_h,
+            if lat.is_some() { " at this latitude" } else { "; its horizontal part is smaller" }
         ));
     }
 
@@ -421,8 +434,8 @@ pub fn align(
         } else {
             lat_sigma.hypot(bias_sigma / crate::nav::earth::OMEGA) * deg
         },
-        // rounded to the microsecond: q0·dt carries the interval's binary rounding
-        skipped_s: (q0 as f64 * dt * 1e6).round() / 1e6,
+        // from the sample times (a jittered clock makes q0·dt wrong), rounded to the microsecond
+        skipped_s: ((data.samples[q0].t - data.samples[0].t) * 1e6).round() / 1e6,
         heading_windows_deg: if no_heading {
             Vec::new()
         } else {

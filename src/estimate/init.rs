@@ -577,7 +577,7 @@ pub fn find(
             let sigma_yaw = ((fx.sigma_v / fx.speed()).powi(2) + COURSE_SLACK.powi(2)).sqrt();
             let report = vec![
                 format!(
-                    "the data start moving (no {MIN_QUIET_S:.0} s at rest before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s",
+                    "the data start moving (no {MIN_QUIET_S:.0} s at rest before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s that has a fix on either side (for the acceleration) and 0.5 s of IMU data before it",
                     first_motion.unwrap(),
                     t_s,
                     priors.speed
