@@ -349,3 +349,182 @@ fn init_auto_refusals() {
         "{err}"
     );
 }
+
+/// Review findings, each a wrong answer before: GNSS positions of 2 m σ at rest no longer read
+/// as a moving start (speed from noisy positions must exceed 4 σ at two fixes in a row); an
+/// outage over a steady drive at the start no longer reads as rest (the GNSS must confirm it),
+/// and an outage that ends before the start is refused; velocity columns swapped against the
+/// positions are refused; a truth file on another clock is refused.
+#[test]
+fn init_auto_is_not_fooled() {
+    let dir = tempfile::tempdir().unwrap();
+    let drive = std::fs::read_to_string(root().join("scenarios/drive.toml")).unwrap();
+    let noisy = dir.path().join("noisy.toml");
+    std::fs::write(
+        &noisy,
+        drive
+            .replace("sigma_ne = \"0.02 m\"", "sigma_ne = \"2 m\"")
+            .replace("sigma_d = \"0.05 m\"", "sigma_d = \"2 m\""),
+    )
+    .unwrap();
+    let sim = simulate(&noisy, dir.path(), "noisy");
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--grade",
+        "tactical",
+        "--mode",
+        "closed",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--init",
+        "auto",
+        "--out",
+        dir.path().join("a").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("from 60.0 s at rest") && err.contains("from the drive-off"),
+        "{err}"
+    );
+    let yaw = number_after(&err, "heading: ");
+    let sigma = number_after(&err, "; 1-sigma ");
+    assert!((yaw - 30.0).abs() < 3.0 * sigma, "{yaw} ± {sigma}");
+
+    let mems = simulate(
+        &root().join("scenarios/mems_moving.toml"),
+        dir.path(),
+        "mems",
+    );
+    let m = |n: &str| mems.join(n).to_str().unwrap().to_string();
+    let run = |aid: &str, extra: &[&str], out: &str| {
+        let o = dir.path().join(out);
+        let mut a = vec![
+            "--model",
+            "P13",
+            "--grade",
+            "mems",
+            "--mode",
+            "closed",
+            "--imu",
+            &m("imu.txt")[..],
+            "--aid",
+            aid,
+            "--init",
+            "auto",
+            "--out",
+            o.to_str().unwrap(),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+        a.extend(extra.iter().map(|x| x.to_string()));
+        let refs: Vec<&str> = a.iter().map(|x| x.as_str()).collect();
+        filter(&refs)
+    };
+    // no fix in the first 30 s of a steady drive: not rest
+    let (ok, err) = run(
+        &m("gnss.txt"),
+        &["--outage", "0,30", "--outage", "100,10"],
+        "b",
+    );
+    assert!(!ok && err.contains("ends before the run starts"), "{err}");
+    let (ok, err) = run(&m("gnss.txt"), &["--outage", "0,30"], "b");
+    assert!(!ok, "{err}");
+    let (ok, err) = run(
+        &m("gnss.txt"),
+        &["--outage", "1,30", "--outage", "100,10"],
+        "c",
+    );
+    assert!(!ok && err.contains("ends before the run starts"), "{err}");
+    let (ok, err) = run(&m("gnss.txt"), &["--outage", "100,10"], "d");
+    assert!(ok && err.contains("the data start moving"), "{err}");
+    // velocity columns swapped
+    let text = std::fs::read_to_string(mems.join("gnss.txt")).unwrap();
+    let swapped: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                return format!("{l}\n");
+            }
+            let mut v: Vec<&str> = l.split_whitespace().collect();
+            v.swap(7, 8);
+            format!("{}\n", v.join(" "))
+        })
+        .collect();
+    let sw = dir.path().join("swapped.txt");
+    std::fs::write(&sw, swapped).unwrap();
+    let (ok, err) = run(sw.to_str().unwrap(), &[], "e");
+    assert!(
+        !ok && err.contains("velocities disagree with its positions"),
+        "{err}"
+    );
+    // a truth file on another clock
+    let truth = std::fs::read_to_string(sim.join("truth.txt")).unwrap();
+    let shifted: String = truth
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                return format!("{l}\n");
+            }
+            let (t, rest) = l.split_once(' ').unwrap();
+            format!("{:.4} {rest}\n", t.parse::<f64>().unwrap() + 1e6)
+        })
+        .collect();
+    let tp = dir.path().join("shifted.txt");
+    std::fs::write(&tp, shifted).unwrap();
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--grade",
+        "tactical",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--init",
+        "auto",
+        "--truth",
+        tp.to_str().unwrap(),
+        "--out",
+        dir.path().join("f").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("no row at any of the"), "{err}");
+    assert!(!dir.path().join("f").exists());
+}
+
+/// A jittered clock (samples spanning 1 to 3 periods): GNSS fixes fall between IMU samples, and
+/// the filter takes its state back to each fix's time, so the innovations stay consistent; the
+/// start comes from the truth row before the first sample, the step from the median interval.
+#[test]
+fn jittered_clock_filters_consistently() {
+    let dir = tempfile::tempdir().unwrap();
+    let drive = std::fs::read_to_string(root().join("scenarios/drive.toml")).unwrap();
+    let jit = dir.path().join("jit.toml");
+    std::fs::write(&jit, format!("clock_jitter_periods = 3\n{drive}")).unwrap();
+    let sim = simulate(&jit, dir.path(), "jit");
+    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
+    let (ok, err) = filter(&[
+        "--model",
+        "P13",
+        "--grade",
+        "tactical",
+        "--mode",
+        "closed",
+        "--imu",
+        &s("imu.txt"),
+        "--aid",
+        &s("gnss.txt"),
+        "--truth",
+        &s("truth.txt"),
+        "--out",
+        dir.path().join("f").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    for nis in mean_nis(&err) {
+        assert!(nis > 0.7 && nis < 1.5, "{err}");
+    }
+}

@@ -26,6 +26,7 @@ fn mems_drive_mounting_and_noise_identification() {
         .map(|p| Fix {
             t: p.t,
             pos: [p.lat_deg.to_radians(), p.lon_deg.to_radians(), p.h],
+            sigma_pos: p.sigma_neu[0].max(p.sigma_neu[1]).max(0.02),
             v: p.v_ned.map(Vector3::from),
             sigma_v: p.sigma_v_ne.map(|s| s[0].max(s[1])).unwrap_or(0.1),
         })

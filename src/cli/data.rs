@@ -113,9 +113,9 @@ pub struct DataArgs {
     /// open (errors estimated only) or closed (fed back).
     #[arg(long, default_value = "open")]
     mode: String,
-    /// Filter step [s].
-    #[arg(long, default_value_t = 0.01)]
-    step: f64,
+    /// Filter step [s] [default: 0.01, or the IMU's median interval when that is longer].
+    #[arg(long)]
+    step: Option<f64>,
     /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
     #[arg(long)]
     zupt: Option<f64>,
@@ -207,13 +207,19 @@ fn grade_table(grade: Option<&str>) -> Result<Option<&'static Grade>> {
     }
 }
 
-/// Raises the attitude priors of `cfg` to what `--init auto` found: tilt 1-σ for phi_n and
-/// phi_e, heading 1-σ for phi_d [rad] (a prior already wider is kept).
-pub fn widen_attitude_priors(
+/// Default filter step [s].
+const DEFAULT_STEP_S: f64 = 0.01;
+
+/// What opening the data decides for the filter set-up: the step [s] (the default raised to the
+/// IMU's interval), and the attitude priors raised to what `--init auto` found — tilt 1-σ for
+/// phi_n and phi_e, heading 1-σ for phi_d [rad] (a prior already wider is kept).
+pub fn apply_opened(
     cfg: &mut FilterConfig,
     model: &Model,
     init_sigma: Option<(f64, f64)>,
+    step_s: f64,
 ) {
+    cfg.step_s = step_s;
     let Some((tilt, yaw)) = init_sigma else {
         return;
     };
@@ -244,6 +250,8 @@ pub struct Inputs {
     pub start: NavState,
     /// With `--init auto`: 1-σ of the found tilt and heading [rad].
     pub init_sigma: Option<(f64, f64)>,
+    /// The filter step [s].
+    pub step_s: f64,
 }
 
 /// The data options opened for one streamed pass.
@@ -262,6 +270,8 @@ pub struct Opened {
     pub init_sigma: Option<(f64, f64)>,
     /// IMU samples read before the start (`--init auto` at a later sample) and not filtered.
     pub skipped_samples: u64,
+    /// The filter step [s]: `--step`, or the default raised to the IMU's interval.
+    pub step_s: f64,
 }
 
 /// Where the aiding epochs come from.
@@ -515,6 +525,7 @@ impl DataArgs {
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
         Ok(Inputs {
             init_sigma: opened.init_sigma,
+            step_s: opened.step_s,
             imu: self.imu.clone().context("--imu FILE is required")?,
             imu_format: self.imu_format.clone(),
             clock_offset: self.clock_offset,
@@ -529,9 +540,7 @@ impl DataArgs {
     /// inside the IMU data are counted after it: [`check_inside`]).
     pub fn open(&self) -> Result<Opened> {
         let args = self;
-        if !(args.step.is_finite() && args.step > 0.0 && args.step <= 10.0) {
-            bail!("--step {}: expected a filter step in (0, 10] s", args.step);
-        }
+        let step = args.step_given()?;
         let imu_path = args.imu.as_ref().context("--imu FILE is required")?;
         let (mut imu, how) = sinsmodel::io::imu_stream::ImuStream::open_with(
             imu_path,
@@ -643,13 +652,45 @@ impl DataArgs {
             Some(p) => Some(truth::TruthReader::open(p)?),
             None => None,
         };
-        if args.step < 0.999 * imu.interval() {
-            bail!(
-                "--step {} s is shorter than the IMU interval ({} s)",
-                args.step,
+        let step_s = match step {
+            Some(s) if s < 0.999 * imu.interval() => bail!(
+                "--step {s} s is shorter than the IMU's median sample interval ({:.6} s); give --step {:.6} or more",
+                imu.interval(),
                 imu.interval()
-            );
+            ),
+            Some(s) => s,
+            None => DEFAULT_STEP_S.max(imu.interval()),
+        };
+        let mut outages = Vec::new();
+        for o in &args.outage {
+            let v: Vec<f64> = o
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|_| {
+                    anyhow::anyhow!(
+                        "--outage `{}`: expected START,DURATION in seconds",
+                        sinsmodel::io::lines::shown(o)
+                    )
+                })?;
+            if v.len() != 2
+                || !v.iter().all(|x| x.is_finite())
+                || v[0] < 0.0
+                || v[1] <= 0.0
+                || v[0] + v[1] > 1e7
+            {
+                bail!(
+                    "--outage `{}`: expected START,DURATION in seconds (START >= 0 from the first IMU sample, DURATION > 0)",
+                    sinsmodel::io::lines::shown(o)
+                );
+            }
+            let start_s = imu.first_t() + v[0];
+            outages.push(Outage {
+                start_s,
+                end_s: start_s + v[1],
+            });
         }
+        outages.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
         let d = std::f64::consts::PI / 180.0;
         let init_values: Option<Vec<f64>> = match args.init.as_deref() {
             None | Some("auto") => None,
@@ -673,7 +714,7 @@ impl DataArgs {
         let mut skipped = 0u64;
         let start = match (&init_values, &mut truth_reader) {
             _ if auto => {
-                let found = self.auto_init(&fixes)?;
+                let found = self.auto_init(&fixes, &outages)?;
                 for line in &found.report {
                     eprintln!("init auto: {line}");
                 }
@@ -734,12 +775,39 @@ impl DataArgs {
                 }
             }
             (None, Some(tr)) => {
-                let r = tr
-                    .at(t0, 1e-6)?
-                    .context("no truth row at the IMU start time; give --init")?;
+                // the truth row at the start of the first sample's interval: t0 on a uniform
+                // clock; on a jittered one the first sample may span other than the median
+                // interval, so the row closest to t0 within 2.5 intervals before the first
+                // sample is taken (and the run starts at its time)
+                let r = match tr.at(t0, 1e-6)? {
+                    Some(r) => r,
+                    None => {
+                        let p = args.truth.as_ref().expect("a truth reader has a path");
+                        let mut scan = truth::TruthReader::open(p)?;
+                        let (lo, first) = (imu.first_t() - 2.5 * imu.interval(), imu.first_t());
+                        let mut best: Option<TruthRow> = None;
+                        while let Some(r) = scan.next_row()? {
+                            if r.t >= first - 1e-9 {
+                                break;
+                            }
+                            if r.t >= lo && best.is_none_or(|b| (r.t - t0).abs() < (b.t - t0).abs())
+                            {
+                                best = Some(r);
+                            }
+                        }
+                        let r = best.with_context(|| {
+                            format!(
+                                "no truth row at the IMU start ({t0:.6} s, or within 2.5 sample intervals before the first sample at {first:.6} s); give --init"
+                            )
+                        })?;
+                        // the lookups of the run start from there
+                        tr.at(r.t, 1e-6)?;
+                        r
+                    }
+                };
                 let c = dcm_from_euler(r.euler.x, r.euler.y, r.euler.z);
                 NavState {
-                    t: t0,
+                    t: r.t,
                     lat: r.lat,
                     lon: r.lon,
                     h: r.h,
@@ -750,6 +818,14 @@ impl DataArgs {
             (None, None) => bail!("give --init or --truth for the initial state"),
         };
         let t0 = start.t;
+        if let Some(o) = outages.iter().find(|o| o.end_s <= t0 + 1e-9) {
+            bail!(
+                "--outage: the window {:.3} .. {:.3} s ends before the run starts ({t0:.3} s{}): there is no drift to measure",
+                o.start_s,
+                o.end_s,
+                if auto { ", where --init auto found its start" } else { "" }
+            );
+        }
         let e = start.euler();
         let (roll, pitch) = (e.x, e.y);
         let head = sinsmodel::io::imu::ImuData {
@@ -799,36 +875,6 @@ impl DataArgs {
                 );
             }
         }
-        let mut outages = Vec::new();
-        for o in &args.outage {
-            let v: Vec<f64> = o
-                .split(',')
-                .map(|x| x.trim().parse::<f64>())
-                .collect::<std::result::Result<_, _>>()
-                .map_err(|_| {
-                    anyhow::anyhow!(
-                        "--outage `{}`: expected START,DURATION in seconds",
-                        sinsmodel::io::lines::shown(o)
-                    )
-                })?;
-            if v.len() != 2
-                || !v.iter().all(|x| x.is_finite())
-                || v[0] < 0.0
-                || v[1] <= 0.0
-                || v[0] + v[1] > 1e7
-            {
-                bail!(
-                    "--outage `{}`: expected START,DURATION in seconds (START >= 0 from the first IMU sample, DURATION > 0)",
-                    sinsmodel::io::lines::shown(o)
-                );
-            }
-            let start_s = imu.first_t() + v[0];
-            outages.push(Outage {
-                start_s,
-                end_s: start_s + v[1],
-            });
-        }
-        outages.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
         Ok(Opened {
             imu,
             aid: fixes.after(t0),
@@ -837,12 +883,27 @@ impl DataArgs {
             outages,
             init_sigma,
             skipped_samples: skipped,
+            step_s,
         })
+    }
+
+    /// `--step` when given, checked: in (0, 10] s.
+    fn step_given(&self) -> Result<Option<f64>> {
+        match self.step {
+            Some(s) if !(s.is_finite() && s > 0.0 && s <= 10.0) => {
+                bail!("--step {s}: expected a filter step in (0, 10] s")
+            }
+            s => Ok(s),
+        }
     }
 
     /// `--init auto`: reads the IMU file from its start (a second pass, memory bounded by
     /// quarter-second means) until [`init::find`] decides.
-    fn auto_init(&self, plan: &AidPlan) -> Result<sinsmodel::estimate::init::AutoInit> {
+    fn auto_init(
+        &self,
+        plan: &AidPlan,
+        outages: &[Outage],
+    ) -> Result<sinsmodel::estimate::init::AutoInit> {
         use sinsmodel::estimate::init::{self, Blocks, Fix, Found, Priors};
         let speed = self.init_speed.unwrap_or(init::DEFAULT_SPEED);
         if !(speed.is_finite() && (0.5..=100.0).contains(&speed)) {
@@ -862,28 +923,31 @@ impl DataArgs {
             accel_bias: prior("nabla_x").context("P28 has nabla_x")?,
             speed,
         };
-        let (mut fixes, static_pos) = match plan {
-            AidPlan::Fixes(list, _, _) => (
-                list.iter()
-                    .map(|(p, v)| Fix {
-                        t: p.t,
-                        pos: [p.lat, p.lon, p.h],
-                        v: v.map(|v| Vector3::from(v.v_ned)),
-                        sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
-                    })
-                    .collect::<Vec<_>>(),
-                None,
-            ),
-            AidPlan::Static { fix, .. } => (Vec::new(), Some([fix.lat, fix.lon, fix.h])),
+        // fixes inside a --outage are not used to start either
+        let outside = |t: f64| !outages.iter().any(|o| t >= o.start_s && t < o.end_s);
+        let (mut fixes, static_pos, receiver) = match plan {
+            AidPlan::Fixes(list, _, _) => {
+                let kept: Vec<_> = list.iter().filter(|(p, _)| outside(p.t)).collect();
+                (
+                    kept.iter()
+                        .map(|(p, v)| Fix {
+                            t: p.t,
+                            pos: [p.lat, p.lon, p.h],
+                            sigma_pos: p.sigma[0].max(p.sigma[1]),
+                            v: v.map(|v| Vector3::from(v.v_ned)),
+                            sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
+                        })
+                        .collect::<Vec<_>>(),
+                    None,
+                    kept.iter().map(|(_, v)| v.is_some()).collect::<Vec<_>>(),
+                )
+            }
+            AidPlan::Static { fix, .. } => {
+                (Vec::new(), Some([fix.lat, fix.lon, fix.h]), Vec::new())
+            }
         };
-        let sigma_pos = match plan {
-            AidPlan::Fixes(list, _, _) => list
-                .iter()
-                .map(|f| f.0.sigma[0].max(f.0.sigma[1]))
-                .fold(0.0, f64::max),
-            AidPlan::Static { .. } => 0.1,
-        };
-        init::velocities_from_positions(&mut fixes, sigma_pos);
+        init::check_velocities(&fixes, &receiver)?;
+        init::velocities_from_positions(&mut fixes);
         let imu_path = self.imu.as_ref().context("--imu FILE is required")?;
         let (mut stream, _) = sinsmodel::io::imu_stream::ImuStream::open_with(
             imu_path,
@@ -949,10 +1013,7 @@ impl DataArgs {
             "closed" => Mode::ClosedLoop,
             m => bail!("--mode `{m}`: expected open or closed"),
         };
-        if !(args.step.is_finite() && args.step > 0.0 && args.step <= 10.0) {
-            bail!("--step {}: expected a filter step in (0, 10] s", args.step);
-        }
-        cfg.step_s = args.step;
+        cfg.step_s = args.step_given()?.unwrap_or(DEFAULT_STEP_S);
         if !model.vertical {
             cfg.vertical = Vertical::Fixed;
         }

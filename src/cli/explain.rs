@@ -118,7 +118,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         };
         let config_for = |m: &Model| {
             let mut c = args.data.config(m, true)?;
-            super::data::widen_attitude_priors(&mut c, m, inputs.init_sigma);
+            super::data::apply_opened(&mut c, m, inputs.init_sigma, inputs.step_s);
             Ok(c)
         };
         let e = run_explain(&baseline, &cands, &data, &config_for, &opts)?;

@@ -47,7 +47,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         inputs.imu = inputs.imu.into_memory()?;
     }
     let start = inputs.start;
-    super::data::widen_attitude_priors(&mut cfg, &model, inputs.init_sigma);
+    super::data::apply_opened(&mut cfg, &model, inputs.init_sigma, inputs.step_s);
     let provenance = super::command_line();
     let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
 
@@ -118,12 +118,9 @@ pub fn run(args: &FilterArgs) -> Result<()> {
             anyhow::bail!("--nav-rate {r}: expected a rate in (0, 1e5] Hz");
         }
     }
-    let every = match args.nav_rate {
-        Some(r) => (1.0 / (r * inputs.imu.interval())).round().max(1.0) as u64,
-        None => 1,
-    };
+    let clock = super::nav_out::RowClock::new(start.t, args.nav_rate, inputs.imu.interval());
     let mut nav =
-        super::nav_out::NavWriter::create(&out.file("nav.txt"), &model, every, &provenance)?;
+        super::nav_out::NavWriter::create(&out.file("nav.txt"), &model, clock, &provenance)?;
     let pb = progress::bar(1000, "filter");
     let mut epochs = inputs.aid.epochs_outside(&inputs.outages);
     let mut io = filter::StreamIo {
@@ -151,6 +148,14 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     if let Some(tr) = inputs.truth.take() {
         tr.finish()?;
         let covered = errors.iter().filter(|e| e.1.is_some()).count();
+        if covered == 0 && !errors.is_empty() {
+            anyhow::bail!(
+                "--truth: the truth file has no row at any of the {} update epochs ({:.3} .. {:.3} s): is it on the IMU's and the aiding's clock?",
+                errors.len(),
+                errors[0].0,
+                errors[errors.len() - 1].0
+            );
+        }
         if covered < errors.len() {
             eprintln!(
                 "warning: the truth file has a row at only {covered} of the {} update epochs: model_error.txt and the model-error RMS cover those only",
@@ -224,20 +229,31 @@ pub fn run(args: &FilterArgs) -> Result<()> {
             );
         }
     }
-    if let (Some(first), Some(last)) = (errors.first(), errors.last()) {
+    if let (Some(first), Some(last), true) = (errors.first(), errors.last(), with_truth) {
         let mid = 0.5 * (first.0 + last.0);
+        let all = errors.iter().filter(|e| e.0 >= mid).count();
         let half: Vec<[f64; 2]> = errors
             .iter()
             .filter(|e| e.0 >= mid)
-            .map_while(|e| e.1)
+            .filter_map(|e| e.1)
             .collect();
-        if !half.is_empty() && errors.iter().filter(|e| e.0 >= mid).all(|e| e.1.is_some()) {
+        if half.is_empty() {
+            eprintln!(
+                "model error: no update epoch of the second half ({mid:.0}–{:.0} s) has a truth row: no RMS",
+                last.0
+            );
+        } else {
             let rms = |c: usize| {
                 (half.iter().map(|e| e[c] * e[c]).sum::<f64>() / half.len() as f64).sqrt() * arcsec
             };
             eprintln!(
-                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s): north {:.2} arcsec, east {:.2} arcsec",
+                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s{}): north {:.2} arcsec, east {:.2} arcsec",
                 last.0,
+                if half.len() < all {
+                    format!(", the {} of {all} update epochs with a truth row", half.len())
+                } else {
+                    String::new()
+                },
                 rms(0),
                 rms(1)
             );

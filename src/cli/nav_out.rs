@@ -40,11 +40,59 @@ impl Thinned {
     }
 }
 
+/// When output rows are due at a rate, on the samples' own times (so a jittered clock keeps the
+/// rate): a row at the first sample at or after each multiple of the period from `t0`, within
+/// half a sample interval.
+pub struct RowClock {
+    t0: f64,
+    period: f64,
+    n: u64,
+    tol: f64,
+}
+
+impl RowClock {
+    /// Rows at `rate_hz` from `t0` [s]; every sample when `rate_hz` is None; `interval` [s] is
+    /// the median sample interval.
+    pub fn new(t0: f64, rate_hz: Option<f64>, interval: f64) -> RowClock {
+        RowClock {
+            t0,
+            period: rate_hz.map(|r| 1.0 / r).unwrap_or(0.0),
+            n: 1,
+            tol: 0.5 * interval,
+        }
+    }
+
+    /// Whether the sample at `t` [s] gets a row.
+    pub fn due(&mut self, t: f64) -> bool {
+        if self.period == 0.0 {
+            return true;
+        }
+        if t < self.t0 + self.n as f64 * self.period - self.tol {
+            return false;
+        }
+        while self.t0 + self.n as f64 * self.period - self.tol <= t {
+            self.n += 1;
+        }
+        true
+    }
+
+    /// The row spacing in words, for file headers.
+    pub fn words(&self) -> String {
+        if self.period == 0.0 {
+            "a row at every IMU sample".to_string()
+        } else {
+            format!(
+                "a row every {} s (at the first IMU sample at or after each)",
+                self.period
+            )
+        }
+    }
+}
+
 /// Writes `nav.txt` rows from the filter's [`Observer::nav_sample`].
 pub struct NavWriter {
     file: AtomicFile,
-    every: u64,
-    k: u64,
+    clock: RowClock,
     idx: [Option<usize>; 9],
     n: usize,
     origin: Option<(f64, f64)>,
@@ -62,11 +110,11 @@ const STATES: [&str; 9] = [
 ];
 
 impl NavWriter {
-    /// Starts `path` (atomic) with its header; a row every `every` IMU samples.
+    /// Starts `path` (atomic) with its header; rows when `clock` says.
     pub fn create(
         path: &std::path::Path,
         model: &Model,
-        every: u64,
+        clock: RowClock,
         provenance: &str,
     ) -> anyhow::Result<NavWriter> {
         let mut file = AtomicFile::create(path)?;
@@ -75,8 +123,9 @@ impl NavWriter {
         writeln!(w, "# {provenance}")?;
         writeln!(
             w,
-            "# navigation solution: the navigator corrected by the filter's estimate ({} states), a row every {every} IMU sample(s)",
-            model.name
+            "# navigation solution: the navigator corrected by the filter's estimate ({} states), {}",
+            model.name,
+            clock.words()
         )?;
         let mut cols = String::from(
             "# t[s] lat lon [deg] h[m] v_n v_e v_d [m/s] roll pitch yaw [deg] (NED, FRD; DESIGN §9 truth layout)",
@@ -111,8 +160,7 @@ impl NavWriter {
         )?;
         Ok(NavWriter {
             file,
-            every: every.max(1),
-            k: 0,
+            clock,
             idx,
             n: model.n(),
             origin: None,
@@ -252,10 +300,8 @@ impl NavWriter {
 
 impl Observer for NavWriter {
     fn nav_sample(&mut self, s: &NavState, x: &[f64], p: &[f64]) {
-        // rows at the every-th sample (t = k·every·dt), as navigate writes them
-        self.k += 1;
-        let due = self.k.is_multiple_of(self.every);
-        if !due || self.error.is_some() {
+        // rows on the samples' times, as navigate writes them
+        if !self.clock.due(s.t) || self.error.is_some() {
             return;
         }
         if let Err(e) = self.row(s, x, p) {

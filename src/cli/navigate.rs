@@ -128,7 +128,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
     };
     let mut nav = Navigator::new(start, args.vertical);
-    let every = (1.0 / (data.interval() * args.out_rate)).round().max(1.0) as u64;
+    let mut clock = super::nav_out::RowClock::new(t0, Some(args.out_rate), data.interval());
     let row = |s: &NavState| TruthRow {
         t: s.t,
         lat: s.lat,
@@ -170,7 +170,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             );
         }
         prev_t = s.t;
-        if (k + 1) % every == 0 {
+        if clock.due(s.t) {
             truth::write_row(out.writer(), &row(&nav.state))?;
             rows += 1;
         }

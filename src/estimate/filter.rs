@@ -466,8 +466,11 @@ impl<'a> Engine<'a> {
         let f_ned = Vector3::from(self.np.f_ned);
         let c = s.dcm();
         let np = NavPoint::new(s.lat, s.h, s.v, &c, &(c.transpose() * f_ned));
+        // the epoch is applied at the first sample at or after its time: the navigation state
+        // is taken back to the fix time (a GNSS fix between two IMU samples, a jittered clock)
+        let s_fix = state_at(&s, ep.t, &f_ned);
         for &(name, rows) in &self.meas {
-            let Some((z, sigma)) = residual(name, &s, ep) else {
+            let Some((z, sigma)) = residual(name, &s_fix, ep) else {
                 continue;
             };
             let h = &mut self.h[..rows * n];
@@ -863,6 +866,27 @@ pub fn run_stream(
         first_nonfinite_t: e.first_nonfinite_t,
         diverged,
     })
+}
+
+/// The navigation state `s` taken back (or forward) to time `t` [s] along its velocity and
+/// acceleration (specific force `f_ned` [m/s²] plus gravity), to first order; `s` itself when
+/// `t` is its time.
+fn state_at(s: &NavState, t: f64, f_ned: &Vector3<f64>) -> NavState {
+    let dt = t - s.t;
+    if dt == 0.0 || !dt.is_finite() {
+        return *s;
+    }
+    let rm = earth::radius_meridian(s.lat) + s.h;
+    let rn = earth::radius_transverse(s.lat) + s.h;
+    let a = f_ned + Vector3::new(0.0, 0.0, earth::gravity(s.lat, s.h));
+    NavState {
+        t,
+        lat: s.lat + s.v.x * dt / rm,
+        lon: s.lon + s.v.y * dt / (rn * s.lat.cos()),
+        h: s.h - s.v.z * dt,
+        v: s.v + a * dt,
+        q: s.q,
+    }
 }
 
 /// Scalar update in Joseph form: P ← (I − K h) P (I − K h)ᵀ + K r Kᵀ, expanded for a row h;

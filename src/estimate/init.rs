@@ -109,6 +109,8 @@ pub struct Fix {
     pub t: f64,
     /// Latitude, longitude [rad], height [m].
     pub pos: [f64; 3],
+    /// Horizontal position 1-σ [m] (the larger of north and east).
+    pub sigma_pos: f64,
     /// NED velocity [m/s]: the receiver's, or from the neighbouring positions.
     pub v: Option<Vector3<f64>>,
     /// 1-σ of each velocity component [m/s].
@@ -119,33 +121,89 @@ impl Fix {
     fn speed(&self) -> f64 {
         self.v.map(|v| v.x.hypot(v.y)).unwrap_or(0.0)
     }
+
+    /// Moving beyond doubt: horizontal speed above 0.5 m/s and above 4 σ of its noise (a
+    /// speed from noisy positions at rest exceeds 3 σ at one fix in a hundred).
+    fn moving(&self) -> bool {
+        self.v.is_some() && self.speed() > 0.5_f64.max(4.0 * self.sigma_v)
+    }
+}
+
+/// The neighbours of fix `k` for a central difference: the nearest fix at least 0.5 s before
+/// and after it (the ends themselves when there is none), at most 5 s apart; None otherwise.
+fn neighbours(fixes: &[Fix], k: usize) -> Option<(usize, usize)> {
+    let t = fixes[k].t;
+    let a = (0..k).rev().find(|&j| t - fixes[j].t >= 0.5).unwrap_or(k);
+    let b = (k + 1..fixes.len())
+        .find(|&j| fixes[j].t - t >= 0.5)
+        .unwrap_or(k);
+    let dt = fixes[b].t - fixes[a].t;
+    (a != b && dt > 0.0 && dt <= 5.0).then_some((a, b))
+}
+
+/// The NED velocity between fixes `a` and `b` from their positions, and its 1-σ [m/s].
+fn velocity_between(fixes: &[Fix], a: usize, b: usize) -> (Vector3<f64>, f64) {
+    let (pa, pb) = (fixes[a].pos, fixes[b].pos);
+    let dt = fixes[b].t - fixes[a].t;
+    let lat = pa[0];
+    let rm = earth::radius_meridian(lat) + pa[2];
+    let rn = earth::radius_transverse(lat) + pa[2];
+    let v = Vector3::new(
+        (pb[0] - pa[0]) * rm / dt,
+        (pb[1] - pa[1]) * rn * lat.cos() / dt,
+        -(pb[2] - pa[2]) / dt,
+    );
+    (v, fixes[a].sigma_pos.hypot(fixes[b].sigma_pos) / dt)
 }
 
 /// Fills the velocity of fixes that have none from the neighbouring positions (central
-/// differences over at most 2.5 s; σ from the position σ `sigma_pos` [m]).
-pub fn velocities_from_positions(fixes: &mut [Fix], sigma_pos: f64) {
-    let n = fixes.len();
-    for k in 0..n {
+/// differences over 1 to 5 s, [`neighbours`]; σ from the positions' σ).
+pub fn velocities_from_positions(fixes: &mut [Fix]) {
+    for k in 0..fixes.len() {
         if fixes[k].v.is_some() {
             continue;
         }
-        let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
-        let dt = fixes[b].t - fixes[a].t;
-        if a == b || !(dt > 0.0 && dt <= 2.5) {
-            continue;
+        if let Some((a, b)) = neighbours(fixes, k) {
+            let (v, sigma) = velocity_between(fixes, a, b);
+            fixes[k].v = Some(v);
+            fixes[k].sigma_v = sigma;
         }
-        let (pa, pb) = (fixes[a].pos, fixes[b].pos);
-        let lat = pa[0];
-        let rm = earth::radius_meridian(lat) + pa[2];
-        let rn = earth::radius_transverse(lat) + pa[2];
-        let v = Vector3::new(
-            (pb[0] - pa[0]) * rm / dt,
-            (pb[1] - pa[1]) * rn * lat.cos() / dt,
-            -(pb[2] - pa[2]) / dt,
-        );
-        fixes[k].v = Some(v);
-        fixes[k].sigma_v = std::f64::consts::SQRT_2 * sigma_pos / dt;
     }
+}
+
+/// Checks the receiver's velocities against the positions: where a central difference of
+/// positions exists, the two must agree within 5 σ plus 1 m/s (the acceleration over the
+/// difference's span); more than a tenth of them disagreeing (swapped or negated columns, a
+/// wrong unit) is refused naming the first.
+pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
+    let (mut checked, mut bad) = (0usize, Vec::new());
+    for k in 0..fixes.len() {
+        let (true, Some(v)) = (receiver[k], fixes[k].v) else {
+            continue;
+        };
+        let Some((a, b)) = neighbours(fixes, k) else {
+            continue;
+        };
+        let (vp, sp) = velocity_between(fixes, a, b);
+        checked += 1;
+        let d = ((v - vp).x).hypot((v - vp).y);
+        if d > 5.0 * fixes[k].sigma_v.hypot(sp) + 1.0 {
+            bad.push((k, v, vp));
+        }
+    }
+    if checked > 0 && bad.len() * 10 > checked {
+        let (k, v, vp) = bad[0];
+        bail!(
+            "--init auto: the aiding file's velocities disagree with its positions at {} of {checked} fixes (first at t = {:.3} s: v_n, v_e = {:.2}, {:.2} m/s given, {:.2}, {:.2} m/s from the positions): swapped, negated or mis-scaled velocity columns? (--aid-use pos leaves them out)",
+            bad.len(),
+            fixes[k].t,
+            v.x,
+            v.y,
+            vp.x,
+            vp.y
+        );
+    }
+    Ok(())
 }
 
 /// Priors that decide how the heading can be found.
@@ -320,13 +378,34 @@ pub fn find(
     };
     let g = earth::gravity(pos0[0], pos0[2]);
     let secs = seconds(blocks, g);
-    // the first GNSS fix that shows motion (speed above 0.5 m/s)
-    let first_motion = fixes
-        .iter()
-        .find(|f| f.t >= t0 && f.speed() > 0.5)
-        .map(|f| f.t);
+    // the first GNSS fix that shows motion beyond its noise, confirmed by the next one
+    let first_motion = (0..fixes.len().saturating_sub(1))
+        .find(|&k| {
+            fixes[k].t >= t0
+                && fixes[k].moving()
+                && fixes[k + 1].moving()
+                && fixes[k + 1].t - fixes[k].t <= 2.5
+        })
+        .map(|k| fixes[k].t);
     let min_q = MIN_QUIET_S.round() as usize;
-    let quiet = quiet_stretch(&secs, first_motion, at_end, min_q);
+    let mut quiet = quiet_stretch(&secs, first_motion, at_end, min_q);
+    let mut unconfirmed: Option<(f64, f64)> = None;
+    // the IMU alone cannot tell rest from a steady straight drive: the GNSS (or --static-aid)
+    // must confirm it, with at least one fix with a velocity inside the stretch and none moving
+    if let (Some((k, e, closed)), None) = (quiet, static_pos) {
+        let (t_a, t_b) = (secs[k].t_start, secs[e - 1].t_end);
+        let inside: Vec<&Fix> = fixes
+            .iter()
+            .filter(|f| f.t >= t_a && f.t <= t_b && f.v.is_some())
+            .collect();
+        if inside.is_empty() || inside.iter().any(|f| f.moving()) {
+            if !closed && !at_end && inside.is_empty() {
+                return Ok(Found::NeedMore);
+            }
+            unconfirmed = Some((t_a, t_b));
+            quiet = None;
+        }
+    }
     let d = std::f64::consts::PI / 180.0;
     let sigma_tilt = (priors.accel_bias / g).max(0.01 * d);
     match quiet {
@@ -380,8 +459,9 @@ pub fn find(
                 )),
             };
             let gc_possible = gc_bias <= GYROCOMPASS_MAX_SIGMA;
-            if gc_possible && !closed {
-                // a longer rest may still bring the noise down
+            if (gc_possible || static_pos.is_some()) && !closed {
+                // a longer rest may still bring the noise down (a static vehicle: wait for all
+                // of it, to say how long it was)
                 return Ok(Found::NeedMore);
             }
             if gc_possible && q_s >= GYROCOMPASS_S && gc_sigma <= GYROCOMPASS_MAX_SIGMA {
@@ -405,10 +485,31 @@ pub fn find(
             let gc_ok = gc_possible;
             // the drive-off after the quiet stretch
             let t_b = q.last().unwrap().t_end;
-            let Some(fx) = fixes.iter().find(|f| f.t > t_b && f.speed() > priors.speed) else {
+            let fast = |f: &Fix| f.moving() && f.speed() > priors.speed;
+            let Some(fx) = fixes.iter().find(|f| f.t > t_b && fast(f)) else {
                 if at_end || static_pos.is_some() {
+                    let with_v: Vec<&Fix> = fixes
+                        .iter()
+                        .filter(|f| f.t > t_b && f.v.is_some())
+                        .collect();
+                    let gnss = if static_pos.is_some() {
+                        "the vehicle is static (--static-aid): no course".to_string()
+                    } else if with_v.is_empty() {
+                        format!(
+                            "no GNSS fix after the rest has a velocity ({} fixes; velocities come from the file's columns or from positions at most 5 s apart)",
+                            fixes.iter().filter(|f| f.t > t_b).count()
+                        )
+                    } else {
+                        format!(
+                            "the GNSS speed never exceeds {} m/s (and 4 sigma of its noise) after it: {} fixes with a velocity, the fastest {:.2} m/s",
+                            priors.speed,
+                            with_v.len(),
+                            with_v.iter().map(|f| f.speed()).fold(0.0, f64::max)
+                        )
+                    };
                     bail!(
-                        "--init auto: no heading: {} and the GNSS speed never exceeds {} m/s after the {:.1} s at rest (to take the course of a drive-off); give the heading with --init LAT,LON,H,ROLL,PITCH,YAW",
+                        "--init auto: no heading after the {:.1} s at rest: {}, and {gnss} (to take the course of a drive-off); give the heading with --init LAT,LON,H,ROLL,PITCH,YAW",
+                        q_s,
                         if gc_ok {
                             format!(
                                 "gyrocompassing the {q_s:.0} s at rest gives a heading 1-sigma of {:.2} deg (used at 1 deg or better, over at least {GYROCOMPASS_S:.0} s)",
@@ -420,9 +521,7 @@ pub fn find(
                                 priors.gyro_bias.to_degrees() * 3600.0,
                                 deg(gc_sigma)
                             )
-                        },
-                        priors.speed,
-                        q_s
+                        }
                     );
                 }
                 if t_read - t_b > SEARCH_S {
@@ -506,15 +605,19 @@ pub fn find(
                 return Ok(Found::NeedMore);
             }
             // the first fast fix with neighbours for the acceleration and IMU data around it
-            let fast = (1..fixes.len().saturating_sub(1)).find(|&k| {
+            // the first fast fix (beyond its noise, confirmed by the next) with velocities
+            // about 1 s either side for the acceleration
+            let fast = (0..fixes.len().saturating_sub(1)).find_map(|k| {
                 let f = &fixes[k];
-                f.t >= t0 + 0.5
+                let ok = f.t >= t0 + 0.5
+                    && f.moving()
                     && f.speed() > priors.speed
-                    && fixes[k - 1].v.is_some()
-                    && fixes[k + 1].v.is_some()
-                    && fixes[k + 1].t - fixes[k - 1].t <= 5.0
+                    && fixes[k + 1].moving()
+                    && fixes[k + 1].t - f.t <= 2.5;
+                let (a, b) = neighbours(fixes, k)?;
+                (ok && fixes[a].v.is_some() && fixes[b].v.is_some()).then_some((k, a, b))
             });
-            let Some(k) = fast else {
+            let Some((k, ka, kb)) = fast else {
                 if at_end {
                     bail!(
                         "--init auto: the data start moving, and the GNSS speed never exceeds {} m/s (with fixes either side) to take a heading from the course; give --init LAT,LON,H,ROLL,PITCH,YAW",
@@ -546,8 +649,10 @@ pub fn find(
                 );
             }
             let (f, _) = mean_of(&around);
-            let (va, vb) = (fixes[k - 1].v.unwrap(), fixes[k + 1].v.unwrap());
-            let a_n = (vb - va) / (fixes[k + 1].t - fixes[k - 1].t);
+            let (va, vb) = (fixes[ka].v.unwrap(), fixes[kb].v.unwrap());
+            let dt_a = fixes[kb].t - fixes[ka].t;
+            let a_n = (vb - va) / dt_a;
+            let sigma_a = fixes[ka].sigma_v.hypot(fixes[kb].sigma_v) / dt_a;
             let v = fx.v.unwrap();
             let yaw = v.y.atan2(v.x);
             // f_b = C_n^b (a_n − g_n): the tilt that turns f_b into a_n − g_n, the heading the course
@@ -573,11 +678,20 @@ pub fn find(
                 fx.pos[2] + v.z * back,
             ];
             let v_s = v - a_n * back;
-            let sigma_tilt = (sigma_tilt.powi(2) + (0.05 / g).powi(2)).sqrt();
+            // the bias prior, the noise of the GNSS acceleration, 0.05 m/s² for the acceleration
+            // changing within the second
+            let sigma_tilt =
+                (sigma_tilt.powi(2) + (sigma_a / g).powi(2) + (0.05 / g).powi(2)).sqrt();
             let sigma_yaw = ((fx.sigma_v / fx.speed()).powi(2) + COURSE_SLACK.powi(2)).sqrt();
             let report = vec![
                 format!(
-                    "the data start moving (no {MIN_QUIET_S:.0} s at rest before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s that has a fix on either side (for the acceleration) and 0.5 s of IMU data before it",
+                    "the data start moving ({} before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s that has a fix on either side (for the acceleration) and 0.5 s of IMU data before it",
+                    match unconfirmed {
+                        Some((a, b)) => format!(
+                            "the IMU looks still from {a:.3} to {b:.3} s, but no GNSS fix with a velocity confirms rest there, and a steady straight drive looks the same"
+                        ),
+                        None => format!("no {MIN_QUIET_S:.0} s at rest"),
+                    },
                     first_motion.unwrap(),
                     t_s,
                     priors.speed
@@ -682,11 +796,12 @@ mod tests {
                     1.0 + 4.0 * k as f64 / (rn * lat.cos()),
                     100.0 - k as f64,
                 ],
+                sigma_pos: 0.1,
                 v: None,
                 sigma_v: 0.0,
             })
             .collect();
-        velocities_from_positions(&mut fixes, 0.1);
+        velocities_from_positions(&mut fixes);
         let v = fixes[1].v.unwrap();
         assert!((v - Vector3::new(3.0, 4.0, 1.0)).norm() < 1e-3, "{v}");
         assert!((fixes[1].sigma_v - 0.1 * std::f64::consts::SQRT_2 / 2.0).abs() < 1e-12);

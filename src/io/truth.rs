@@ -182,6 +182,15 @@ impl TruthReader {
 }
 
 impl TruthReader {
+    /// The next row in file order (and the reader moves past it).
+    pub fn next_row(&mut self) -> Result<Option<TruthRow>> {
+        let r = self.cur;
+        if r.is_some() {
+            self.cur = self.read_row()?;
+        }
+        Ok(r)
+    }
+
     /// Reads the rest of the file, so that a bad row after the last lookup is still reported.
     pub fn finish(mut self) -> Result<()> {
         while self.read_row()?.is_some() {}
