@@ -685,7 +685,7 @@ pub fn find(
             let sigma_yaw = ((fx.sigma_v / fx.speed()).powi(2) + COURSE_SLACK.powi(2)).sqrt();
             let report = vec![
                 format!(
-                    "the data start moving ({} before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s that has a fix on either side (for the acceleration) and 0.5 s of IMU data before it",
+                    "the data start moving ({} before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s (confirmed by the next fix) with fixes around it for the acceleration and 0.5 s of IMU data before it",
                     match unconfirmed {
                         Some((a, b)) => format!(
                             "the IMU looks still from {a:.3} to {b:.3} s, but no GNSS fix with a velocity confirms rest there, and a steady straight drive looks the same"
