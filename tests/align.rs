@@ -27,8 +27,8 @@ fn simulated_static_alignment_recovers_attitude_and_latitude() {
         "heading {hd} ± {hs}"
     );
     assert!(
-        (a.lat_deg.unwrap() - 45.0).abs() < 3.0 * a.lat_sigma_deg.max(0.01),
-        "lat {:?} ± {}",
+        (a.lat_deg.unwrap() - 45.0).abs() < 3.0 * a.lat_sigma_deg.unwrap().max(0.01),
+        "lat {:?} ± {:?}",
         a.lat_deg,
         a.lat_sigma_deg
     );
@@ -50,7 +50,7 @@ fn lasergyro_alignment_finds_latitude_and_the_disturbed_start() {
     )
     .unwrap();
     eprintln!(
-        "lasergyro: lat {:?} ± {:.4} deg, heading {:?} ± {:?} deg (header {:.1}), skipped {} s",
+        "lasergyro: lat {:?} ± {:?} deg, heading {:?} ± {:?} deg (header {:.1}), skipped {} s",
         a.lat_deg,
         a.lat_sigma_deg,
         a.heading_deg,

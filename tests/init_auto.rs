@@ -240,6 +240,12 @@ fn jittered_moving_mems_case_through_align_allan_and_filter() {
         serde_json::from_str(&std::fs::read_to_string(j).unwrap()).unwrap()
     };
     let (aj, au) = (allan(&sim), allan(&uni));
+    // on the whole log (moving at first) allan warns that it measures the motion
+    let (ok, _, err) = sinsmodel(&["allan", "--imu", &s("imu.txt")]);
+    assert!(
+        ok && err.contains("are not at rest") && err.contains("measures the motion"),
+        "{err}"
+    );
     let axes = [
         "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
     ];

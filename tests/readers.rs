@@ -240,4 +240,20 @@ fn matlab_file_reads_like_the_text_it_came_from() {
         m,
     ]);
     assert!(!ok && err.contains("input"), "{err}");
+    // nor under a name that reads as FILE.mat:VARIABLE
+    let named = format!("{}:imu", dir.path().join("out.mat").display());
+    let (ok, _, err) = common::sinsmodel(&[
+        "navigate",
+        "--imu",
+        &format!("{m}:imu"),
+        "--lat",
+        "30",
+        "--lon",
+        "114",
+        "--att",
+        "0,0,0",
+        "--out",
+        &named,
+    ]);
+    assert!(!ok && err.contains("selects a MATLAB variable"), "{err}");
 }

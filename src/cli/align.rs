@@ -94,9 +94,9 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         (_, None) => println!(
             "latitude: not determined (it comes from the Earth rate's direction, which the gyro bias hides); pass --lat"
         ),
-        (None, Some(l)) if a.lat_sigma_deg > 0.0 => println!(
+        (None, Some(l)) if a.lat_sigma_deg.is_some_and(|s| s > 0.0) => println!(
             "latitude {l:.4} deg (estimated from the Earth-rate and gravity directions, 1-sigma {:.4} deg)",
-            a.lat_sigma_deg
+            a.lat_sigma_deg.unwrap_or_default()
         ),
         (None, Some(l)) => println!(
             "latitude {l:.4} deg (estimated from one window only: no spread to give a sigma; pass --lat if known)"

@@ -95,6 +95,21 @@ pub fn run(args: &AllanArgs) -> Result<()> {
             args.src.imu.display()
         );
     }
+    // Allan deviation describes a sensor at rest: say so when the span moves (10-s windows by
+    // the absolute tests of `align`)
+    let win = ((10.0 / dt).round() as usize).max(2);
+    let g = span.mean_rates().0.norm();
+    let evidence = sinsmodel::estimate::align::rest_evidence(&span, win, g);
+    let moving = evidence.iter().filter(|e| !e.at_rest()).count();
+    if moving > 0 {
+        eprintln!(
+            "warning: {moving} of the {} ten-second windows of the chosen span are not at rest (specific-force spread > {} m/s^2 or angular-rate spread > {:.2} deg/s): \
+             the Allan deviation of moving data measures the motion, not the sensor; choose a stretch at rest with --skip / --seconds (`sinsmodel align` finds one)",
+            evidence.len(),
+            sinsmodel::estimate::align::STATIC_F_SPREAD,
+            sinsmodel::estimate::align::STATIC_W_SPREAD.to_degrees()
+        );
+    }
     // a jittered clock: each increment keeps its own interval (cumulative integral resampled
     // to a uniform grid); dividing by one interval would turn the jitter times the mean (gravity
     // on an accelerometer) into noise

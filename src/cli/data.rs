@@ -42,7 +42,13 @@ impl ImuSource {
             self.imu_format.as_deref(),
             self.clock_offset,
         )?;
-        eprintln!("reading {} {how}", self.imu.display());
+        eprintln!(
+            "{}",
+            sinsmodel::io::lines::printable_message(&format!(
+                "reading {} {how}",
+                self.imu.display()
+            ))
+        );
         Ok(stream)
     }
 
@@ -547,7 +553,13 @@ impl DataArgs {
             args.imu_format.as_deref(),
             args.clock_offset,
         )?;
-        eprintln!("reading {} {how}", imu_path.display());
+        eprintln!(
+            "{}",
+            sinsmodel::io::lines::printable_message(&format!(
+                "reading {} {how}",
+                imu_path.display()
+            ))
+        );
         if let Some(z) = args.zupt {
             if !(z.is_finite() && z > 0.0 && z < 100.0) {
                 bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");

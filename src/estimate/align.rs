@@ -200,8 +200,8 @@ pub struct Alignment {
     /// latitude comes from its direction) and none was given.
     pub lat_deg: Option<f64>,
     /// 1-σ of the estimated latitude [deg]: the scatter of one-minute estimates and the gyro
-    /// bias against the Earth rate (0 when given).
-    pub lat_sigma_deg: f64,
+    /// bias against the Earth rate (0 when given; None when the latitude is not determined).
+    pub lat_sigma_deg: Option<f64>,
     /// Seconds skipped as disturbed at the start.
     pub skipped_s: f64,
     /// Coarse heading per window of the used data [deg] (evidence of stability); empty when
@@ -430,9 +430,9 @@ pub fn align(
         lat_deg: (lat.is_some() || !no_heading).then_some(lat_used * deg),
         // the bias tilts the measured Earth rate by up to σ_b / Ω
         lat_sigma_deg: if lat.is_some() {
-            0.0
+            Some(0.0)
         } else {
-            lat_sigma.hypot(bias_sigma / crate::nav::earth::OMEGA) * deg
+            (!no_heading).then(|| lat_sigma.hypot(bias_sigma / crate::nav::earth::OMEGA) * deg)
         },
         // from the sample times (a jittered clock makes q0·dt wrong), rounded to the microsecond
         skipped_s: ((data.samples[q0].t - data.samples[0].t) * 1e6).round() / 1e6,

@@ -62,9 +62,10 @@ pub fn write_with_velocity(
         writeln!(w, "# t[s] lat lon [deg] h[m] sigma_n sigma_e sigma_d [m]")?;
     }
     for (k, r) in rows.iter().enumerate() {
+        // σ in shortest round-trip form: a σ of 1e-5 m must not be written as 0
         write!(
             w,
-            "{:.4} {:.11} {:.11} {:.4} {:.4} {:.4} {:.4}",
+            "{:.4} {:.11} {:.11} {:.4} {} {} {}",
             r.t,
             r.lat.to_degrees(),
             r.lon.to_degrees(),
@@ -76,7 +77,7 @@ pub fn write_with_velocity(
         if let Some(v) = velocities.map(|v| &v[k]) {
             write!(
                 w,
-                " {:.4} {:.4} {:.4} {:.4}",
+                " {:.6} {:.6} {:.6} {}",
                 v.v_ned[0], v.v_ned[1], v.v_ned[2], v.sigma
             )?;
         }

@@ -143,6 +143,7 @@ impl OutputDir {
     /// Checks `target` can be replaced and that no `inputs` lie inside it, then creates the
     /// staging directory.
     pub fn create(target: &Path, inputs: &[&Path]) -> Result<OutputDir> {
+        refuse_mat_variable_name("--out", target)?;
         if target.exists() {
             if !target.is_dir() {
                 anyhow::bail!("--out {}: exists and is not a directory", target.display());
@@ -310,10 +311,24 @@ fn remove_stale(dir: &Path, prefix: &str) {
     }
 }
 
+/// Refuses an output named like `FILE.mat:VARIABLE`: inputs of that form select a variable of a
+/// MATLAB file, and a file of that literal name would be read instead of it.
+fn refuse_mat_variable_name(option: &str, path: &Path) -> Result<()> {
+    let s = path.to_string_lossy().to_ascii_lowercase();
+    if s.contains(".mat:") {
+        anyhow::bail!(
+            "{option} {}: a name like FILE.mat:VARIABLE selects a MATLAB variable where inputs are read; choose another name",
+            crate::io::lines::shown(&path.to_string_lossy())
+        );
+    }
+    Ok(())
+}
+
 /// Refuses an output file `path` (named by `option` in the message) that is one of `inputs`
 /// (also through a link) or exists as something other than a regular file; call it before the
 /// computation.
 pub fn check_output_file(option: &str, path: &Path, inputs: &[&Path]) -> Result<()> {
+    refuse_mat_variable_name(option, path)?;
     // writable before minutes of work: create the directory and a probe file in it
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).with_context(|| {

@@ -525,9 +525,10 @@ impl Scenario {
                     .map_err(|e| anyhow!("{}: [gnss] sigma_ne: {e}", at("sigma_ne")))?;
                 let sd = units::parse_quantity_as(&g.sigma_d, "m")
                     .map_err(|e| anyhow!("{}: [gnss] sigma_d: {e}", at("sigma_d")))?;
-                if !(sne > 0.0 && sne <= 1e4 && sd > 0.0 && sd <= 1e4) {
+                // gnss.txt holds heights to 0.1 mm: a σ must be well above that
+                if !((1e-3..=1e4).contains(&sne) && (1e-3..=1e4).contains(&sd)) {
                     bail!(
-                        "{}: [gnss] sigma_ne and sigma_d must be in (0, 1e4] m",
+                        "{}: [gnss] sigma_ne and sigma_d must be in [1e-3, 1e4] m (gnss.txt holds positions to 0.1 mm)",
                         at("sigma_ne")
                     );
                 }
@@ -539,8 +540,11 @@ impl Scenario {
             Some(v) => {
                 let sv = units::parse_quantity_as(v, "m/s")
                     .map_err(|e| anyhow!("{}: [gnss] sigma_v: {e}", at("sigma_v")))?;
-                if !(sv > 0.0 && sv <= 100.0) {
-                    bail!("{}: [gnss] sigma_v must be in (0, 100] m/s", at("sigma_v"));
+                if !(1e-4..=100.0).contains(&sv) {
+                    bail!(
+                        "{}: [gnss] sigma_v must be in [1e-4, 100] m/s (gnss.txt holds velocities to 1 um/s)",
+                        at("sigma_v")
+                    );
                 }
                 Some(sv)
             }

@@ -93,9 +93,10 @@ pub fn read_array(path: &Path, var: Option<&str>, n_cols: usize, what: &str) -> 
     if !text.starts_with("MATLAB 5.0") {
         bail!("{file}: not a MATLAB level-5 .mat file (its header does not start with `MATLAB 5.0 MAT-file`; a MATLAB 4 file can be re-saved with -v6)");
     }
+    prescan(&bytes, &file)?;
     let mat = parse_quietly(&bytes).map_err(|e| {
         anyhow::anyhow!(
-            "{file}: not a readable MATLAB level-5 .mat file ({e}); save it with -v7 or -v6"
+            "{file}: a MATLAB level-5 file whose contents cannot be read ({e}): corrupt, or holding arrays of a kind not read here"
         )
     })?;
     let listing = || {
@@ -204,6 +205,85 @@ pub fn read_array(path: &Path, var: Option<&str>, n_cols: usize, what: &str) -> 
         n_cols,
         name,
     })
+}
+
+/// Largest total size of a file's compressed elements once inflated [bytes].
+pub const MAX_INFLATED_BYTES: u64 = MAX_MAT_BYTES;
+
+/// Walks the top-level elements of a level-5 file before the `matfile` crate reads it: each
+/// must be a matrix (14) or a compressed matrix (15) lying wholly inside the file, and the
+/// compressed ones must inflate (checksum included) to at most [`MAX_INFLATED_BYTES`] in all,
+/// counted without keeping them. A truncated file, a corrupt stream or a small file that
+/// inflates without bound is refused here, with what was found.
+fn prescan(bytes: &[u8], file: &str) -> Result<()> {
+    prescan_within(bytes, file, MAX_INFLATED_BYTES)
+}
+
+/// [`prescan`] with an inflation budget [bytes].
+fn prescan_within(bytes: &[u8], file: &str, max_inflated: u64) -> Result<()> {
+    let little = match &bytes[126..128] {
+        b"IM" => true,
+        b"MI" => false,
+        _ => bail!("{file}: the header's byte-order mark is neither IM nor MI: not a MATLAB level-5 file, or corrupt"),
+    };
+    let u32_at = |o: usize| {
+        let b = [bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]];
+        if little {
+            u32::from_le_bytes(b)
+        } else {
+            u32::from_be_bytes(b)
+        }
+    };
+    let (mut o, mut k, mut inflated) = (128usize, 0usize, 0u64);
+    while o < bytes.len() {
+        k += 1;
+        if o + 8 > bytes.len() {
+            bail!(
+                "{file}: truncated: element {k} at byte {o} has no complete tag ({} bytes left): an interrupted copy or download?",
+                bytes.len() - o
+            );
+        }
+        let (ty, n) = (u32_at(o), u32_at(o + 4) as usize);
+        let end = o + 8 + n;
+        if end > bytes.len() {
+            bail!(
+                "{file}: truncated: element {k} at byte {o} declares {n} bytes, {} remain: an interrupted copy or download?",
+                bytes.len() - o - 8
+            );
+        }
+        match ty {
+            14 => {}
+            15 => {
+                use std::io::Read;
+                let budget = max_inflated - inflated;
+                let corrupt = |e: std::io::Error| {
+                    anyhow::anyhow!("{file}: compressed element {k} at byte {o} is corrupt ({e})")
+                };
+                let dec = libflate::zlib::Decoder::new(&bytes[o + 8..end]).map_err(corrupt)?;
+                let got = std::io::copy(&mut dec.take(budget + 1), &mut std::io::sink())
+                    .map_err(corrupt)?;
+                if got > budget {
+                    bail!(
+                        "{file}: compressed element {k} inflates beyond {max_inflated} bytes (with the elements before it): refused, a .mat is read whole here"
+                    );
+                }
+                inflated += got;
+            }
+            _ => bail!(
+                "{file}: element {k} at byte {o} has data type {ty}, not a matrix (14) or a compressed matrix (15): corrupt, or not a MATLAB data file"
+            ),
+        }
+        o = end;
+        // some writers pad a compressed element to 8 bytes; trailing zeros end the file
+        let aligned = (o + 7) & !7;
+        if aligned <= bytes.len() && bytes[o..aligned].iter().all(|b| *b == 0) {
+            o = aligned;
+        }
+        if bytes[o..].iter().all(|b| *b == 0) {
+            break;
+        }
+    }
+    Ok(())
 }
 
 /// Parses a `.mat` file with the `matfile` crate, a panic inside it (an arithmetic overflow on
@@ -420,6 +500,61 @@ mod tests {
         );
         let e = read_avp(&p, Some("imu")).unwrap_err().to_string();
         assert!(e.contains("2x7") && e.contains("N x 10"), "{e}");
+    }
+
+    /// A compressed element (as `save -v7` writes) reads like the plain one; truncation, a
+    /// foreign element type, a corrupt stream and an inflation beyond the budget are refused
+    /// by the pre-scan with what was found.
+    #[test]
+    fn compressed_elements_and_the_prescan() {
+        use std::io::Write;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain.mat");
+        let imu: Vec<f64> = (1..=20)
+            .flat_map(|k| [1e-6, 2e-6, 7e-7, 1e-3, 2e-3, 0.098, k as f64 * 0.01])
+            .collect();
+        write(&plain, &[("imu", &imu, 7)]).unwrap();
+        let bytes = std::fs::read(&plain).unwrap();
+        // the same miMATRIX element, zlib-compressed into a miCOMPRESSED element
+        let mut enc = libflate::zlib::Encoder::new(Vec::new()).unwrap();
+        enc.write_all(&bytes[128..]).unwrap();
+        let z = enc.finish().into_result().unwrap();
+        let mut comp = bytes[..128].to_vec();
+        comp.extend_from_slice(&15u32.to_le_bytes());
+        comp.extend_from_slice(&(z.len() as u32).to_le_bytes());
+        comp.extend_from_slice(&z);
+        let cp = dir.path().join("comp.mat");
+        std::fs::write(&cp, &comp).unwrap();
+        let (a, b) = (
+            read_imu(&plain, None).unwrap().0,
+            read_imu(&cp, None).unwrap().0,
+        );
+        assert_eq!(a.samples.len(), 20);
+        assert!(a
+            .samples
+            .iter()
+            .zip(&b.samples)
+            .all(|(x, y)| x.t == y.t && x.dv == y.dv));
+        // inflation budget
+        let e = prescan_within(&comp, "c.mat", 100).unwrap_err().to_string();
+        assert!(e.contains("inflates beyond 100 bytes"), "{e}");
+        assert!(prescan_within(&comp, "c.mat", 1 << 20).is_ok());
+        // truncated
+        let e = prescan(&comp[..comp.len() - 5], "t.mat")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("truncated: element 1"), "{e}");
+        // corrupt stream (a flipped byte in the deflate data)
+        let mut bad = comp.clone();
+        let mid = 136 + z.len() / 2;
+        bad[mid] ^= 0x55;
+        let e = prescan(&bad, "b.mat").unwrap_err().to_string();
+        assert!(e.contains("corrupt") || e.contains("truncated"), "{e}");
+        // a foreign element type
+        let mut foreign = bytes.clone();
+        foreign[128] = 13;
+        let e = prescan(&foreign, "f.mat").unwrap_err().to_string();
+        assert!(e.contains("data type 13"), "{e}");
     }
 
     #[test]
