@@ -569,7 +569,7 @@ impl DataArgs {
             .static_aid
             .as_ref()
             .map(|_| sinsmodel::model::measurement_sigma("vel_ne").unwrap_or(0.01)));
-        let t0 = imu.first_t() - imu.interval();
+        let t0 = imu.start_time();
         let fixes: AidPlan = match (&args.aid, &args.static_aid) {
             (Some(p), None) => {
                 let fixes: Vec<(aiding::PositionFix, Option<aiding::VelocityFix>)> =
@@ -703,6 +703,15 @@ impl DataArgs {
             });
         }
         outages.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+        if let Some(w) = outages.windows(2).find(|w| w[1].start_s < w[0].end_s) {
+            bail!(
+                "--outage: the windows {:.3} .. {:.3} s and {:.3} .. {:.3} s overlap: give each outage once (one window from the first start to the last end)",
+                w[0].start_s,
+                w[0].end_s,
+                w[1].start_s,
+                w[1].end_s
+            );
+        }
         let d = std::f64::consts::PI / 180.0;
         let init_values: Option<Vec<f64>> = match args.init.as_deref() {
             None | Some("auto") => None,

@@ -183,6 +183,13 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         f.commit()?;
     }
     let nav_rows = nav.rows;
+    if nav_rows == 0 {
+        anyhow::bail!(
+            "--nav-rate {}: not one row of nav.txt within the data ({:.3} s of filtering): choose a higher rate",
+            args.nav_rate.unwrap_or(0.0),
+            t_last - start.t
+        );
+    }
     nav.finish(&out.file("nav.png"))?;
     let outage_rows = outage_drifts(&inputs.outages, &run, t_first, t_last)?;
     if !outage_rows.is_empty() {

@@ -67,10 +67,12 @@ impl RowClock {
         if self.period == 0.0 {
             return true;
         }
-        if t < self.t0 + self.n as f64 * self.period - self.tol {
+        // a relative 1e-9 so that a sample exactly at a threshold counts on either rounding
+        let eps = 1e-9 * t.abs().max(1.0);
+        if t + eps < self.t0 + self.n as f64 * self.period - self.tol {
             return false;
         }
-        while self.t0 + self.n as f64 * self.period - self.tol <= t {
+        while self.t0 + self.n as f64 * self.period - self.tol <= t + eps {
             self.n += 1;
         }
         true

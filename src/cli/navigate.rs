@@ -118,7 +118,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     drop(head);
     let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
     let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
-    let t0 = data.first_t() - data.interval();
+    let t0 = data.start_time();
     let start = NavState {
         t: t0,
         lat: args.lat * d,
@@ -150,6 +150,10 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     let pb = progress::bar(1000, "navigate");
     let mut prev_t = t0;
     while let Some(s) = data.next()? {
+        if s.t <= t0 {
+            // a jittered clock starts at its first sample (`ImuStream::start_time`)
+            continue;
+        }
         let k = data.count() - 1;
         nav.step(&s.dtheta, &s.dv, s.t - prev_t);
         nav.state.t = s.t;

@@ -389,7 +389,7 @@ pub fn find(
         .map(|k| fixes[k].t);
     let min_q = MIN_QUIET_S.round() as usize;
     let mut quiet = quiet_stretch(&secs, first_motion, at_end, min_q);
-    let mut unconfirmed: Option<(f64, f64)> = None;
+    let mut unconfirmed: Option<String> = None;
     // the IMU alone cannot tell rest from a steady straight drive: the GNSS (or --static-aid)
     // must confirm it, with at least one fix with a velocity inside the stretch and none moving
     if let (Some((k, e, closed)), None) = (quiet, static_pos) {
@@ -402,7 +402,31 @@ pub fn find(
             if !closed && !at_end && inside.is_empty() {
                 return Ok(Found::NeedMore);
             }
-            unconfirmed = Some((t_a, t_b));
+            unconfirmed = Some(format!(
+                "the IMU looks still from {t_a:.3} to {t_b:.3} s, but no GNSS fix with a velocity confirms rest there, and a steady straight drive looks the same"
+            ));
+            quiet = None;
+        }
+    }
+    // at rest the gyros measure the Earth rate and their bias: a mean rate beyond that is a
+    // steady turn (a vehicle turning in place, a slow swing), not rest
+    if let Some((k, e, _)) = quiet {
+        let r = &secs[k..e];
+        let n = r.len() as f64;
+        let w_mean = r.iter().map(|x| x.w).sum::<Vector3<f64>>() / n;
+        let w_scatter = (r.iter().map(|x| (x.w - w_mean).norm_squared()).sum::<f64>()
+            / (n - 1.0).max(1.0))
+        .sqrt();
+        let allowed =
+            earth::OMEGA + 3.0 * (3.0 * priors.gyro_bias.powi(2) + w_scatter.powi(2) / n).sqrt();
+        if w_mean.norm() > allowed {
+            unconfirmed = Some(format!(
+                "the IMU turns steadily at {:.4} deg/s from {:.3} to {:.3} s, more than the Earth rate and the gyro-bias prior allow ({:.4} deg/s): not at rest",
+                w_mean.norm().to_degrees(),
+                r[0].t_start,
+                r[r.len() - 1].t_end,
+                allowed.to_degrees()
+            ));
             quiet = None;
         }
     }
@@ -420,16 +444,24 @@ pub fn find(
                 .copied()
                 .collect();
             let (f, w) = mean_of(&q);
-            let (roll, pitch) = tilt_from(f);
             let t_q = q[0].t_start;
             let q_s = q.last().unwrap().t_end - t_q;
+            // the run starts at the stretch's start: level from its first seconds (at most 10 s;
+            // an attitude that creeps while standing is not averaged into the start)
+            let first: Vec<Block> = q
+                .iter()
+                .filter(|b| b.t_end <= t_q + 10.0 + 1e-9)
+                .copied()
+                .collect();
+            let (f_first, _) = mean_of(&first);
+            let (roll, pitch) = tilt_from(f_first);
             let mut report = vec![format!(
-                "level: roll {:.3} deg, pitch {:.3} deg from {:.1} s at rest from t = {:.3} s (1-sigma {:.3} deg from the accelerometer bias prior)",
+                "level: roll {:.3} deg, pitch {:.3} deg from the first {:.1} s of {:.1} s at rest from t = {:.3} s",
                 deg(roll),
                 deg(pitch),
+                first.last().map(|b| b.t_end - t_q).unwrap_or(0.0),
                 q_s,
-                t_q,
-                deg(sigma_tilt)
+                t_q
             )];
             // the scatter of the 1-s means at rest: noise and vibration, as the data show them
             let rest_secs = &secs[k..e];
@@ -444,6 +476,8 @@ pub fn find(
             };
             let f_scatter = scatter(&|x| x.f, f);
             let w_scatter = scatter(&|x| x.w, w);
+            // the tilt's 1-σ: the accelerometer bias prior and how much the 1-s means wander
+            let sigma_tilt = sigma_tilt.hypot(f_scatter / g);
             let horiz_rate = earth::OMEGA * pos0[0].cos();
             // heading 1-σ of gyrocompassing: the bias prior and the noise of the mean rate
             let gc_bias = priors.gyro_bias / horiz_rate;
@@ -535,6 +569,13 @@ pub fn find(
             // the acceleration: from the end of rest (at most 2 s before the GNSS shows motion)
             // for at most 5 s, not past the fix
             let t_m = first_motion.unwrap_or(t_b).max(t_b);
+            if fx.t - t_m > 10.0 {
+                bail!(
+                    "--init auto: the first GNSS fix faster than {} m/s comes {:.1} s after the drive-off begins ({t_m:.3} s): by then the course no longer shows the heading at rest; denser GNSS fixes, or --init",
+                    priors.speed,
+                    fx.t - t_m
+                );
+            }
             let (w0, w1) = ((t_m - 2.0).max(t_b), fx.t.min(t_m + 3.0));
             let acc: Vec<Block> = blocks
                 .iter()
@@ -545,7 +586,34 @@ pub fn find(
                 bail!("--init auto: no IMU data between the end of rest ({t_b:.3} s) and the fix at {:.3} s", fx.t);
             }
             let (fa, _) = mean_of(&acc);
-            let a_level = dcm_from_euler(roll, pitch, 0.0) * (fa - f);
+            // against the last seconds at rest (the attitude the drive-off starts from)
+            let last: Vec<Block> = q
+                .iter()
+                .filter(|b| b.t_start >= t_b - 5.0 - 1e-9)
+                .copied()
+                .collect();
+            let (f_last, _) = mean_of(&last);
+            let (roll_l, pitch_l) = tilt_from(f_last);
+            let level_last = dcm_from_euler(roll_l, pitch_l, 0.0);
+            // the heading change the gyros see from time a to b, their mean at rest (Earth rate
+            // and bias) taken off
+            let turned = |a: f64, b: f64| -> f64 {
+                blocks
+                    .iter()
+                    .filter(|x| x.t_start >= a - 1e-9 && x.t_end <= b + 1e-9)
+                    .map(|x| (level_last * (x.w - w)).z * (x.t_end - x.t_start))
+                    .sum()
+            };
+            let turn_acc = turned(w0, acc.last().unwrap().t_end);
+            if turn_acc.abs() > COURSE_SLACK {
+                bail!(
+                    "--init auto: the vehicle turns {:.1} deg during the drive-off ({w0:.3} .. {:.3} s, by the gyros): the acceleration then does not point along the travel; give the heading with --init LAT,LON,H,ROLL,PITCH,YAW",
+                    deg(turn_acc),
+                    acc.last().unwrap().t_end
+                );
+            }
+            let turn_fix = turned(t_b, fx.t);
+            let a_level = level_last * (fa - f_last);
             let a_h = a_level.x.hypot(a_level.y);
             if a_h < MIN_DRIVE_OFF_ACCEL {
                 bail!(
@@ -555,16 +623,20 @@ pub fn find(
             let v = fx.v.unwrap();
             let course = v.y.atan2(v.x);
             let travel = a_level.y.atan2(a_level.x);
-            let yaw = course - travel;
+            // the heading at the fix less the turn since the rest: the heading at rest
+            let yaw = course - travel - turn_fix;
             // the accelerometer bias is in both means and cancels; their noise does not
             let acc_s = acc.last().unwrap().t_end - w0;
             let sigma_a = f_scatter * (1.0 / nsec + 1.0 / acc_s.max(BLOCK_S)).sqrt();
+            // the gyros' noise over the time from rest to the fix
+            let sigma_turn = w_scatter / nsec.sqrt() * (fx.t - t_b);
             let sigma_yaw = ((sigma_a / a_h).powi(2)
                 + (fx.sigma_v / fx.speed()).powi(2)
+                + sigma_turn.powi(2)
                 + COURSE_SLACK.powi(2))
             .sqrt();
             report.push(format!(
-                "heading: {:.3} deg from the drive-off: acceleration {:.2} m/s^2 at {:.1} deg from the IMU x axis over {:.2} s after t = {:.3} s, GNSS course {:.2} deg at {:.3} s ({:.1} m/s); 1-sigma {:.2} deg (accelerometer noise, course noise, {:.0} deg for a turn during the drive-off)",
+                "heading: {:.3} deg from the drive-off: acceleration {:.2} m/s^2 at {:.1} deg from the IMU x axis over {:.2} s after t = {:.3} s, GNSS course {:.2} deg at {:.3} s ({:.1} m/s), {:.2} deg turned since the rest (gyros); 1-sigma {:.2} deg (accelerometer noise, course noise, gyro noise, {:.0} deg for the acceleration's direction)",
                 deg(yaw.rem_euclid(2.0 * std::f64::consts::PI)),
                 a_h,
                 deg(travel),
@@ -573,6 +645,7 @@ pub fn find(
                 deg(course.rem_euclid(2.0 * std::f64::consts::PI)),
                 fx.t,
                 fx.speed(),
+                deg(turn_fix),
                 deg(sigma_yaw),
                 deg(COURSE_SLACK)
             ));
@@ -605,49 +678,71 @@ pub fn find(
                 return Ok(Found::NeedMore);
             }
             // the first fast fix with neighbours for the acceleration and IMU data around it
-            // the first fast fix (beyond its noise, confirmed by the next) with velocities
-            // about 1 s either side for the acceleration
-            let fast = (0..fixes.len().saturating_sub(1)).find_map(|k| {
+            // the first fast fix (beyond its noise, confirmed by the next) with velocities about
+            // 1 s before and after it for the acceleration, where the vehicle does not turn
+            // (the specific force is averaged in the body frame, the GNSS acceleration in NED:
+            // in a turn they differ)
+            let mut chosen = None;
+            let mut turning: Option<(f64, f64)> = None;
+            for k in 0..fixes.len().saturating_sub(1) {
                 let f = &fixes[k];
                 let ok = f.t >= t0 + 0.5
                     && f.moving()
                     && f.speed() > priors.speed
                     && fixes[k + 1].moving()
                     && fixes[k + 1].t - f.t <= 2.5;
-                let (a, b) = neighbours(fixes, k)?;
-                (ok && fixes[a].v.is_some() && fixes[b].v.is_some()).then_some((k, a, b))
-            });
-            let Some((k, ka, kb)) = fast else {
+                let Some((a, b)) = neighbours(fixes, k) else {
+                    continue;
+                };
+                if !(ok && a < k && k < b && fixes[a].v.is_some() && fixes[b].v.is_some()) {
+                    continue;
+                }
+                if t_read < fixes[b].t {
+                    if at_end {
+                        break;
+                    }
+                    return Ok(Found::NeedMore);
+                }
+                let win: Vec<Block> = blocks
+                    .iter()
+                    .filter(|x| x.t_start >= fixes[a].t - 1e-9 && x.t_end <= fixes[b].t + 1e-9)
+                    .copied()
+                    .collect();
+                if win.is_empty() {
+                    continue;
+                }
+                let (fw, _) = mean_of(&win);
+                let (r0, p0) = tilt_from(fw);
+                let lev = dcm_from_euler(r0, p0, 0.0);
+                let turn: f64 = win
+                    .iter()
+                    .map(|x| (lev * x.w).z * (x.t_end - x.t_start))
+                    .sum();
+                if turn.abs() > COURSE_SLACK {
+                    turning.get_or_insert((f.t, turn));
+                    continue;
+                }
+                chosen = Some((k, a, b, win));
+                break;
+            }
+            let Some((k, ka, kb, around)) = chosen else {
                 if at_end {
                     bail!(
-                        "--init auto: the data start moving, and the GNSS speed never exceeds {} m/s (with fixes either side) to take a heading from the course; give --init LAT,LON,H,ROLL,PITCH,YAW",
-                        priors.speed
+                        "--init auto: the data start moving, and no GNSS fix faster than {} m/s (and 4 sigma of its noise, confirmed by the next fix) has fixes about 1 s before and after it{}; give --init LAT,LON,H,ROLL,PITCH,YAW",
+                        priors.speed,
+                        match turning {
+                            Some((t, turn)) => format!(
+                                " while the vehicle drives straight (the first candidate, at {t:.3} s, turns {:.1} deg in its window)",
+                                deg(turn)
+                            ),
+                            None => String::new(),
+                        }
                     );
                 }
                 return Ok(Found::NeedMore);
             };
             let fx = fixes[k];
-            if t_read < fx.t + 0.5 {
-                return if at_end {
-                    bail!(
-                        "--init auto: the IMU data end at the first fast GNSS fix ({:.3} s)",
-                        fx.t
-                    )
-                } else {
-                    Ok(Found::NeedMore)
-                };
-            }
-            let around: Vec<Block> = blocks
-                .iter()
-                .filter(|b| b.t_start >= fx.t - 0.5 - 1e-9 && b.t_end <= fx.t + 0.5 + 1e-9)
-                .copied()
-                .collect();
-            if around.is_empty() {
-                bail!(
-                    "--init auto: no IMU data around the GNSS fix at {:.3} s",
-                    fx.t
-                );
-            }
+            // the specific force over the same span as the GNSS acceleration
             let (f, _) = mean_of(&around);
             let (va, vb) = (fixes[ka].v.unwrap(), fixes[kb].v.unwrap());
             let dt_a = fixes[kb].t - fixes[ka].t;
@@ -686,12 +781,9 @@ pub fn find(
             let report = vec![
                 format!(
                     "the data start moving ({} before the GNSS shows motion at {:.3} s): the run starts at {:.3} s, at the first GNSS fix faster than {} m/s (confirmed by the next fix) with fixes around it for the acceleration and 0.5 s of IMU data before it",
-                    match unconfirmed {
-                        Some((a, b)) => format!(
-                            "the IMU looks still from {a:.3} to {b:.3} s, but no GNSS fix with a velocity confirms rest there, and a steady straight drive looks the same"
-                        ),
-                        None => format!("no {MIN_QUIET_S:.0} s at rest"),
-                    },
+                    unconfirmed
+                        .clone()
+                        .unwrap_or_else(|| format!("no {MIN_QUIET_S:.0} s at rest")),
                     first_motion.unwrap(),
                     t_s,
                     priors.speed
@@ -704,9 +796,11 @@ pub fn find(
                     deg(sigma_yaw)
                 ),
                 format!(
-                    "level: roll {:.3} deg, pitch {:.3} deg from the specific force over 1 s around it less the GNSS acceleration ({:.2} m/s^2); 1-sigma {:.3} deg",
+                    "level: roll {:.3} deg, pitch {:.3} deg from the specific force from {:.3} to {:.3} s less the GNSS acceleration over the same span ({:.2} m/s^2); 1-sigma {:.3} deg",
                     deg(roll),
                     deg(pitch),
+                    fixes[ka].t,
+                    fixes[kb].t,
                     a_n.norm(),
                     deg(sigma_tilt)
                 ),

@@ -386,6 +386,21 @@ impl ImuStream {
         self.head[0].t
     }
 
+    /// When a run over the stream starts [s]: the start of the first sample's interval on a
+    /// uniform clock (first time − interval); on a jittered clock that interval is unknown, so
+    /// the run starts at the first sample's time and integrates from the second sample (a
+    /// median interval in its place had put up to 10 ms of gravity into the first step).
+    pub fn start_time(&self) -> f64 {
+        let head = ImuData {
+            samples: self.head.clone(),
+        };
+        if head.samples.len() > 2 && head.jitter_rms() > 1e-6 * self.interval {
+            self.first_t()
+        } else {
+            self.first_t() - self.interval
+        }
+    }
+
     /// Time of the last sample handed out [s] (NaN before the first).
     pub fn last_t(&self) -> f64 {
         self.last_t

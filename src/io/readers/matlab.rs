@@ -259,9 +259,32 @@ fn prescan_within(bytes: &[u8], file: &str, max_inflated: u64) -> Result<()> {
                 let corrupt = |e: std::io::Error| {
                     anyhow::anyhow!("{file}: compressed element {k} at byte {o} is corrupt ({e})")
                 };
-                let dec = libflate::zlib::Decoder::new(&bytes[o + 8..end]).map_err(corrupt)?;
-                let got = std::io::copy(&mut dec.take(budget + 1), &mut std::io::sink())
+                let mut dec = libflate::zlib::Decoder::new(&bytes[o + 8..end]).map_err(corrupt)?;
+                // what it holds must be one matrix (MATLAB never nests compression)
+                let mut tag = [0u8; 8];
+                dec.read_exact(&mut tag).map_err(corrupt)?;
+                let u = |b: &[u8]| {
+                    let b = [b[0], b[1], b[2], b[3]];
+                    if little {
+                        u32::from_le_bytes(b)
+                    } else {
+                        u32::from_be_bytes(b)
+                    }
+                };
+                let (inner_ty, inner_n) = (u(&tag[..4]), u(&tag[4..]) as u64);
+                if inner_ty != 14 {
+                    bail!(
+                        "{file}: compressed element {k} at byte {o} holds data type {inner_ty}, not a matrix (14): corrupt, or written by something other than MATLAB"
+                    );
+                }
+                let got = 8 + std::io::copy(&mut dec.take(budget.saturating_sub(8) + 1), &mut std::io::sink())
                     .map_err(corrupt)?;
+                if got <= budget && inner_n + 8 > got {
+                    bail!(
+                        "{file}: compressed element {k} at byte {o} holds a matrix declaring {inner_n} bytes, but only {} inflate: corrupt",
+                        got - 8
+                    );
+                }
                 if got > budget {
                     bail!(
                         "{file}: compressed element {k} inflates beyond {max_inflated} bytes (with the elements before it): refused, a .mat is read whole here"
@@ -550,6 +573,17 @@ mod tests {
         bad[mid] ^= 0x55;
         let e = prescan(&bad, "b.mat").unwrap_err().to_string();
         assert!(e.contains("corrupt") || e.contains("truncated"), "{e}");
+        // compression nested in compression (MATLAB never writes it; the inner layer would
+        // escape the budget)
+        let mut enc = libflate::zlib::Encoder::new(Vec::new()).unwrap();
+        enc.write_all(&comp[128..]).unwrap();
+        let z2 = enc.finish().into_result().unwrap();
+        let mut nested = bytes[..128].to_vec();
+        nested.extend_from_slice(&15u32.to_le_bytes());
+        nested.extend_from_slice(&(z2.len() as u32).to_le_bytes());
+        nested.extend_from_slice(&z2);
+        let e = prescan(&nested, "n.mat").unwrap_err().to_string();
+        assert!(e.contains("holds data type 15"), "{e}");
         // a foreign element type
         let mut foreign = bytes.clone();
         foreign[128] = 13;
