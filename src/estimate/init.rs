@@ -3,20 +3,22 @@
 //! The IMU is reduced to quarter-second means of specific force and angular rate (each
 //! increment over its own interval, so a jittered clock gives the uniform clock's means). Then:
 //!
-//! - **Quiet start** (the first seconds at rest by the absolute tests of
-//!   [`crate::estimate::align::RestEvidence`], before the GNSS shows motion): roll and pitch from
-//!   the mean specific force over the whole quiet stretch; yaw by gyrocompassing when the gyro
-//!   bias prior lets the Earth rate show north to 1° and the stretch lasts 60 s, else from the
-//!   drive-off: the direction of the first acceleration after the stretch, levelled, matched to
-//!   the GNSS course once the speed exceeds the threshold (no assumption on how the IMU is
-//!   mounted in the vehicle: the angle between the IMU's x axis and the direction of travel is
-//!   found, [`crate::estimate::mounting`]'s method). The run starts at the quiet stretch's start,
-//!   at rest.
-//! - **Moving start** (no quiet stretch before the vehicle moves): the run starts at the first
-//!   GNSS fix faster than the threshold; yaw is the GNSS course there (this assumes the IMU's x
-//!   axis points along the direction of travel: the data cannot say otherwise), roll and pitch
-//!   from the mean specific force around it corrected by the GNSS acceleration; position and
-//!   velocity from the GNSS.
+//! - **Quiet start**: the first stretch at rest by the tests of [`crate::estimate::align`]
+//!   (angular-rate spread, |f| against gravity), its 1-s means steady, its mean rate no more
+//!   than the Earth rate and the gyro-bias prior allow (a steady turn is not rest), and GNSS
+//!   fixes inside it showing no motion (a steady straight drive passes every IMU test). Roll
+//!   and pitch from its first 10 s; the run starts there, at rest. Yaw by gyrocompassing when
+//!   the bias prior and the scatter of the rates give 1° over at least 60 s; else from the
+//!   drive-off: the IMU's own velocity since the rest (specific force levelled, turned by the
+//!   heading change the gyros see, the force at rest taken off) matched to the GNSS course at
+//!   the first fast fix within 10 s of the motion. No assumption on how the IMU sits in the
+//!   vehicle, which may turn while it drives off: the direction of travel from the IMU's x
+//!   axis (the mounting yaw) comes out too. The IMU's and the GNSS's speeds must agree.
+//! - **Moving start** (no confirmed rest before the GNSS shows motion): the run starts at the
+//!   first GNSS fix that is fast beyond its noise, confirmed by the next, with fixes about 1 s
+//!   either side over which the vehicle drives straight; yaw is the GNSS course (this assumes
+//!   the IMU's x axis along the direction of travel, and says so), roll and pitch from the
+//!   specific force over that span less the GNSS acceleration over the same span.
 //!
 //! Each found angle comes with a 1-σ the filter starts from.
 
@@ -38,8 +40,6 @@ pub const GYROCOMPASS_S: f64 = 60.0;
 pub const GYROCOMPASS_MAX_SIGMA: f64 = std::f64::consts::PI / 180.0;
 /// Default GNSS speed above which the course gives the heading [m/s].
 pub const DEFAULT_SPEED: f64 = 3.0;
-/// Smallest levelled drive-off acceleration whose direction is used [m/s²].
-pub const MIN_DRIVE_OFF_ACCEL: f64 = 0.3;
 /// Seconds of IMU data searched for a start before giving up [s].
 pub const SEARCH_S: f64 = 1800.0;
 /// Heading 1-σ allowed for the vehicle turning during a drive-off, or for a course that is not
@@ -384,7 +384,7 @@ pub fn find(
             fixes[k].t >= t0
                 && fixes[k].moving()
                 && fixes[k + 1].moving()
-                && fixes[k + 1].t - fixes[k].t <= 2.5
+                && fixes[k + 1].t - fixes[k].t <= 5.0
         })
         .map(|k| fixes[k].t);
     let min_q = MIN_QUIET_S.round() as usize;
@@ -566,27 +566,18 @@ pub fn find(
             if t_read < fx.t {
                 return Ok(Found::NeedMore);
             }
-            // the acceleration: from the end of rest (at most 2 s before the GNSS shows motion)
-            // for at most 5 s, not past the fix
+            // the course fix must follow the drive-off closely
             let t_m = first_motion.unwrap_or(t_b).max(t_b);
             if fx.t - t_m > 10.0 {
                 bail!(
-                    "--init auto: the first GNSS fix faster than {} m/s comes {:.1} s after the drive-off begins ({t_m:.3} s): by then the course no longer shows the heading at rest; denser GNSS fixes, or --init",
+                    "--init auto: the first GNSS fix faster than {} m/s comes {:.1} s after the drive-off begins ({t_m:.3} s): by then the course no longer shows the heading at rest (a fix has a velocity from the file's columns, or from positions at most 5 s apart); denser GNSS fixes, or --init",
                     priors.speed,
                     fx.t - t_m
                 );
             }
-            let (w0, w1) = ((t_m - 2.0).max(t_b), fx.t.min(t_m + 3.0));
-            let acc: Vec<Block> = blocks
-                .iter()
-                .filter(|b| b.t_start >= w0 - 1e-9 && b.t_end <= w1 + 1e-9)
-                .copied()
-                .collect();
-            if acc.is_empty() {
-                bail!("--init auto: no IMU data between the end of rest ({t_b:.3} s) and the fix at {:.3} s", fx.t);
-            }
-            let (fa, _) = mean_of(&acc);
-            // against the last seconds at rest (the attitude the drive-off starts from)
+            // the IMU's own velocity since the rest, in the levelled frame of the heading at
+            // rest: each block's specific force levelled, turned by the heading change the
+            // gyros saw since the rest (their mean at rest taken off), less the force at rest
             let last: Vec<Block> = q
                 .iter()
                 .filter(|b| b.t_start >= t_b - 5.0 - 1e-9)
@@ -595,57 +586,92 @@ pub fn find(
             let (f_last, _) = mean_of(&last);
             let (roll_l, pitch_l) = tilt_from(f_last);
             let level_last = dcm_from_euler(roll_l, pitch_l, 0.0);
-            // the heading change the gyros see from time a to b, their mean at rest (Earth rate
-            // and bias) taken off
-            let turned = |a: f64, b: f64| -> f64 {
-                blocks
-                    .iter()
-                    .filter(|x| x.t_start >= a - 1e-9 && x.t_end <= b + 1e-9)
-                    .map(|x| (level_last * (x.w - w)).z * (x.t_end - x.t_start))
-                    .sum()
+            let f_rest_l = level_last * f_last;
+            // the GNSS side: the chord between the fixes about 1 s either side of the fast fix
+            // (the velocity there, as a mean over the same span the IMU's is taken over, so a
+            // turn in between is seen alike by both)
+            let kx = fixes.iter().position(|f| f.t == fx.t).unwrap_or(0);
+            let Some((ka, kb)) = neighbours(fixes, kx) else {
+                bail!(
+                    "--init auto: no GNSS fixes around the fix at {:.3} s for the course",
+                    fx.t
+                );
             };
-            let turn_acc = turned(w0, acc.last().unwrap().t_end);
-            if turn_acc.abs() > COURSE_SLACK {
+            let (ta, tb) = (fixes[ka].t, fixes[kb].t);
+            if t_read < tb {
+                return if at_end {
+                    bail!("--init auto: the IMU data end before the GNSS fix at {tb:.3} s the course needs")
+                } else {
+                    Ok(Found::NeedMore)
+                };
+            }
+            let (v_chord, sigma_chord) = velocity_between(fixes, ka, kb);
+            // the IMU side: velocity and displacement since the rest, block by block
+            let (mut psi, mut v_imu, mut disp) =
+                (0.0f64, Vector3::<f64>::zeros(), Vector3::<f64>::zeros());
+            let mut track: Vec<(f64, Vector3<f64>, f64)> = vec![(t_b, disp, psi)];
+            for x in blocks
+                .iter()
+                .filter(|x| x.t_start >= t_b - 1e-9 && x.t_end <= tb + 1e-9)
+            {
+                let dt = x.t_end - x.t_start;
+                let rate = (level_last * (x.w - w)).z;
+                let mid = psi + 0.5 * rate * dt;
+                let v0 = v_imu;
+                v_imu += (dcm_from_euler(0.0, 0.0, mid) * (level_last * x.f) - f_rest_l) * dt;
+                disp += 0.5 * (v0 + v_imu) * dt;
+                psi += rate * dt;
+                track.push((x.t_end, disp, psi));
+            }
+            let at = |t: f64| {
+                *track
+                    .iter()
+                    .min_by(|p, q| (p.0 - t).abs().total_cmp(&(q.0 - t).abs()))
+                    .unwrap()
+            };
+            let (a_imu, b_imu) = (at(ta), at(tb));
+            let d_imu = (b_imu.1 - a_imu.1) / (b_imu.0 - a_imu.0).max(BLOCK_S);
+            let speed_imu = d_imu.x.hypot(d_imu.y);
+            let speed_gnss = v_chord.x.hypot(v_chord.y);
+            // the GNSS and the IMU must agree on how fast the vehicle goes there
+            if !(speed_imu > 0.5 * speed_gnss && speed_imu < 2.0 * speed_gnss) {
                 bail!(
-                    "--init auto: the vehicle turns {:.1} deg during the drive-off ({w0:.3} .. {:.3} s, by the gyros): the acceleration then does not point along the travel; give the heading with --init LAT,LON,H,ROLL,PITCH,YAW",
-                    deg(turn_acc),
-                    acc.last().unwrap().t_end
+                    "--init auto: from {ta:.3} to {tb:.3} s the IMU's integrated speed is {speed_imu:.2} m/s, the GNSS positions give {speed_gnss:.2} m/s: a clock offset between IMU and GNSS, or wrong IMU units? (give the heading with --init)"
                 );
             }
-            let turn_fix = turned(t_b, fx.t);
-            let a_level = level_last * (fa - f_last);
-            let a_h = a_level.x.hypot(a_level.y);
-            if a_h < MIN_DRIVE_OFF_ACCEL {
-                bail!(
-                    "--init auto: the drive-off after {t_b:.3} s accelerates only {a_h:.3} m/s^2 horizontally (at least {MIN_DRIVE_OFF_ACCEL} needed to see its direction); give the heading with --init LAT,LON,H,ROLL,PITCH,YAW"
-                );
-            }
-            let v = fx.v.unwrap();
-            let course = v.y.atan2(v.x);
-            let travel = a_level.y.atan2(a_level.x);
-            // the heading at the fix less the turn since the rest: the heading at rest
-            let yaw = course - travel - turn_fix;
-            // the accelerometer bias is in both means and cancels; their noise does not
-            let acc_s = acc.last().unwrap().t_end - w0;
-            let sigma_a = f_scatter * (1.0 / nsec + 1.0 / acc_s.max(BLOCK_S)).sqrt();
-            // the gyros' noise over the time from rest to the fix
-            let sigma_turn = w_scatter / nsec.sqrt() * (fx.t - t_b);
-            let sigma_yaw = ((sigma_a / a_h).powi(2)
-                + (fx.sigma_v / fx.speed()).powi(2)
+            let course = v_chord.y.atan2(v_chord.x);
+            // direction of the IMU's travel from the heading at rest
+            let alpha = d_imu.y.atan2(d_imu.x);
+            let yaw = course - alpha;
+            // the direction of travel seen from the IMU's axes (their heading mid-span)
+            let psi_mid = 0.5 * (a_imu.2 + b_imu.2);
+            let travel = (alpha - psi_mid + std::f64::consts::PI)
+                .rem_euclid(2.0 * std::f64::consts::PI)
+                - std::f64::consts::PI;
+            // 1-σ: the accelerometer noise integrated (1-s means scattering by f_scatter) and
+            // the force at rest subtracted over the span, the course noise, the gyros' noise
+            // over the span, and 2° for what the integration leaves out (pitching, a tilt change)
+            let span = tb - t_b;
+            let sigma_v_imu = (f_scatter.powi(2) * span.max(1.0)
+                + (f_scatter / (last.len() as f64 * BLOCK_S).max(1.0).sqrt() * span).powi(2))
+            .sqrt();
+            let sigma_turn = w_scatter / nsec.sqrt() * span;
+            let sigma_yaw = ((sigma_v_imu / speed_imu).powi(2)
+                + (sigma_chord / speed_gnss).powi(2)
                 + sigma_turn.powi(2)
                 + COURSE_SLACK.powi(2))
             .sqrt();
             report.push(format!(
-                "heading: {:.3} deg from the drive-off: acceleration {:.2} m/s^2 at {:.1} deg from the IMU x axis over {:.2} s after t = {:.3} s, GNSS course {:.2} deg at {:.3} s ({:.1} m/s), {:.2} deg turned since the rest (gyros); 1-sigma {:.2} deg (accelerometer noise, course noise, gyro noise, {:.0} deg for the acceleration's direction)",
+                "heading: {:.3} deg from the drive-off: from {:.3} to {:.3} s the IMU's own track since the rest at {:.3} s (specific force levelled and turned by the gyros, {:.1} deg by the end; {:.2} m/s) runs {:.1} deg from the heading at rest, the GNSS positions {:.2} deg ({:.2} m/s); 1-sigma {:.2} deg (accelerometer noise, course noise, gyro noise, {:.0} deg for what the integration leaves out)",
                 deg(yaw.rem_euclid(2.0 * std::f64::consts::PI)),
-                a_h,
-                deg(travel),
-                acc.last().unwrap().t_end - w0,
-                w0,
+                ta,
+                tb,
+                t_b,
+                deg(psi),
+                speed_imu,
+                deg(alpha),
                 deg(course.rem_euclid(2.0 * std::f64::consts::PI)),
-                fx.t,
-                fx.speed(),
-                deg(turn_fix),
+                speed_gnss,
                 deg(sigma_yaw),
                 deg(COURSE_SLACK)
             ));
@@ -690,7 +716,7 @@ pub fn find(
                     && f.moving()
                     && f.speed() > priors.speed
                     && fixes[k + 1].moving()
-                    && fixes[k + 1].t - f.t <= 2.5;
+                    && fixes[k + 1].t - f.t <= 5.0;
                 let Some((a, b)) = neighbours(fixes, k) else {
                     continue;
                 };
