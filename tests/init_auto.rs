@@ -47,6 +47,21 @@ fn filter(args: &[&str]) -> (bool, String) {
     (ok, err)
 }
 
+/// `filter` on a simulation's imu.txt and gnss.txt, writing to `out`: (success, stderr).
+fn filter_sim(sim: &Path, args: &[&str], out: &str) -> (bool, String) {
+    let (imu, aid) = (sim.join("imu.txt"), sim.join("gnss.txt"));
+    let mut a = vec![
+        "--imu",
+        imu.to_str().unwrap(),
+        "--aid",
+        aid.to_str().unwrap(),
+        "--out",
+        out,
+    ];
+    a.extend_from_slice(args);
+    filter(&a)
+}
+
 /// Mean NIS of each channel line (`  pos_n  220 updates  mean NIS  1.08 …`).
 fn mean_nis(err: &str) -> Vec<f64> {
     err.lines()
@@ -65,22 +80,20 @@ fn quiet_start_heading_from_the_drive_off_and_the_mounting() {
     let sim = simulate(&root().join("scenarios/drive.toml"), dir.path(), "drive");
     let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
     let out = dir.path().join("f");
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--grade",
-        "tactical",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--truth",
-        &s("truth.txt"),
-        "--init",
-        "auto",
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &[
+            "--model",
+            "P13",
+            "--grade",
+            "tactical",
+            "--truth",
+            &s("truth.txt"),
+            "--init",
+            "auto",
+        ],
         out.to_str().unwrap(),
-    ]);
+    );
     assert!(ok, "{err}");
     assert!(
         err.contains("init auto: level:") && err.contains("of 60.0 s at rest"),
@@ -149,19 +162,11 @@ fn navigation_grade_rest_gyrocompasses() {
     )
     .unwrap();
     let sim = simulate(&scen, dir.path(), "nav");
-    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--init",
-        "auto",
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &["--model", "P13", "--init", "auto"],
         dir.path().join("f").to_str().unwrap(),
-    ]);
+    );
     assert!(ok, "{err}");
     assert!(err.contains("by gyrocompassing 120.0 s at rest"), "{err}");
     let yaw = number_after(&err, "heading: ");
@@ -170,20 +175,11 @@ fn navigation_grade_rest_gyrocompasses() {
         (yaw - 130.0).abs() < 3.0 * sigma && sigma < 1.0,
         "{yaw} ± {sigma}"
     );
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--grade",
-        "mems",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--init",
-        "auto",
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &["--model", "P13", "--grade", "mems", "--init", "auto"],
         dir.path().join("g").to_str().unwrap(),
-    ]);
+    );
     assert!(ok, "{err}");
     assert!(err.contains("from the drive-off"), "{err}");
 }
@@ -263,26 +259,24 @@ fn jittered_moving_mems_case_through_align_allan_and_filter() {
 
     // filter from a moving start, velocity aiding, one outage
     let out_dir = dir.path().join("f");
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--mode",
-        "closed",
-        "--grade",
-        "mems",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--truth",
-        &s("truth.txt"),
-        "--init",
-        "auto",
-        "--outage",
-        "100,20",
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &[
+            "--model",
+            "P13",
+            "--mode",
+            "closed",
+            "--grade",
+            "mems",
+            "--truth",
+            &s("truth.txt"),
+            "--init",
+            "auto",
+            "--outage",
+            "100,20",
+        ],
         out_dir.to_str().unwrap(),
-    ]);
+    );
     assert!(ok, "{err}");
     assert!(err.contains("the data start moving"), "{err}");
     let yaw = number_after(&err, "heading: ");
@@ -374,23 +368,13 @@ fn init_auto_is_not_fooled() {
     )
     .unwrap();
     let sim = simulate(&noisy, dir.path(), "noisy");
-    let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--grade",
-        "tactical",
-        "--mode",
-        "closed",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--init",
-        "auto",
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &[
+            "--model", "P13", "--grade", "tactical", "--mode", "closed", "--init", "auto",
+        ],
         dir.path().join("a").to_str().unwrap(),
-    ]);
+    );
     assert!(ok, "{err}");
     assert!(
         err.contains("of 60.0 s at rest") && err.contains("from the drive-off"),
@@ -482,22 +466,20 @@ fn init_auto_is_not_fooled() {
         .collect();
     let tp = dir.path().join("shifted.txt");
     std::fs::write(&tp, shifted).unwrap();
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--grade",
-        "tactical",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--init",
-        "auto",
-        "--truth",
-        tp.to_str().unwrap(),
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &[
+            "--model",
+            "P13",
+            "--grade",
+            "tactical",
+            "--init",
+            "auto",
+            "--truth",
+            tp.to_str().unwrap(),
+        ],
         dir.path().join("f").to_str().unwrap(),
-    ]);
+    );
     assert!(!ok && err.contains("no row at any of the"), "{err}");
     assert!(!dir.path().join("f").exists());
 }
@@ -513,22 +495,20 @@ fn jittered_clock_filters_consistently() {
     std::fs::write(&jit, format!("clock_jitter_periods = 3\n{drive}")).unwrap();
     let sim = simulate(&jit, dir.path(), "jit");
     let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--grade",
-        "tactical",
-        "--mode",
-        "closed",
-        "--imu",
-        &s("imu.txt"),
-        "--aid",
-        &s("gnss.txt"),
-        "--truth",
-        &s("truth.txt"),
-        "--out",
+    let (ok, err) = filter_sim(
+        &sim,
+        &[
+            "--model",
+            "P13",
+            "--grade",
+            "tactical",
+            "--mode",
+            "closed",
+            "--truth",
+            &s("truth.txt"),
+        ],
         dir.path().join("f").to_str().unwrap(),
-    ]);
+    );
     assert!(ok, "{err}");
     for nis in mean_nis(&err) {
         assert!(nis > 0.7 && nis < 1.5, "{err}");
