@@ -29,12 +29,14 @@ fn mems_drive_mounting_and_noise_identification() {
             sigma_pos: p.sigma_neu[0].max(p.sigma_neu[1]).max(0.02),
             v: p.v_ned.map(Vector3::from),
             sigma_v: p.sigma_v_ne.map(|s| s[0].max(s[1])).unwrap_or(0.1),
+            derived: false,
         })
         .collect();
     let priors = Priors {
         gyro_bias: 0.5f64.to_radians(),
         accel_bias: 0.5,
         speed: init::DEFAULT_SPEED,
+        gyro_scale: 0.01,
     };
     let Found::Done(m) = init::find(&blocks.blocks, &fixes, None, priors, true).unwrap() else {
         panic!("no start found")

@@ -943,6 +943,7 @@ impl DataArgs {
             gyro_bias: prior("eps_x").context("P28 has eps_x")?,
             accel_bias: prior("nabla_x").context("P28 has nabla_x")?,
             speed,
+            gyro_scale: prior("kg_33").context("P28 has kg_33")?,
         };
         // fixes inside a --outage are not used to start either
         let outside = |t: f64| !outages.iter().any(|o| t >= o.start_s && t < o.end_s);
@@ -957,6 +958,7 @@ impl DataArgs {
                             sigma_pos: p.sigma[0].max(p.sigma[1]),
                             v: v.map(|v| Vector3::from(v.v_ned)),
                             sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
+                            derived: false,
                         })
                         .collect::<Vec<_>>(),
                     None,

@@ -40,6 +40,8 @@ pub const GYROCOMPASS_S: f64 = 60.0;
 pub const GYROCOMPASS_MAX_SIGMA: f64 = std::f64::consts::PI / 180.0;
 /// Default GNSS speed above which the course gives the heading [m/s].
 pub const DEFAULT_SPEED: f64 = 3.0;
+/// Largest horizontal GNSS acceleration of a calm span for a moving start [m/s²].
+const CALM_ACCEL: f64 = 0.3;
 /// Seconds of IMU data searched for a start before giving up [s].
 pub const SEARCH_S: f64 = 1800.0;
 /// Heading 1-σ allowed for the vehicle turning during a drive-off, or for a course that is not
@@ -115,6 +117,8 @@ pub struct Fix {
     pub v: Option<Vector3<f64>>,
     /// 1-σ of each velocity component [m/s].
     pub sigma_v: f64,
+    /// The velocity was derived from the neighbouring positions (not the receiver's).
+    pub derived: bool,
 }
 
 impl Fix {
@@ -167,6 +171,7 @@ pub fn velocities_from_positions(fixes: &mut [Fix]) {
             let (v, sigma) = velocity_between(fixes, a, b);
             fixes[k].v = Some(v);
             fixes[k].sigma_v = sigma;
+            fixes[k].derived = true;
         }
     }
 }
@@ -215,6 +220,8 @@ pub struct Priors {
     pub accel_bias: f64,
     /// GNSS speed above which the course is used [m/s].
     pub speed: f64,
+    /// Gyro scale-factor 1-σ [1] (a heading change the gyros measure is off by this fraction).
+    pub gyro_scale: f64,
 }
 
 /// What `--init auto` found.
@@ -590,21 +597,52 @@ pub fn find(
             // the GNSS side: the chord between the fixes about 1 s either side of the fast fix
             // (the velocity there, as a mean over the same span the IMU's is taken over, so a
             // turn in between is seen alike by both)
-            let kx = fixes.iter().position(|f| f.t == fx.t).unwrap_or(0);
-            let Some((ka, kb)) = neighbours(fixes, kx) else {
+            // Of the fast fixes within 10 s of the motion, the first whose chord the gyros see
+            // straight: in a turn a clock offset between IMU and GNSS turns the comparison by
+            // the turn rate times the offset
+            let turn_over = |a: f64, b: f64| -> f64 {
+                blocks
+                    .iter()
+                    .filter(|x| x.t_start >= a - 1e-9 && x.t_end <= b + 1e-9)
+                    .map(|x| (level_last * (x.w - w)).z * (x.t_end - x.t_start))
+                    .sum()
+            };
+            let k0 = fixes.iter().position(|f| f.t == fx.t).unwrap_or(0);
+            let mut pick: Option<(usize, usize, f64)> = None;
+            for k in k0..fixes.len() {
+                if fixes[k].t > t_m + 10.0 {
+                    break;
+                }
+                let Some((a, b)) = neighbours(fixes, k) else {
+                    continue;
+                };
+                if !(fixes[k].moving() && fixes[k].speed() > priors.speed) {
+                    continue;
+                }
+                if t_read < fixes[b].t {
+                    if at_end {
+                        break;
+                    }
+                    return Ok(Found::NeedMore);
+                }
+                let turn = turn_over(fixes[a].t, fixes[b].t);
+                if pick.is_none() {
+                    pick = Some((a, b, turn));
+                }
+                if turn.abs() <= COURSE_SLACK {
+                    pick = Some((a, b, turn));
+                    break;
+                }
+            }
+            let Some((ka, kb, chord_turn)) = pick else {
                 bail!(
-                    "--init auto: no GNSS fixes around the fix at {:.3} s for the course",
+                    "--init auto: no GNSS fixes around the fix at {:.3} s (within the IMU data) for the course",
                     fx.t
                 );
             };
             let (ta, tb) = (fixes[ka].t, fixes[kb].t);
-            if t_read < tb {
-                return if at_end {
-                    bail!("--init auto: the IMU data end before the GNSS fix at {tb:.3} s the course needs")
-                } else {
-                    Ok(Found::NeedMore)
-                };
-            }
+            // a turn over the chord: 0.2 s of IMU/GNSS clock offset is allowed for in the σ
+            let sigma_clock = chord_turn.abs() / (tb - ta) * 0.2;
             let (v_chord, sigma_chord) = velocity_between(fixes, ka, kb);
             // the IMU side: velocity and displacement since the rest, block by block
             let (mut psi, mut v_imu, mut disp) =
@@ -655,14 +693,17 @@ pub fn find(
             let sigma_v_imu = (f_scatter.powi(2) * span.max(1.0)
                 + (f_scatter / (last.len() as f64 * BLOCK_S).max(1.0).sqrt() * span).powi(2))
             .sqrt();
-            let sigma_turn = w_scatter / nsec.sqrt() * span;
+            // the gyros' noise over the span, and their scale error on the heading change
+            let sigma_turn =
+                (w_scatter / nsec.sqrt() * span).hypot(priors.gyro_scale * psi_mid.abs());
             let sigma_yaw = ((sigma_v_imu / speed_imu).powi(2)
                 + (sigma_chord / speed_gnss).powi(2)
                 + sigma_turn.powi(2)
+                + sigma_clock.powi(2)
                 + COURSE_SLACK.powi(2))
             .sqrt();
             report.push(format!(
-                "heading: {:.3} deg from the drive-off: from {:.3} to {:.3} s the IMU's own track since the rest at {:.3} s (specific force levelled and turned by the gyros, {:.1} deg by the end; {:.2} m/s) runs {:.1} deg from the heading at rest, the GNSS positions {:.2} deg ({:.2} m/s); 1-sigma {:.2} deg (accelerometer noise, course noise, gyro noise, {:.0} deg for what the integration leaves out)",
+                "heading: {:.3} deg from the drive-off: from {:.3} to {:.3} s the IMU's own track since the rest at {:.3} s (specific force levelled and turned by the gyros, {:.1} deg by the end; {:.2} m/s) runs {:.1} deg from the heading at rest, the GNSS positions {:.2} deg ({:.2} m/s); 1-sigma {:.2} deg (accelerometer noise, course noise, gyro noise and scale, 0.2 s of clock offset times the turn rate, {:.0} deg for what the integration leaves out)",
                 deg(yaw.rem_euclid(2.0 * std::f64::consts::PI)),
                 ta,
                 tb,
@@ -708,9 +749,35 @@ pub fn find(
             // 1 s before and after it for the acceleration, where the vehicle does not turn
             // (the specific force is averaged in the body frame, the GNSS acceleration in NED:
             // in a turn they differ)
-            let mut chosen = None;
+            // the GNSS acceleration over a span: from the receiver's velocities, or from the
+            // positions' second difference (velocities derived at the span's ends are means
+            // over other spans and would bias it)
+            let gnss_accel = |ka: usize, k: usize, kb: usize| -> (Vector3<f64>, f64) {
+                let dt_a = fixes[kb].t - fixes[ka].t;
+                if fixes[ka].derived || fixes[kb].derived {
+                    let (v1, s1) = velocity_between(fixes, ka, k);
+                    let (v2, s2) = velocity_between(fixes, k, kb);
+                    (2.0 * (v2 - v1) / dt_a, 2.0 * s1.hypot(s2) / dt_a)
+                } else {
+                    let (va, vb) = (fixes[ka].v.unwrap(), fixes[kb].v.unwrap());
+                    (
+                        (vb - va) / dt_a,
+                        fixes[ka].sigma_v.hypot(fixes[kb].sigma_v) / dt_a,
+                    )
+                }
+            };
+            // a calm span (the GNSS acceleration under CALM_ACCEL) is preferred for up to 60 s
+            // after the first candidate: the level's correction by the GNSS acceleration
+            // assumes the IMU's x axis along travel
+            let mut chosen: Option<(usize, usize, usize, Vec<Block>)> = None;
+            let mut fallback: Option<(usize, usize, usize, Vec<Block>)> = None;
             let mut turning: Option<(f64, f64)> = None;
             for k in 0..fixes.len().saturating_sub(1) {
+                if let Some((kf, _, _, _)) = &fallback {
+                    if fixes[k].t > fixes[*kf].t + 60.0 {
+                        break;
+                    }
+                }
                 let f = &fixes[k];
                 let ok = f.t >= t0 + 0.5
                     && f.moving()
@@ -748,8 +815,22 @@ pub fn find(
                     turning.get_or_insert((f.t, turn));
                     continue;
                 }
-                chosen = Some((k, a, b, win));
-                break;
+                let (an, _) = gnss_accel(a, k, b);
+                if an.x.hypot(an.y) <= CALM_ACCEL {
+                    chosen = Some((k, a, b, win));
+                    break;
+                }
+                if fallback.is_none() {
+                    fallback = Some((k, a, b, win));
+                }
+            }
+            if chosen.is_none() && fallback.is_some() {
+                let (kf, _, _, _) = fallback.as_ref().unwrap();
+                let waited = t_read - fixes[*kf].t;
+                if !at_end && waited <= 60.0 {
+                    return Ok(Found::NeedMore);
+                }
+                chosen = fallback;
             }
             let Some((k, ka, kb, around)) = chosen else {
                 if at_end {
@@ -770,10 +851,7 @@ pub fn find(
             let fx = fixes[k];
             // the specific force over the same span as the GNSS acceleration
             let (f, _) = mean_of(&around);
-            let (va, vb) = (fixes[ka].v.unwrap(), fixes[kb].v.unwrap());
-            let dt_a = fixes[kb].t - fixes[ka].t;
-            let a_n = (vb - va) / dt_a;
-            let sigma_a = fixes[ka].sigma_v.hypot(fixes[kb].sigma_v) / dt_a;
+            let (a_n, sigma_a) = gnss_accel(ka, k, kb);
             let v = fx.v.unwrap();
             let yaw = v.y.atan2(v.x);
             // f_b = C_n^b (a_n − g_n): the tilt that turns f_b into a_n − g_n, the heading the course
@@ -801,8 +879,14 @@ pub fn find(
             let v_s = v - a_n * back;
             // the bias prior, the noise of the GNSS acceleration, 0.05 m/s² for the acceleration
             // changing within the second
-            let sigma_tilt =
-                (sigma_tilt.powi(2) + (sigma_a / g).powi(2) + (0.05 / g).powi(2)).sqrt();
+            // the correction by the GNSS acceleration assumes the IMU's x axis along travel: a
+            // mounting turned from that moves it, so its own size counts in the σ too
+            let a_h = a_n.x.hypot(a_n.y);
+            let sigma_tilt = (sigma_tilt.powi(2)
+                + (sigma_a / g).powi(2)
+                + (0.05 / g).powi(2)
+                + (a_h / g).powi(2))
+            .sqrt();
             let sigma_yaw = ((fx.sigma_v / fx.speed()).powi(2) + COURSE_SLACK.powi(2)).sqrt();
             let report = vec![
                 format!(
@@ -919,6 +1003,7 @@ mod tests {
                 sigma_pos: 0.1,
                 v: None,
                 sigma_v: 0.0,
+                derived: false,
             })
             .collect();
         velocities_from_positions(&mut fixes);
