@@ -824,8 +824,7 @@ pub fn find(
                     fallback = Some((k, a, b, win));
                 }
             }
-            if chosen.is_none() && fallback.is_some() {
-                let (kf, _, _, _) = fallback.as_ref().unwrap();
+            if let (None, Some((kf, _, _, _))) = (&chosen, &fallback) {
                 let waited = t_read - fixes[*kf].t;
                 if !at_end && waited <= 60.0 {
                     return Ok(Found::NeedMore);
