@@ -656,37 +656,16 @@ fn init_auto_second_review() {
         "heading {yaw} at {t} s, truth {truth}"
     );
     // overlapping outages, a nav rate without a row
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--imu",
-        sparse.join("imu.txt").to_str().unwrap(),
-        "--aid",
-        sparse.join("gnss.txt").to_str().unwrap(),
-        "--truth",
-        sparse.join("truth.txt").to_str().unwrap(),
-        "--outage",
-        "100,20",
-        "--outage",
-        "110,5",
-        "--out",
-        dir.path().join("ov").to_str().unwrap(),
-    ]);
+    let truth = sparse.join("truth.txt");
+    let with_truth = |extra: &[&str], out: &str| {
+        let o = dir.path().join(out);
+        let mut a = vec!["--model", "P13", "--truth", truth.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        filter_sim(&sparse, &a, o.to_str().unwrap())
+    };
+    let (ok, err) = with_truth(&["--outage", "100,20", "--outage", "110,5"], "ov");
     assert!(!ok && err.contains("overlap"), "{err}");
-    let (ok, err) = filter(&[
-        "--model",
-        "P13",
-        "--imu",
-        sparse.join("imu.txt").to_str().unwrap(),
-        "--aid",
-        sparse.join("gnss.txt").to_str().unwrap(),
-        "--truth",
-        sparse.join("truth.txt").to_str().unwrap(),
-        "--nav-rate",
-        "0.001",
-        "--out",
-        dir.path().join("nr").to_str().unwrap(),
-    ]);
+    let (ok, err) = with_truth(&["--nav-rate", "0.001"], "nr");
     assert!(!ok && err.contains("not one row"), "{err}");
     assert!(!dir.path().join("nr").exists());
 }

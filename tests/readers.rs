@@ -225,35 +225,18 @@ fn matlab_file_reads_like_the_text_it_came_from() {
             && err.contains("avp ("),
         "{err}"
     );
-    // an output is never written over the .mat it reads
-    let (ok, _, err) = common::sinsmodel(&[
-        "navigate",
-        "--imu",
-        &format!("{m}:imu"),
-        "--lat",
-        "30",
-        "--lon",
-        "114",
-        "--att",
-        "0,0,0",
-        "--out",
-        m,
-    ]);
+    // an output is never written over the .mat it reads, nor under a name that reads as
+    // FILE.mat:VARIABLE
+    let imu_var = format!("{m}:imu");
+    let navigate_to = |out: &str| {
+        common::sinsmodel(&[
+            "navigate", "--imu", &imu_var, "--lat", "30", "--lon", "114", "--att", "0,0,0",
+            "--out", out,
+        ])
+    };
+    let (ok, _, err) = navigate_to(m);
     assert!(!ok && err.contains("input"), "{err}");
-    // nor under a name that reads as FILE.mat:VARIABLE
     let named = format!("{}:imu", dir.path().join("out.mat").display());
-    let (ok, _, err) = common::sinsmodel(&[
-        "navigate",
-        "--imu",
-        &format!("{m}:imu"),
-        "--lat",
-        "30",
-        "--lon",
-        "114",
-        "--att",
-        "0,0,0",
-        "--out",
-        &named,
-    ]);
+    let (ok, _, err) = navigate_to(&named);
     assert!(!ok && err.contains("selects a MATLAB variable"), "{err}");
 }

@@ -391,10 +391,16 @@ impl ImuStream {
     /// the run starts at the first sample's time and integrates from the second sample (a
     /// median interval in its place had put up to 10 ms of gravity into the first step).
     pub fn start_time(&self) -> f64 {
-        let head = ImuData {
-            samples: self.head.clone(),
-        };
-        if head.samples.len() > 2 && head.jitter_rms() > 1e-6 * self.interval {
+        // RMS deviation of the head's intervals from the median interval (no copy of the head)
+        let n = self.head.len().saturating_sub(1).max(1) as f64;
+        let jitter = (self
+            .head
+            .windows(2)
+            .map(|w| (w[1].t - w[0].t - self.interval).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        if self.head.len() > 2 && jitter > 1e-6 * self.interval {
             self.first_t()
         } else {
             self.first_t() - self.interval

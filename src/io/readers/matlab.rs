@@ -166,18 +166,16 @@ pub fn read_array(path: &Path, var: Option<&str>, n_cols: usize, what: &str) -> 
         bail!("{name}: the {what} array has no rows");
     }
     use matfile::NumericData as D;
-    let col_major: Vec<f64> = match array.data() {
-        D::Double { real, imag } => {
-            if imag.is_some() {
-                bail!("{name}: the {what} array is complex; expected real numbers");
-            }
-            real.clone()
+    // doubles are read in place (a file can hold 1 GiB of them); singles are widened
+    let widened: Vec<f64>;
+    let col_major: &[f64] = match array.data() {
+        D::Double { imag: Some(_), .. } | D::Single { imag: Some(_), .. } => {
+            bail!("{name}: the {what} array is complex; expected real numbers")
         }
-        D::Single { real, imag } => {
-            if imag.is_some() {
-                bail!("{name}: the {what} array is complex; expected real numbers");
-            }
-            real.iter().map(|&x| x as f64).collect()
+        D::Double { real, .. } => real,
+        D::Single { real, .. } => {
+            widened = real.iter().map(|&x| x as f64).collect();
+            &widened
         }
         _ => bail!("{name}: the {what} array holds integers; expected double or single (PSINS arrays are double)"),
     };
@@ -226,14 +224,7 @@ fn prescan_within(bytes: &[u8], file: &str, max_inflated: u64) -> Result<()> {
         b"MI" => false,
         _ => bail!("{file}: the header's byte-order mark is neither IM nor MI: not a MATLAB level-5 file, or corrupt"),
     };
-    let u32_at = |o: usize| {
-        let b = [bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]];
-        if little {
-            u32::from_le_bytes(b)
-        } else {
-            u32::from_be_bytes(b)
-        }
-    };
+    let u32_at = |o: usize| u32_in(&bytes[o..o + 4], little);
     let (mut o, mut k, mut inflated) = (128usize, 0usize, 0u64);
     while o < bytes.len() {
         k += 1;
@@ -263,15 +254,7 @@ fn prescan_within(bytes: &[u8], file: &str, max_inflated: u64) -> Result<()> {
                 // what it holds must be one matrix (MATLAB never nests compression)
                 let mut tag = [0u8; 8];
                 dec.read_exact(&mut tag).map_err(corrupt)?;
-                let u = |b: &[u8]| {
-                    let b = [b[0], b[1], b[2], b[3]];
-                    if little {
-                        u32::from_le_bytes(b)
-                    } else {
-                        u32::from_be_bytes(b)
-                    }
-                };
-                let (inner_ty, inner_n) = (u(&tag[..4]), u(&tag[4..]) as u64);
+                let (inner_ty, inner_n) = (u32_in(&tag[..4], little), u32_in(&tag[4..], little) as u64);
                 if inner_ty != 14 {
                     bail!(
                         "{file}: compressed element {k} at byte {o} holds data type {inner_ty}, not a matrix (14): corrupt, or written by something other than MATLAB"
@@ -307,6 +290,16 @@ fn prescan_within(bytes: &[u8], file: &str, max_inflated: u64) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The u32 in the first four bytes of `b`, in the file's byte order.
+fn u32_in(b: &[u8], little: bool) -> u32 {
+    let b = [b[0], b[1], b[2], b[3]];
+    if little {
+        u32::from_le_bytes(b)
+    } else {
+        u32::from_be_bytes(b)
+    }
 }
 
 /// Parses a `.mat` file with the `matfile` crate, a panic inside it (an arithmetic overflow on
