@@ -147,6 +147,13 @@ pub struct Outage {
     pub end_s: f64,
 }
 
+impl Outage {
+    /// Whether time `t` [s] falls in the window [start, end).
+    pub fn contains(&self, t: f64) -> bool {
+        t >= self.start_s && t < self.end_s
+    }
+}
+
 /// A sensor grade: name, priors by state-name prefix, ARW, VRW (the project's units).
 type Grade = (
     &'static str,
@@ -326,7 +333,7 @@ impl AidPlan {
     ) -> Box<dyn Iterator<Item = AidingEpoch> + 'a> {
         Box::new(
             self.epochs()
-                .filter(move |e| !outages.iter().any(|o| e.t >= o.start_s && e.t < o.end_s)),
+                .filter(move |e| !outages.iter().any(|o| o.contains(e.t))),
         )
     }
 
@@ -933,12 +940,7 @@ impl DataArgs {
         // the bias priors the run will use (grade, --prior)
         let m = Model::parse("P28")?;
         let cfg = self.config(&m, true)?;
-        let prior = |name: &str| {
-            m.names
-                .iter()
-                .position(|n| *n == name)
-                .map(|i| cfg.prior_sigma[i])
-        };
+        let prior = |name: &str| m.index_of(name).map(|i| cfg.prior_sigma[i]);
         let priors = Priors {
             gyro_bias: prior("eps_x").context("P28 has eps_x")?,
             accel_bias: prior("nabla_x").context("P28 has nabla_x")?,
@@ -946,7 +948,7 @@ impl DataArgs {
             gyro_scale: prior("kg_33").context("P28 has kg_33")?,
         };
         // fixes inside a --outage are not used to start either
-        let outside = |t: f64| !outages.iter().any(|o| t >= o.start_s && t < o.end_s);
+        let outside = |t: f64| !outages.iter().any(|o| o.contains(t));
         let (mut fixes, static_pos, receiver) = match plan {
             AidPlan::Fixes(list, _, _) => {
                 let kept: Vec<_> = list.iter().filter(|(p, _)| outside(p.t)).collect();
