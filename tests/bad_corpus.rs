@@ -6,8 +6,14 @@
 //! thing at a time, for every reader: IMU text, PSINS `.imu`, GNSS_IMU `.csv`, format
 //! descriptions, aiding, truth, RTKLIB `.pos`, scenarios, Jacobian points, noise files.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::Mutex;
+
+/// Every refusal's message, in order, for the golden comparison (`tests/golden/bad_corpus.txt`).
+static MESSAGES: Mutex<Vec<String>> = Mutex::new(Vec::new());
 
 /// Exit status, stderr.
 fn run(args: &[&str]) -> (Option<i32>, String) {
@@ -24,6 +30,10 @@ fn run(args: &[&str]) -> (Option<i32>, String) {
 /// What every refused case must look like; a failure is recorded (all are reported at the end).
 fn refused(case: &str, args: &[&str], must_name: &str, out: Option<&Path>) -> Result<(), String> {
     let (code, err) = run(args);
+    MESSAGES
+        .lock()
+        .unwrap()
+        .push(format!("{case} (exit {code:?}):\n{err}"));
     let fail = |what: &str| Err(format!("{case}: {what}\n{err}"));
     if err.contains("panicked") || err.contains("RUST_BACKTRACE") {
         return fail("panic");
@@ -551,6 +561,14 @@ fn every_command_refuses_every_bad_file_with_exit_2_and_a_clear_message() {
         failures.len(),
         failures.join("\n\n")
     );
+    // and every message is the one it was (a refactoring changes none)
+    let corpus = c.dir.path().to_str().unwrap().to_string();
+    let log = MESSAGES
+        .lock()
+        .unwrap()
+        .join("\n")
+        .replace(&corpus, "<corpus>");
+    common::check_golden("bad_corpus", &log);
 
     // the valid look-alikes are read: a byte-order mark and CR LF line ends
     let bom = c.write(
