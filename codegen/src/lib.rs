@@ -9,9 +9,11 @@
 
 pub mod emit;
 pub mod expr;
+pub mod fuzzing;
 pub mod layout;
 pub mod spec;
-pub mod units;
+/// Units and quantities: the `sinsmodel-units` crate, shared with the runtime.
+pub use sinsmodel_units as units;
 
 pub use layout::{Layout, StateRef};
 pub use spec::{Spec, SpecError};
