@@ -1,7 +1,7 @@
 """A new error term is one `[[term]]` entry: added to a temporary copy of the spec (nothing else
 edited), it goes through the whole chain — build (codegen), `model show`, `jacobian`, the CasADi
-check (which must check the new term), a simulation with the term injected, and a filter that
-estimates it.
+check (which must check the new term), a simulation with the term injected, a filter that
+estimates it, and `--grade mems` priors for it from the spec's grades file alone.
 
 The copy shares the project's target directory (its crates are compiled once, only the copy's
 own packages are rebuilt); its binary is renamed `sinsmodel-chain` so the project's own
@@ -72,6 +72,27 @@ sigma_ne = "0.1 m"
 """.format(k4=TRUE_K4)
 
 
+# level rest with GNSS: nothing excites k4_x (f_x = 0), so its sigma stays at the prior
+REST = """name = "rest"
+imu_rate_hz = 100.0
+truth_rate_hz = 1.0
+seed = 5
+
+[start]
+lat_deg = 28.22
+lon_deg = 112.99
+
+[[segment]]
+kind = "rest"
+duration_s = 20.0
+
+[gnss]
+rate_hz = 1.0
+sigma_ne = "0.5 m"
+sigma_d = "1 m"
+"""
+
+
 def run(cmd, **kw):
     res = subprocess.run(cmd, capture_output=True, text=True, **kw)
     if res.returncode != 0:
@@ -87,7 +108,7 @@ class NewTermThroughTheChain(unittest.TestCase):
         os.mkdir(crate)
         for f in ["Cargo.toml", "Cargo.lock", "build.rs"]:
             shutil.copy(os.path.join(ROOT, f), crate)
-        for d in ["src", "codegen", "model-spec", "benches"]:
+        for d in ["src", "codegen", "units", "model-spec", "benches"]:
             shutil.copytree(os.path.join(ROOT, d), os.path.join(crate, d),
                             ignore=shutil.ignore_patterns("target"))
         # the only spec edit: one [[term]] entry
@@ -168,6 +189,37 @@ class NewTermThroughTheChain(unittest.TestCase):
         print(f"k4_x: true {TRUE_K4:.3e}, estimated {est:.3e} +- {sig:.1e} s^6/m^3", file=sys.stderr)
         self.assertLess(sig, 0.1 * TRUE_K4, "the data determine the new term")
         self.assertLess(abs(est - TRUE_K4), max(3 * sig, 0.05 * TRUE_K4), "estimate within 3 sigma / 5 %")
+
+    def test_5_grade_prior_from_the_spec(self):
+        # the new group is in no grade's list: its prior under --grade mems is the navigation
+        # prior times the accelerometer factor of grades.toml's `unlisted` rule
+        with open(os.path.join(self.spec, "grades.toml"), "rb") as fh:
+            import tomllib
+            grades = {g["name"]: g for g in tomllib.load(fh)["grade"]}
+        factor = grades["mems"]["unlisted"]["accel"]
+        self.assertNotIn("test: fourth-order", grades["mems"].get("groups", {}))
+        scen = os.path.join(self.tmp, "rest.toml")
+        with open(scen, "w") as fh:
+            fh.write(REST)
+        sim = os.path.join(self.tmp, "rest")
+        run([self.bin, "simulate", scen, "--out", sim])
+
+        def first_sigma(extra, out):
+            run([self.bin, "filter", "--model", "P13+k4_x", "--imu", os.path.join(sim, "imu.txt"),
+                 "--aid", os.path.join(sim, "gnss.txt"), "--init", "28.22,112.99,0,0,0,0", "--out", out] + extra)
+            with open(os.path.join(out, "states.txt")) as fh:
+                lines = fh.readlines()
+            header = [ln for ln in lines if ln.startswith("# t")][0].split()[1:]
+            names = [re.sub(r"\[.*\]$", "", h) for h in header]
+            row = [ln.split() for ln in lines if not ln.startswith("#")][0]
+            return float(row[names.index("sigma_k4_x")])
+
+        nav = first_sigma([], os.path.join(self.tmp, "f_nav"))
+        mems = first_sigma(["--grade", "mems"], os.path.join(self.tmp, "f_mems"))
+        print(f"k4_x prior: navigation {nav:.6e}, mems {mems:.6e} (factor {factor})", file=sys.stderr)
+        # at rest, level, f_x = 0: nothing observes k4_x, its sigma stays at the prior
+        self.assertAlmostEqual(nav, 1e-8, delta=1e-12)
+        self.assertAlmostEqual(mems / nav, factor, delta=1e-4 * factor)
 
 
 if __name__ == "__main__":

@@ -314,8 +314,27 @@ pub fn common_module(spec: &Spec) -> String {
 
     let arw = f64_lit(spec.sensor_noise.gyro_arw);
     let vrw = f64_lit(spec.sensor_noise.accel_vrw);
+    let n_grades = spec.grades.len();
+    let grade_infos = spec.grades.iter().map(|g| {
+        let (name, doc, arw_text, vrw_text) = (&g.name, &g.doc, &g.gyro_arw_text, &g.accel_vrw_text);
+        let (g_arw, g_vrw) = (f64_lit(g.gyro_arw), f64_lit(g.accel_vrw));
+        let nav = g.nav_sigma.iter().map(|v| match v {
+            Some(v) => {
+                let v = f64_lit(*v);
+                quote!(Some(#v))
+            }
+            None => quote!(None),
+        });
+        let terms = g.term_sigma.iter().map(|v| f64_lit(*v));
+        let rules = g.term_rule.iter().map(|r| match r {
+            crate::grades::GradeRule::Term => quote!(GradeRule::Term),
+            crate::grades::GradeRule::Group => quote!(GradeRule::Group),
+            crate::grades::GradeRule::Unlisted => quote!(GradeRule::Unlisted),
+        });
+        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*], term_rule: [#(#rules),*] })
+    });
     let tokens = quote! {
-        use crate::model::catalog::{MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo, WhiteNoise};
+        use crate::model::catalog::{GradeInfo, GradeRule, MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo, WhiteNoise};
         use crate::nav::nav_point::NavPoint;
         use nalgebra::Vector3;
 
@@ -342,6 +361,10 @@ pub fn common_module(spec: &Spec) -> String {
         pub const GYRO_ARW: f64 = #arw;
         /// Accelerometer velocity random walk [m/s/√s] (spec default).
         pub const ACCEL_VRW: f64 = #vrw;
+        /// Number of sensor grades in grades.toml (navigation, the spec's defaults, not counted).
+        pub const GRADE_COUNT: usize = #n_grades;
+        /// Sensor grades for `--grade`: white noise and the prior of every state (grades.toml).
+        pub const GRADES: [GradeInfo; GRADE_COUNT] = [#(#grade_infos),*];
         /// Number of measurement types.
         pub const MEASUREMENT_COUNT: usize = #n_meas;
         /// Measurement types.

@@ -8,11 +8,12 @@ use crate::{Layout, Spec};
 use std::path::Path;
 
 /// The real spec files, in [`SPEC_FILES`] order, held fixed while one of them is fuzzed.
-const REAL_SPEC: [&str; 4] = [
+const REAL_SPEC: [&str; SPEC_FILES.len()] = [
     include_str!("../../model-spec/navigation.toml"),
     include_str!("../../model-spec/terms.toml"),
     include_str!("../../model-spec/measurements.toml"),
     include_str!("../../model-spec/presets.toml"),
+    include_str!("../../model-spec/grades.toml"),
 ];
 
 /// Panics naming `what` unless `v` is finite.
@@ -31,9 +32,9 @@ fn bounded(d: Dim, what: &str) {
 
 /// The model-spec compiler's front end (TOML, units, expressions, presets).
 ///
-/// The first byte picks the file to replace (`byte % 4`, in [`SPEC_FILES`] order: `0`
-/// navigation, `1` terms, `2` measurements, `3` presets as ASCII digits); the rest of the input
-/// is its text, the other three files are the real ones. Property: an accepted spec has finite
+/// The first byte picks the file to replace (`byte % 5`, in [`SPEC_FILES`] order: `0`
+/// navigation, `1` terms, `2` measurements, `3` presets, `4` grades as ASCII digits); the rest of the input
+/// is its text, the other files are the real ones. Property: an accepted spec has finite
 /// numbers everywhere (priors, noise densities, display factors, expression literals) and its
 /// presets lay out without panicking.
 pub fn spec(data: &[u8]) {
@@ -82,6 +83,16 @@ pub fn spec(data: &[u8]) {
             for v in e.expr.literals() {
                 finite(v, &format!("literal of `{}`", e.expr.source));
             }
+        }
+    }
+    for g in &spec.grades {
+        finite(g.gyro_arw, &format!("grade `{}` gyro_arw", g.name));
+        finite(g.accel_vrw, &format!("grade `{}` accel_vrw", g.name));
+        for (v, t) in g.term_sigma.iter().zip(&spec.terms) {
+            finite(*v, &format!("grade `{}` prior of `{}`", g.name, t.name));
+        }
+        for v in g.nav_sigma.iter().flatten() {
+            finite(*v, &format!("grade `{}` state prior", g.name));
         }
     }
     finite(spec.sensor_noise.gyro_arw, "gyro_arw");

@@ -10,6 +10,7 @@
 pub mod emit;
 pub mod expr;
 pub mod fuzzing;
+pub mod grades;
 pub mod layout;
 pub mod spec;
 /// Units and quantities: the `sinsmodel-units` crate, shared with the runtime.

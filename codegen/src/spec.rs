@@ -4,6 +4,7 @@
 //! term, entry, preset or measurement) and what is wrong.
 
 use crate::expr::{self, Expr, ExprKind};
+use crate::grades::{self, Grade};
 use crate::units;
 use serde::Deserialize;
 use std::collections::{BTreeSet, HashMap};
@@ -12,11 +13,12 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 /// The spec files, in the order they are read.
-pub const SPEC_FILES: [&str; 4] = [
+pub const SPEC_FILES: [&str; 5] = [
     "navigation.toml",
     "terms.toml",
     "measurements.toml",
     "presets.toml",
+    "grades.toml",
 ];
 
 /// One problem in the spec: file, 1-based line, the item it concerns, and the message.
@@ -136,6 +138,8 @@ pub struct Term {
     pub doc: String,
     /// Candidate library term (in no preset by default).
     pub library: bool,
+    /// Priors this term declares for named grades: (grade, 1-σ [SI], line in terms.toml).
+    pub grade_sigma: Vec<(String, f64, usize)>,
 }
 
 /// One H entry of a measurement row.
@@ -225,6 +229,8 @@ pub struct Spec {
     pub presets: Vec<Preset>,
     /// White sensor noise.
     pub sensor_noise: SensorNoise,
+    /// Sensor grades for `--grade` (`grades.toml`): priors and white noise of other IMU classes.
+    pub grades: Vec<Grade>,
 }
 
 // ---------------------------------------------------------------- raw TOML
@@ -298,6 +304,8 @@ struct RawTerm {
     doc: String,
     #[serde(default)]
     library: bool,
+    #[serde(default)]
+    grade_sigma: std::collections::BTreeMap<String, Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -352,13 +360,13 @@ struct RawPreset {
 // ---------------------------------------------------------------- loading
 
 /// Source text of one spec file, for turning byte spans into line numbers.
-struct Source {
-    path: PathBuf,
+pub(crate) struct Source {
+    pub(crate) path: PathBuf,
     text: String,
 }
 
 impl Source {
-    fn read(dir: &Path, name: &str) -> Result<Source, SpecError> {
+    pub(crate) fn read(dir: &Path, name: &str) -> Result<Source, SpecError> {
         let path = dir.join(name);
         let text = std::fs::read_to_string(&path).map_err(|e| SpecError {
             file: path.clone(),
@@ -369,19 +377,19 @@ impl Source {
         Ok(Source { path, text })
     }
 
-    fn new(dir: &Path, name: &str, text: &str) -> Source {
+    pub(crate) fn new(dir: &Path, name: &str, text: &str) -> Source {
         Source {
             path: dir.join(name),
             text: text.to_string(),
         }
     }
 
-    fn line_of(&self, offset: usize) -> usize {
+    pub(crate) fn line_of(&self, offset: usize) -> usize {
         let end = offset.min(self.text.len());
         self.text[..end].bytes().filter(|&b| b == b'\n').count() + 1
     }
 
-    fn error(
+    pub(crate) fn error(
         &self,
         span: std::ops::Range<usize>,
         item: &str,
@@ -395,7 +403,7 @@ impl Source {
         }
     }
 
-    fn parse<T: for<'de> Deserialize<'de>>(&self) -> Result<T, SpecError> {
+    pub(crate) fn parse<T: for<'de> Deserialize<'de>>(&self) -> Result<T, SpecError> {
         toml::from_str(&self.text).map_err(|e| {
             let line = e.span().map(|s| self.line_of(s.start)).unwrap_or(0);
             SpecError {
@@ -408,7 +416,11 @@ impl Source {
     }
 }
 
-fn check_name(src: &Source, name: &Spanned<String>, what: &str) -> Result<(), SpecError> {
+pub(crate) fn check_name(
+    src: &Source,
+    name: &Spanned<String>,
+    what: &str,
+) -> Result<(), SpecError> {
     let n = name.get_ref();
     let ok = !n.is_empty()
         && n.chars().next().is_some_and(|c| c.is_ascii_lowercase())
@@ -425,7 +437,7 @@ fn check_name(src: &Source, name: &Spanned<String>, what: &str) -> Result<(), Sp
     }
 }
 
-fn quantity(
+pub(crate) fn quantity(
     src: &Source,
     text: &Spanned<String>,
     unit: &str,
@@ -437,38 +449,22 @@ fn quantity(
 }
 
 impl Spec {
-    /// Reads and validates the spec in `dir` (the four files of [`SPEC_FILES`]), one file and
-    /// one kind of item at a time; the first problem found is returned.
+    /// Reads and validates the spec in `dir` (the files of [`SPEC_FILES`]), one file and one
+    /// kind of item at a time; the first problem found is returned.
     pub fn load(dir: &Path) -> Result<Spec, SpecError> {
-        let [nav_src, terms_src, meas_src, preset_src] = [
-            Source::read(dir, SPEC_FILES[0])?,
-            Source::read(dir, SPEC_FILES[1])?,
-            Source::read(dir, SPEC_FILES[2])?,
-            Source::read(dir, SPEC_FILES[3])?,
-        ];
-        Spec::from_sources(dir, nav_src, terms_src, meas_src, preset_src)
+        let [nav, terms, meas, presets, grades] = SPEC_FILES.map(|f| Source::read(dir, f));
+        Spec::from_sources(dir, [nav?, terms?, meas?, presets?, grades?])
     }
 
-    /// Validates a spec given as the texts of its four files, in [`SPEC_FILES`] order, as
+    /// Validates a spec given as the texts of its files, in [`SPEC_FILES`] order, as
     /// [`Spec::load`] does once it has read them; `dir` only names the files in messages.
-    pub fn from_texts(dir: &Path, texts: [&str; 4]) -> Result<Spec, SpecError> {
-        let [nav, terms, meas, presets] = texts;
-        Spec::from_sources(
-            dir,
-            Source::new(dir, SPEC_FILES[0], nav),
-            Source::new(dir, SPEC_FILES[1], terms),
-            Source::new(dir, SPEC_FILES[2], meas),
-            Source::new(dir, SPEC_FILES[3], presets),
-        )
+    pub fn from_texts(dir: &Path, texts: [&str; SPEC_FILES.len()]) -> Result<Spec, SpecError> {
+        let sources = std::array::from_fn(|i| Source::new(dir, SPEC_FILES[i], texts[i]));
+        Spec::from_sources(dir, sources)
     }
 
-    fn from_sources(
-        dir: &Path,
-        nav_src: Source,
-        terms_src: Source,
-        meas_src: Source,
-        preset_src: Source,
-    ) -> Result<Spec, SpecError> {
+    fn from_sources(dir: &Path, sources: [Source; SPEC_FILES.len()]) -> Result<Spec, SpecError> {
+        let [nav_src, terms_src, meas_src, preset_src, grades_src] = sources;
         let raw_nav: RawNavigation = nav_src.parse()?;
         let raw_terms: RawTerms = terms_src.parse()?;
         let raw_meas: RawMeasurements = meas_src.parse()?;
@@ -488,6 +484,7 @@ impl Spec {
             &terms,
             &names,
         )?;
+        let grades = grades::load(&grades_src, &terms_src, &nav_states, &terms)?;
         Ok(Spec {
             dir: dir.to_path_buf(),
             nav_states,
@@ -498,6 +495,7 @@ impl Spec {
             measurements,
             presets,
             sensor_noise,
+            grades,
         })
     }
 
@@ -779,6 +777,15 @@ fn load_terms(
             group: t.group.clone(),
             doc: t.doc.clone(),
             library: t.library,
+            grade_sigma: t
+                .grade_sigma
+                .iter()
+                .map(|(g, q)| {
+                    let si =
+                        quantity(src, q, t.unit.get_ref(), &item, &format!("grade_sigma.{g}"))?;
+                    Ok((g.clone(), si, src.line_of(q.span().start)))
+                })
+                .collect::<Result<_, SpecError>>()?,
         });
     }
     Ok((terms, regressors))

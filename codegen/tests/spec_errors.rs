@@ -321,3 +321,91 @@ fn a_user_preset_compiles_to_its_own_kernels() {
     // and the library flag check of `the_real_spec_loads` would now flag the two terms
     assert!(spec.terms.iter().any(|t| t.name == "kaq_x_xy" && t.library));
 }
+
+#[test]
+fn grade_errors_name_the_grade_and_the_problem() {
+    expect_error(
+        "grades.toml",
+        "\"gyro bias\" = \"1 deg/h\"",
+        "\"gyro bias\" = \"1 mg\"",
+        "\"gyro bias\" = \"1 mg\"",
+        "grade `tactical`",
+        "groups.\"gyro bias\" for term `eps_x`",
+    );
+    expect_error(
+        "grades.toml",
+        "\"accel bias\" = \"1 mg\"",
+        "\"accel biases\" = \"1 mg\"",
+        "accel biases",
+        "grade `tactical`",
+        "no term has group `accel biases`",
+    );
+    expect_error(
+        "grades.toml",
+        "phi_d = \"1 deg\"",
+        "phi_z = \"1 deg\"",
+        "phi_z",
+        "grade `tactical`",
+        "no navigation state `phi_z`",
+    );
+    expect_error(
+        "grades.toml",
+        "unlisted = { gyro = 50.0,",
+        "unlisted = { gyro = -50.0,",
+        "gyro = -50.0",
+        "grade `tactical`",
+        "positive and finite",
+    );
+    expect_error(
+        "grades.toml",
+        "name = \"mems\"",
+        "name = \"navigation\"",
+        "name = \"navigation\"",
+        "grade `navigation`",
+        "duplicate grade",
+    );
+    expect_error(
+        "terms.toml",
+        "doc = \"x gyro constant bias\"",
+        "doc = \"x gyro constant bias\"\ngrade_sigma = { consumer = \"1 deg/s\" }",
+        "consumer",
+        "term `eps_x`",
+        "no grade `consumer` in grades.toml",
+    );
+    expect_error(
+        "terms.toml",
+        "doc = \"x gyro constant bias\"",
+        "doc = \"x gyro constant bias\"\ngrade_sigma = { mems = \"1 mg\" }",
+        "grade_sigma = { mems",
+        "term `eps_x`",
+        "grade_sigma.mems",
+    );
+}
+
+#[test]
+fn a_term_prior_comes_from_the_term_then_its_group_then_the_unlisted_rule() {
+    use sinsmodel_codegen::grades::GradeRule;
+    let (_dir, r) = load_edited(|f, t| match f {
+        "terms.toml" => t.replacen(
+            "doc = \"y gyro constant bias\"",
+            "doc = \"y gyro constant bias\"\ngrade_sigma = { mems = \"2 deg/s\" }",
+            1,
+        ),
+        "grades.toml" => t.replacen("\"gyro g^2-sensitivity\" = \"0.01 deg/s/g^2\"\n", "", 1),
+        _ => t,
+    });
+    let spec = r.unwrap_or_else(|e| panic!("{e}"));
+    let mems = spec.grades.iter().find(|g| g.name == "mems").unwrap();
+    let t = |n: &str| spec.term_index(n).unwrap();
+    assert_eq!(mems.term_rule[t("eps_y")], GradeRule::Term);
+    assert!((mems.term_sigma[t("eps_y")] - 2f64.to_radians()).abs() < 1e-15);
+    assert_eq!(mems.term_rule[t("eps_x")], GradeRule::Group);
+    assert!((mems.term_sigma[t("eps_x")] - 0.5f64.to_radians()).abs() < 1e-15);
+    // the group no longer listed: its navigation prior times the gyro factor (1000)
+    assert_eq!(mems.term_rule[t("kgq_x")], GradeRule::Unlisted);
+    let k = t("kgq_x");
+    assert_eq!(mems.term_sigma[k], spec.terms[k].sigma * 1000.0);
+    // the tactical grade is untouched by the mems entry
+    let tactical = spec.grades.iter().find(|g| g.name == "tactical").unwrap();
+    assert_eq!(tactical.term_rule[t("eps_y")], GradeRule::Group);
+}

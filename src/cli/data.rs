@@ -8,6 +8,8 @@ use sinsmodel::estimate::filter::{AidingEpoch, FilterConfig, Mode};
 use sinsmodel::io::imu::ImuData;
 use sinsmodel::io::truth::{TruthLookup, TruthRow};
 use sinsmodel::io::{aiding, truth};
+use sinsmodel::model::catalog::GradeInfo;
+use sinsmodel::model::priors::{self, StatePattern};
 use sinsmodel::model::Model;
 use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::strapdown::{NavState, Vertical};
@@ -154,70 +156,15 @@ impl Outage {
     }
 }
 
-/// A sensor grade: name, priors by state-name prefix, ARW, VRW (the project's units).
-type Grade = (
-    &'static str,
-    &'static [(&'static str, &'static str)],
-    &'static str,
-    &'static str,
-);
-
-/// Priors by state-name prefix and the white noise (ARW, VRW) of a sensor grade, in the
-/// project's units; `navigation` is the spec's own defaults (the paper's laser-gyro INS).
-const GRADES: [Grade; 2] = [
-    (
-        "tactical",
-        &[
-            ("phi_n", "0.1 deg"),
-            ("phi_e", "0.1 deg"),
-            ("phi_d", "1 deg"),
-            ("eps_", "1 deg/h"),
-            ("nabla_", "1 mg"),
-            ("kg_", "300 ppm"),
-            ("ka_", "500 ppm"),
-            ("kas_", "500 ppm"),
-            ("d_", "100 ug/g^2"),
-            ("kaq_", "100 ug/g^2"),
-            ("kao_", "100 ug/g^2"),
-            ("kgf_", "1 deg/h/g"),
-            ("kgq_", "0.1 deg/h/g^2"),
-        ],
-        "0.1 deg/sqrt(h)",
-        "50 ug/sqrt(Hz)",
-    ),
-    (
-        "mems",
-        &[
-            ("phi_n", "2 deg"),
-            ("phi_e", "2 deg"),
-            ("phi_d", "10 deg"),
-            ("eps_", "0.5 deg/s"),
-            ("nabla_", "50 mg"),
-            ("kg_", "10000 ppm"),
-            ("ka_", "10000 ppm"),
-            ("kas_", "10000 ppm"),
-            ("d_", "5000 ug/g^2"),
-            ("kaq_", "5000 ug/g^2"),
-            ("kao_", "5000 ug/g^2"),
-            ("kgf_", "0.1 deg/s/g"),
-            ("kgq_", "0.01 deg/s/g^2"),
-        ],
-        "0.5 deg/sqrt(h)",
-        "150 ug/sqrt(Hz)",
-    ),
-];
-
-/// The table of `--grade` (None for navigation, the spec's defaults).
-fn grade_table(grade: Option<&str>) -> Result<Option<&'static Grade>> {
-    match grade {
-        None | Some("navigation") => Ok(None),
-        Some(g) => GRADES.iter().find(|x| x.0 == g).map(Some).ok_or_else(|| {
-            anyhow::anyhow!(
-                "--grade `{}`: expected navigation, tactical or mems",
-                sinsmodel::io::lines::shown(g)
-            )
-        }),
-    }
+/// The grade `--grade` names (None for navigation, the spec's defaults): `model-spec/grades.toml`.
+fn grade_table(grade: Option<&str>) -> Result<Option<&'static GradeInfo>> {
+    priors::grade(grade).map_err(|_| {
+        anyhow::anyhow!(
+            "--grade `{}`: expected {}",
+            sinsmodel::io::lines::shown(grade.unwrap_or_default()),
+            priors::grade_names()
+        )
+    })
 }
 
 /// Default filter step [s].
@@ -417,8 +364,11 @@ impl DataArgs {
                 if self.grade.is_some() { "--grade navigation" } else { "navigation grade" },
                 if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
             ),
-            Some((g, _, arw, vrw)) => eprintln!(
-                "priors and noise: --grade {g} (ARW {arw}, VRW {vrw}; the priors of the README's --grade table){}",
+            Some(g) => eprintln!(
+                "priors and noise: --grade {} (ARW {}, VRW {}; the priors of the README's --grade table){}",
+                g.name,
+                g.gyro_arw_text,
+                g.accel_vrw_text,
                 if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
             ),
         }
@@ -461,29 +411,17 @@ impl DataArgs {
     pub fn term_priors(&self) -> Result<Vec<(usize, f64)>> {
         use sinsmodel::model::generated::common;
         let mut out: Vec<(usize, f64)> = Vec::new();
-        if let Some((_, priors, _, _)) = grade_table(self.grade.as_deref())? {
-            for (prefix, q) in priors.iter() {
-                for (t, info) in common::TERMS.iter().enumerate() {
-                    if info.name.starts_with(prefix) {
-                        let si = sinsmodel::io::units::parse_quantity_as(q, info.unit)
-                            .map_err(|e| anyhow::anyhow!("--grade: {prefix}: {e}"))?;
-                        out.retain(|x| x.0 != t);
-                        out.push((t, si));
-                    }
-                }
-            }
+        if let Some(g) = grade_table(self.grade.as_deref())? {
+            out.extend(g.term_sigma.iter().copied().enumerate());
         }
         for spec in &self.prior {
             let (name, value) = spec
                 .split_once('=')
                 .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
             let (name, value) = (name.trim(), value.trim());
+            let pattern = StatePattern::new(name);
             for (t, info) in common::TERMS.iter().enumerate() {
-                let hit = match name.strip_suffix('*') {
-                    Some(prefix) => info.name.starts_with(prefix),
-                    None => info.name == name,
-                };
-                if hit {
+                if pattern.matches(info.name) {
                     let si = sinsmodel::io::units::parse_quantity_as(value, info.unit)
                         .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
                     if !(si.is_finite() && si > 0.0) {
@@ -1017,21 +955,9 @@ impl DataArgs {
     pub fn config(&self, model: &Model, lenient_priors: bool) -> Result<FilterConfig> {
         let args = self;
         let mut cfg = FilterConfig::new(model);
-        if let Some((_, priors, arw, vrw)) = grade_table(args.grade.as_deref())? {
-            for (prefix, q) in priors.iter() {
-                for i in 0..model.n() {
-                    if model.names[i].starts_with(prefix) {
-                        cfg.prior_sigma[i] =
-                            sinsmodel::io::units::parse_quantity_as(q, model.unit(i))
-                                .map_err(|e| anyhow::anyhow!("--grade: {prefix}: {e}"))?;
-                    }
-                }
-            }
-            let arw = sinsmodel::io::units::parse_quantity_as(arw, "rad/sqrt(s)")
-                .map_err(|e| anyhow::anyhow!("--grade: ARW: {e}"))?;
-            let vrw = sinsmodel::io::units::parse_quantity_as(vrw, "m/s/sqrt(s)")
-                .map_err(|e| anyhow::anyhow!("--grade: VRW: {e}"))?;
-            cfg = cfg.with_sensor_noise(model, arw, vrw);
+        if let Some(g) = grade_table(args.grade.as_deref())? {
+            priors::apply_grade(model, g, &mut cfg.prior_sigma);
+            cfg = cfg.with_sensor_noise(model, g.gyro_arw, g.accel_vrw);
         }
         cfg.mode = match args.mode.as_str() {
             "open" => Mode::OpenLoop,
@@ -1047,11 +973,9 @@ impl DataArgs {
                 .split_once('=')
                 .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
             let (name, value) = (name.trim(), value.trim());
+            let pattern = StatePattern::new(name);
             let matches: Vec<usize> = (0..model.n())
-                .filter(|&i| match name.strip_suffix('*') {
-                    Some(prefix) => model.names[i].starts_with(prefix),
-                    None => model.names[i] == name,
-                })
+                .filter(|&i| pattern.matches(model.names[i]))
                 .collect();
             if matches.is_empty() && !lenient_priors {
                 bail!(

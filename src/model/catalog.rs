@@ -73,6 +73,41 @@ pub struct TermInfo {
     pub library: bool,
 }
 
+/// Where a term's prior under a sensor grade comes from (`model-spec/grades.toml`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GradeRule {
+    /// The term's own `grade_sigma` entry in terms.toml.
+    Term,
+    /// The grade's entry for the term's group.
+    Group,
+    /// The grade's factor for unlisted groups times the term's navigation-grade prior.
+    Unlisted,
+}
+
+/// A sensor grade as declared in `model-spec/grades.toml`: white noise and the prior of every
+/// state (navigation states in `NAV_STATES` order, terms in `TERMS` order; SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GradeInfo {
+    /// Name as given to `--grade`.
+    pub name: &'static str,
+    /// What IMUs it describes.
+    pub doc: &'static str,
+    /// Gyro angle random walk [rad/√s].
+    pub gyro_arw: f64,
+    /// The angle random walk as written in the spec.
+    pub gyro_arw_text: &'static str,
+    /// Accelerometer velocity random walk [m/s/√s].
+    pub accel_vrw: f64,
+    /// The velocity random walk as written in the spec.
+    pub accel_vrw_text: &'static str,
+    /// Prior 1-σ of each navigation state [SI]; `None` keeps the spec's default.
+    pub nav_sigma: [Option<f64>; crate::model::generated::common::NAV_COUNT],
+    /// Prior 1-σ of each term [SI].
+    pub term_sigma: [f64; crate::model::generated::common::TERM_COUNT],
+    /// Where each term's prior comes from.
+    pub term_rule: [GradeRule; crate::model::generated::common::TERM_COUNT],
+}
+
 /// One component of a measurement.
 #[derive(Debug, Clone, Copy)]
 pub struct MeasRowInfo {
