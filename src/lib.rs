@@ -2,7 +2,7 @@
 //! navigation systems. Frames: NED navigation, FRD body; SI units and radians inside.
 //!
 //! The data path: `model-spec/*.toml` → `codegen/` (build.rs) → [`model::generated`] →
-//! [`model::Model`] → [`estimate::filter`] → [`report`]. Modules are grouped by domain:
+//! [`model::Model`] → [`estimate::filter`] → [`experiment`] / [`report`]. Modules are grouped by domain:
 //!
 //! - [`model`]: the compiled error models (catalogue, generated kernels, run-time composition,
 //!   covariance propagation, Jacobians at a point).
@@ -11,10 +11,13 @@
 //! - [`estimate`]: the error-state Kalman filter, alignment, Allan deviation, mounting.
 //! - [`io`]: IMU, aiding and truth files, readers of other formats, units at the edges,
 //!   atomic output files.
-//! - [`report`]: the paper's reproduction and its analysis, plots and progress bars.
+//! - [`experiment`]: the paper's reproduction, hidden-effect cases end to end, explain's
+//!   evaluation campaign (built on `estimate`, never used by it).
+//! - [`report`]: rendering: explain's words and Markdown, plots and progress bars.
 //! - [`fuzzing`]: fuzz target bodies, shared by cargo-fuzz and the stable corpus test.
 
 pub mod estimate;
+pub mod experiment;
 pub mod fuzzing;
 pub mod io;
 pub mod model;

@@ -1,7 +1,9 @@
 """A new error term is one `[[term]]` entry: added to a temporary copy of the spec (nothing else
 edited), it goes through the whole chain — build (codegen), `model show`, `jacobian`, the CasADi
 check (which must check the new term), a simulation with the term injected, a filter that
-estimates it, and `--grade mems` priors for it from the spec's grades file alone.
+estimates it, and `--grade mems` priors for it from the spec's grades file alone. The same copy
+also moves the height measurement's residual in measurements.toml, and the filter's innovations
+move with it: the residual the filter forms comes from the spec, not from code.
 
 The copy shares the project's target directory (its crates are compiled once, only the copy's
 own packages are rebuilt); its binary is renamed `sinsmodel-chain` so the project's own
@@ -36,6 +38,7 @@ group = "test: fourth-order"
 library = true
 doc = "x accelerometer fourth-order term (added by the chain test)"
 """
+HEIGHT_SHIFT = 20.0  # m, added to the height residual in the copy's measurements.toml
 TRUE_K4 = 3e-9  # s^6/m^3: 1.37 mg at 6 g, 0.09 mg at 3 g
 
 SCENARIO = """name = "chain"
@@ -111,9 +114,16 @@ class NewTermThroughTheChain(unittest.TestCase):
         for d in ["src", "codegen", "units", "model-spec", "benches"]:
             shutil.copytree(os.path.join(ROOT, d), os.path.join(crate, d),
                             ignore=shutil.ignore_patterns("target"))
-        # the only spec edit: one [[term]] entry
+        # the spec edits: one [[term]] entry, and the height measurement's residual offset by
+        # HEIGHT_SHIFT (only the +vertical run of test_6 forms that measurement)
         with open(os.path.join(crate, "model-spec", "terms.toml"), "a") as fh:
             fh.write(NEW_TERM)
+        meas = os.path.join(crate, "model-spec", "measurements.toml")
+        with open(meas) as fh:
+            text = fh.read()
+        assert 'residual = "h - aid.h"' in text
+        with open(meas, "w") as fh:
+            fh.write(text.replace('residual = "h - aid.h"', f'residual = "h - aid.h + {HEIGHT_SHIFT}"'))
         # not a spec edit: the copy's binary gets its own name, so the project's is not replaced
         manifest = os.path.join(crate, "Cargo.toml")
         with open(manifest) as fh:
@@ -220,6 +230,23 @@ class NewTermThroughTheChain(unittest.TestCase):
         # at rest, level, f_x = 0: nothing observes k4_x, its sigma stays at the prior
         self.assertAlmostEqual(nav, 1e-8, delta=1e-12)
         self.assertAlmostEqual(mems / nav, factor, delta=1e-4 * factor)
+
+    def test_6_residual_from_the_spec(self):
+        sim = os.path.join(self.tmp, "rest")
+        if not os.path.isdir(sim):
+            self.test_5_grade_prior_from_the_spec()
+        out = os.path.join(self.tmp, "f_vertical")
+        run([self.bin, "filter", "--model", "P13+vertical", "--imu", os.path.join(sim, "imu.txt"),
+             "--aid", os.path.join(sim, "gnss.txt"), "--init", "28.22,112.99,0,0,0,0", "--out", out])
+        with open(os.path.join(out, "innovations.txt")) as fh:
+            rows = [ln.split() for ln in fh if not ln.startswith("#")]
+        first_h = [float(r[3]) for r in rows if r[1] == "pos_h"][0]
+        first_n = [float(r[3]) for r in rows if r[1] == "pos_ne"][0]
+        print(f"first innovations: height {first_h:.3f} m (residual shifted by {HEIGHT_SHIFT} m), north {first_n:.3f} m",
+              file=sys.stderr)
+        # the simulated fixes have 1 m height noise: the first height innovation is the shift
+        self.assertLess(abs(first_h - HEIGHT_SHIFT), 5.0)
+        self.assertLess(abs(first_n), 5.0, "the untouched measurement is not moved")
 
 
 if __name__ == "__main__":

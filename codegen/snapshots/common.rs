@@ -3,8 +3,8 @@
 // codegen/snapshots/ with `UPDATE_SNAPSHOTS=1 cargo test -p sinsmodel-codegen --test snapshots`.
 
 use crate::model::catalog::{
-    GradeInfo, GradeRule, MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo,
-    WhiteNoise,
+    Aiding, AidRecord, GradeInfo, GradeRule, MeasRowInfo, MeasurementInfo, NavStateInfo,
+    ResidualState, Sensor, TermInfo, WhiteNoise,
 };
 
 use crate::nav::nav_point::NavPoint;
@@ -1261,6 +1261,7 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
         name: "vel_ne",
         doc: "north and east velocity error (computed minus aiding), m/s",
         sigma: 0.01,
+        aiding: Aiding::Velocity,
         rows: &[
             MeasRowInfo {
                 name: "dv_n",
@@ -1277,6 +1278,7 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
         name: "pos_ne",
         doc: "north and east position error in metres: (R_M+h) dlat, (R_N+h) cos(lat) dlon",
         sigma: 0.5,
+        aiding: Aiding::Position,
         rows: &[
             MeasRowInfo {
                 name: "dp_n",
@@ -1293,6 +1295,7 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
         name: "pos_h",
         doc: "height error (up), m",
         sigma: 1.0,
+        aiding: Aiding::Position,
         rows: &[
             MeasRowInfo {
                 name: "dp_u",
@@ -1987,6 +1990,49 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             col[DV_D] = c33 * r;
         }
         _ => panic!("term index {term} out of range"),
+    }
+}
+
+/// Forms measurement `m` from the filter's state `s` and the aiding record `aid` (the one
+/// `MEASUREMENTS[m].aiding` names): the residual z = computed − aided and its 1-σ per
+/// component, as measurements.toml writes them.
+pub fn residual(
+    m: usize,
+    s: &ResidualState,
+    aid: &AidRecord,
+    z: &mut [f64],
+    sigma: &mut [f64],
+) {
+    match m {
+        0 => {
+            let vn = s.vn;
+            let ve = s.ve;
+            // dv_n: vn - aid.vn [m/s], 1-σ aid.sigma_v
+            z[0] = vn - aid.vn;
+            sigma[0] = aid.sigma_v;
+            // dv_e: ve - aid.ve [m/s], 1-σ aid.sigma_v
+            z[1] = ve - aid.ve;
+            sigma[1] = aid.sigma_v;
+        }
+        1 => {
+            let lat = s.lat;
+            let lon = s.lon;
+            let rm = s.rm;
+            let rn = s.rn;
+            // dp_n: (lat - aid.lat) * rm [m], 1-σ aid.sigma_n
+            z[0] = (lat - aid.lat) * rm;
+            sigma[0] = aid.sigma_n;
+            // dp_e: (lon - aid.lon) * rn * lat.cos() [m], 1-σ aid.sigma_e
+            z[1] = (lon - aid.lon) * rn * lat.cos();
+            sigma[1] = aid.sigma_e;
+        }
+        2 => {
+            let h = s.h;
+            // dp_u: h - aid.h [m], 1-σ aid.sigma_d
+            z[0] = h - aid.h;
+            sigma[0] = aid.sigma_d;
+        }
+        _ => panic!("measurement index {m} out of range"),
     }
 }
 

@@ -5,7 +5,7 @@
 use crate::layout::{term_column, Layout, StateRef, SymEntry};
 use crate::spec::{Sensor, Spec, WhiteNoise};
 use proc_macro2::TokenStream;
-use quote::{format_ident, quote};
+use quote::{format_ident, quote, ToTokens};
 use std::collections::BTreeSet;
 
 /// Header written above every generated file.
@@ -276,7 +276,37 @@ pub fn common_module(spec: &Spec) -> String {
         });
         let states: BTreeSet<&str> = m.rows.iter().flat_map(|r| r.h.iter().map(|h| h.state.as_str())).collect();
         let states = states.into_iter();
-        quote!(MeasurementInfo { name: #name, doc: #doc, sigma: #sigma, rows: &[#(#rows),*], states: &[#(#states),*] })
+        let aiding = match m.aiding {
+            crate::spec::Aiding::Position => quote!(Aiding::Position),
+            crate::spec::Aiding::Velocity => quote!(Aiding::Velocity),
+        };
+        quote!(MeasurementInfo { name: #name, doc: #doc, sigma: #sigma, aiding: #aiding, rows: &[#(#rows),*], states: &[#(#states),*] })
+    });
+    let residual_arms = spec.measurements.iter().enumerate().map(|(m, meas)| {
+        let mut used = BTreeSet::new();
+        for r in &meas.rows {
+            for e in [&r.residual, &r.residual_sigma] {
+                for tok in e.ast.to_token_stream() {
+                    collect_idents(tok, &mut used);
+                }
+            }
+        }
+        let binds = crate::expr::RESIDUAL_STATE_SYMBOLS
+            .iter()
+            .filter(|(n, _)| used.contains(*n))
+            .map(|(n, _)| {
+                let id = format_ident!("{}", n);
+                quote!(let #id = s.#id;)
+            });
+        let lines = meas.rows.iter().enumerate().map(|(i, r)| {
+            let (z, sig) = (&r.residual.ast, &r.residual_sigma.ast);
+            let cm = comment(&format!(
+                "{}: {} [{}], 1-σ {}",
+                r.name, r.residual.source, r.unit, r.residual_sigma.source
+            ));
+            quote!(#cm z[#i] = #z; sigma[#i] = #sig;)
+        });
+        quote!(#m => { #(#binds)* #(#lines)* })
     });
     let meas_arms = spec.measurements.iter().enumerate().map(|(m, meas)| {
         let entries: Vec<SymEntry> = meas
@@ -334,7 +364,7 @@ pub fn common_module(spec: &Spec) -> String {
         quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*], term_rule: [#(#rules),*] })
     });
     let tokens = quote! {
-        use crate::model::catalog::{GradeInfo, GradeRule, MeasRowInfo, MeasurementInfo, NavStateInfo, Sensor, TermInfo, WhiteNoise};
+        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, GradeRule, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
         use crate::nav::nav_point::NavPoint;
         use nalgebra::Vector3;
 
@@ -389,6 +419,16 @@ pub fn common_module(spec: &Spec) -> String {
             match term {
                 #(#term_arms)*
                 _ => panic!("term index {term} out of range"),
+            }
+        }
+
+        /// Forms measurement `m` from the filter's state `s` and the aiding record `aid` (the one
+        /// `MEASUREMENTS[m].aiding` names): the residual z = computed − aided and its 1-σ per
+        /// component, as measurements.toml writes them.
+        pub fn residual(m: usize, s: &ResidualState, aid: &AidRecord, z: &mut [f64], sigma: &mut [f64]) {
+            match m {
+                #(#residual_arms)*
+                _ => panic!("measurement index {m} out of range"),
             }
         }
 

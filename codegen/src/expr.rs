@@ -40,6 +40,25 @@ pub const NAV_SYMBOLS: [(&str, &str); 22] = [
     ("dg_dh", "normal gravity derivative by height [1/s^2]"),
 ];
 
+/// Navigation-state quantities a measurement residual may use: the filter's state at the fix
+/// time (SI units), with the WGS-84 radii at that state.
+pub const RESIDUAL_STATE_SYMBOLS: [(&str, &str); 8] = [
+    ("lat", "geodetic latitude [rad]"),
+    ("lon", "longitude [rad]"),
+    ("h", "height above the ellipsoid, up [m]"),
+    ("vn", "north velocity [m/s]"),
+    ("ve", "east velocity [m/s]"),
+    ("vd", "down velocity [m/s]"),
+    ("rm", "R_M + h at the state [m]"),
+    ("rn", "R_N + h at the state [m]"),
+];
+
+/// Fields of the aiding record a residual may use (`aid.lat`, …): what a position fix gives and
+/// what a velocity fix gives.
+pub const AID_POSITION_FIELDS: [&str; 6] = ["lat", "lon", "h", "sigma_n", "sigma_e", "sigma_d"];
+/// Fields of a velocity fix (`aid.vn`, …; one 1-σ for every component).
+pub const AID_VELOCITY_FIELDS: [&str; 4] = ["vn", "ve", "vd", "sigma_v"];
+
 /// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s].
 pub const IMU_SIGNALS: [&str; 2] = ["f", "w"];
 
@@ -53,6 +72,9 @@ pub enum ExprKind {
     Navigation,
     /// A term's regressor: IMU signals only.
     Regressor,
+    /// A measurement's residual or its 1-σ: the state's quantities and the aiding record's
+    /// fields (`aid.lat`, `aid.sigma_n`, …).
+    Residual,
 }
 
 /// A validated expression.
@@ -275,6 +297,17 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 .map(|i| i.to_string())
                 .ok_or_else(|| format!("unknown symbol `{}`", p.to_token_stream()))?;
             match kind {
+                ExprKind::Residual if RESIDUAL_STATE_SYMBOLS.iter().any(|(n, _)| *n == name) => {
+                    Ok(())
+                }
+                ExprKind::Residual => Err(format!(
+                    "unknown symbol `{name}` (a residual uses {} and aid.FIELD)",
+                    RESIDUAL_STATE_SYMBOLS
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                )),
                 ExprKind::Navigation if is_nav_symbol(&name) => Ok(()),
                 ExprKind::Navigation => Err(format!(
                     "unknown symbol `{name}` (navigation symbols: {})",
@@ -295,7 +328,16 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 syn::Member::Unnamed(_) => String::new(),
             };
             let ok_member = matches!(member.as_str(), "x" | "y" | "z");
+            let aid_field = AID_POSITION_FIELDS.contains(&member.as_str())
+                || AID_VELOCITY_FIELDS.contains(&member.as_str());
             match (kind, base.as_deref()) {
+                (ExprKind::Residual, Some("aid")) if aid_field => Ok(()),
+                (ExprKind::Residual, _) => Err(format!(
+                    "unknown field `{}` (the aiding record has aid.{} and aid.{})",
+                    f.to_token_stream().to_string().replace(' ', ""),
+                    AID_POSITION_FIELDS.join(" aid."),
+                    AID_VELOCITY_FIELDS.join(" aid.")
+                )),
                 (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
                 (ExprKind::Regressor, _) => Err(format!(
                     "unknown signal `{}` (use f.x f.y f.z or w.x w.y w.z)",
@@ -437,6 +479,19 @@ mod tests {
                 .literals(),
             [2.0, 3.0, 0.5]
         );
+    }
+
+    #[test]
+    fn residual_expressions_use_the_state_and_the_aiding_record() {
+        let e = parse("(lon - aid.lon) * rn * lat.cos()", ExprKind::Residual).unwrap();
+        let s = e.symbols();
+        assert!(s.contains("aid.lon") && s.contains("rn") && s.contains("lat"));
+        let e = parse("lat - aid.latitude", ExprKind::Residual).unwrap_err();
+        assert!(e.contains("unknown field `aid.latitude`"), "{e}");
+        let e = parse("omega * aid.h", ExprKind::Residual).unwrap_err();
+        assert!(e.contains("unknown symbol `omega`"), "{e}");
+        let e = parse("f.x - aid.vn", ExprKind::Residual).unwrap_err();
+        assert!(e.contains("unknown field `f.x`"), "{e}");
     }
 
     #[test]

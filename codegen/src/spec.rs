@@ -160,6 +160,19 @@ pub struct MeasRow {
     pub unit: String,
     /// Non-zero H entries.
     pub h: Vec<HEntry>,
+    /// The residual z = computed − aided, in `unit`, over the state and the aiding record.
+    pub residual: Expr,
+    /// The residual's 1-σ, from the aiding record.
+    pub residual_sigma: Expr,
+}
+
+/// Which aiding record a measurement is formed from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Aiding {
+    /// A position fix (`aid.lat`, `aid.lon`, `aid.h`, `aid.sigma_n|e|d`).
+    Position,
+    /// A velocity fix (`aid.vn`, `aid.ve`, `aid.vd`, `aid.sigma_v`).
+    Velocity,
 }
 
 /// A measurement type (`vel_ne`, `pos_ne`, `pos_h`).
@@ -171,6 +184,8 @@ pub struct Measurement {
     pub doc: String,
     /// Default noise 1-σ per component, SI.
     pub sigma: f64,
+    /// The aiding record it is formed from.
+    pub aiding: Aiding,
     /// Components.
     pub rows: Vec<MeasRow>,
 }
@@ -320,6 +335,7 @@ struct RawMeasurement {
     name: Spanned<String>,
     doc: String,
     sigma: Spanned<String>,
+    aiding: Spanned<String>,
     rows: Vec<RawMeasRow>,
 }
 
@@ -329,6 +345,8 @@ struct RawMeasRow {
     name: String,
     unit: String,
     h: Vec<RawHEntry>,
+    residual: Spanned<String>,
+    residual_sigma: Spanned<String>,
 }
 
 #[derive(Deserialize)]
@@ -851,8 +869,22 @@ fn load_measurements(
         if !(sigma > 0.0 && sigma.is_finite()) {
             return Err(src.error(m.sigma.span(), &item, "sigma must be positive and finite"));
         }
+        let aiding = match m.aiding.get_ref().as_str() {
+            "position" => Aiding::Position,
+            "velocity" => Aiding::Velocity,
+            other => {
+                return Err(src.error(
+                    m.aiding.span(),
+                    &item,
+                    format!("aiding: unknown record `{other}` (expected `position` or `velocity`)"),
+                ))
+            }
+        };
         let mut rows = Vec::new();
         for r in &m.rows {
+            let residual = residual_expr(src, &r.residual, aiding, &item, "residual")?;
+            let residual_sigma =
+                residual_expr(src, &r.residual_sigma, aiding, &item, "residual_sigma")?;
             let mut h = Vec::new();
             for e in &r.h {
                 if !names.contains_key(e.state.get_ref()) {
@@ -873,16 +905,51 @@ fn load_measurements(
                 name: r.name.clone(),
                 unit: r.unit.clone(),
                 h,
+                residual,
+                residual_sigma,
             });
         }
         measurements.push(Measurement {
             name: m.name.get_ref().clone(),
             doc: m.doc.clone(),
             sigma,
+            aiding,
             rows,
         });
     }
     Ok(measurements)
+}
+
+/// A residual (or its 1-σ) expression of a measurement formed from `aiding`: it may use only that
+/// record's fields.
+fn residual_expr(
+    src: &Source,
+    text: &Spanned<String>,
+    aiding: Aiding,
+    item: &str,
+    field: &str,
+) -> Result<Expr, SpecError> {
+    let e = expr::parse(text.get_ref(), ExprKind::Residual)
+        .map_err(|msg| src.error(text.span(), item, format!("{field}: {msg}")))?;
+    let (fields, record): (&[&str], &str) = match aiding {
+        Aiding::Position => (&expr::AID_POSITION_FIELDS, "position"),
+        Aiding::Velocity => (&expr::AID_VELOCITY_FIELDS, "velocity"),
+    };
+    for sym in e.symbols() {
+        if let Some(f) = sym.strip_prefix("aid.") {
+            if !fields.contains(&f) {
+                return Err(src.error(
+                    text.span(),
+                    item,
+                    format!(
+                        "{field}: `{sym}` is not in a {record} fix (it has aid.{})",
+                        fields.join(" aid.")
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(e)
 }
 
 /// Presets: `[[preset]]` entries with either the full `states` list or a `base` preset (defined

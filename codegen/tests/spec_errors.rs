@@ -409,3 +409,39 @@ fn a_term_prior_comes_from_the_term_then_its_group_then_the_unlisted_rule() {
     let tactical = spec.grades.iter().find(|g| g.name == "tactical").unwrap();
     assert_eq!(tactical.term_rule[t("eps_y")], GradeRule::Group);
 }
+
+#[test]
+fn residual_errors_name_the_measurement_and_the_record() {
+    expect_error(
+        "measurements.toml",
+        "residual = \"h - aid.h\"",
+        "residual = \"h - aid.vd\"",
+        "h - aid.vd",
+        "measurement `pos_h`",
+        "`aid.vd` is not in a position fix",
+    );
+    expect_error(
+        "measurements.toml",
+        "residual = \"vn - aid.vn\"",
+        "residual = \"vn - aid.speed\"",
+        "aid.speed",
+        "measurement `vel_ne`",
+        "unknown field `aid.speed`",
+    );
+    expect_error(
+        "measurements.toml",
+        "aiding = \"velocity\"",
+        "aiding = \"odometer\"",
+        "odometer",
+        "measurement `vel_ne`",
+        "unknown record `odometer`",
+    );
+    expect_error(
+        "measurements.toml",
+        "residual_sigma = \"aid.sigma_n\"",
+        "residual_sigma = \"omega\"",
+        "residual_sigma = \"omega\"",
+        "measurement `pos_ne`",
+        "residual_sigma: unknown symbol `omega`",
+    );
+}

@@ -4,8 +4,8 @@
 use anyhow::Result;
 use clap::Args;
 use sinsmodel::estimate::filter::{self, AidingEpoch, FilterConfig};
+use sinsmodel::experiment::reproduce::{self, Priors};
 use sinsmodel::model::Model;
-use sinsmodel::report::reproduce::{self, Priors};
 use sinsmodel::sim::scenario::Scenario;
 use sinsmodel::sim::simulator::{simulate, SimOutput};
 use std::io::Write as _;

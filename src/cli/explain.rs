@@ -8,10 +8,11 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use sinsmodel::estimate::explain::{self, ExplainData, ExplainOptions, Explanation};
 use sinsmodel::estimate::filter::FilterConfig;
+use sinsmodel::experiment::reproduce;
 use sinsmodel::io::atomic_file::{self, OutputDir};
 use sinsmodel::model::Model;
 use sinsmodel::report::plot::{self, Bar, Scale, Series};
-use sinsmodel::report::{explain as report, progress, reproduce};
+use sinsmodel::report::{explain as report, progress};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `explain`.

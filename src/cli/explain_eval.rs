@@ -6,7 +6,7 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
-use sinsmodel::estimate::explain_eval::{self, CaseResult, EvalSpec, Summary};
+use sinsmodel::experiment::explain_eval::{self, CaseResult, EvalSpec, Summary};
 use sinsmodel::io::atomic_file::{self, OutputDir};
 use sinsmodel::report::plot::{self, Scale, Series};
 use sinsmodel::report::progress;

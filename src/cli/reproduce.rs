@@ -5,10 +5,10 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::filter::FilterRun;
+use sinsmodel::experiment::reproduce::{self, CaseResult, GridPoint, Priors};
 use sinsmodel::io::atomic_file;
 use sinsmodel::report::plot::{line_plot, Scale, Series};
 use sinsmodel::report::progress;
-use sinsmodel::report::reproduce::{self, CaseResult, GridPoint, Priors};
 use std::path::PathBuf;
 
 /// Arguments of `reproduce`.
@@ -222,7 +222,7 @@ fn markdown(r: &Results, quick: bool) -> String {
     s
 }
 
-/// The consistency Monte Carlo (library: `report::reproduce::consistency`), printed and plotted.
+/// The consistency Monte Carlo (library: `experiment::reproduce::consistency`), printed and plotted.
 fn consistency(args: &ReproduceArgs, dir: sinsmodel::io::atomic_file::OutputDir) -> Result<()> {
     let pb = progress::bar(20, "monte carlo");
     let out = reproduce::consistency(args.quick, |k, _| pb.set_position(k as u64))?;

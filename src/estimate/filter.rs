@@ -18,7 +18,7 @@
 
 use crate::io::imu::{ImuData, ImuSample};
 use crate::io::truth::{TruthLookup, TruthRow, TruthSlice};
-use crate::model::catalog::{Sensor, StateRef, WhiteNoise};
+use crate::model::catalog::{AidRecord, Aiding, ResidualState, Sensor, StateRef, WhiteNoise};
 use crate::model::covariance::SparsePropagator;
 use crate::model::generated::common;
 use crate::model::Model;
@@ -278,28 +278,50 @@ pub fn run(
 
 /// The residual z = computed − aiding of spec measurement `meas` at an epoch, in the
 /// measurement's components and units, with each component's 1-σ; None when the epoch does not
-/// carry that measurement. H for the same measurement comes from the spec ([`Model::fill_h`]);
-/// `residual_matches_generated_h` (tests/filter.rs) checks that z and H agree to first order.
+/// carry the record that measurement is formed from. Both z and H come from the spec
+/// (`residual` and `h` of each row in measurements.toml: `common::residual`, [`Model::fill_h`]);
+/// `residual_matches_generated_h` (tests/filter.rs) checks that they agree to first order.
 pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>, Vec<f64>)> {
-    match meas {
-        "vel_ne" => ep
-            .vel
-            .map(|(v, sig)| (vec![s.v.x - v.x, s.v.y - v.y], vec![sig, sig])),
-        "pos_ne" => ep.pos.map(|(lat, lon, _, sig)| {
-            let rm = earth::radius_meridian(s.lat) + s.h;
-            let rn = earth::radius_transverse(s.lat) + s.h;
-            (
-                vec![(s.lat - lat) * rm, (s.lon - lon) * rn * s.lat.cos()],
-                vec![sig[0], sig[1]],
-            )
-        }),
-        "pos_h" => ep.pos.map(|(_, _, h, sig)| (vec![s.h - h], vec![sig[2]])),
-        _ => None,
+    let m = common::MEASUREMENTS.iter().position(|x| x.name == meas)?;
+    let info = &common::MEASUREMENTS[m];
+    let mut aid = AidRecord {
+        lat: f64::NAN,
+        lon: f64::NAN,
+        h: f64::NAN,
+        sigma_n: f64::NAN,
+        sigma_e: f64::NAN,
+        sigma_d: f64::NAN,
+        vn: f64::NAN,
+        ve: f64::NAN,
+        vd: f64::NAN,
+        sigma_v: f64::NAN,
+    };
+    match info.aiding {
+        Aiding::Position => {
+            let (lat, lon, h, sig) = ep.pos?;
+            (aid.lat, aid.lon, aid.h) = (lat, lon, h);
+            (aid.sigma_n, aid.sigma_e, aid.sigma_d) = (sig[0], sig[1], sig[2]);
+        }
+        Aiding::Velocity => {
+            let (v, sig) = ep.vel?;
+            (aid.vn, aid.ve, aid.vd, aid.sigma_v) = (v.x, v.y, v.z, sig);
+        }
     }
+    let state = ResidualState {
+        lat: s.lat,
+        lon: s.lon,
+        h: s.h,
+        vn: s.v.x,
+        ve: s.v.y,
+        vd: s.v.z,
+        rm: earth::radius_meridian(s.lat) + s.h,
+        rn: earth::radius_transverse(s.lat) + s.h,
+    };
+    let k = info.rows.len();
+    let (mut z, mut sigma) = (vec![0.0; k], vec![0.0; k]);
+    common::residual(m, &state, &aid, &mut z, &mut sigma);
+    Some((z, sigma))
 }
-
-/// Spec measurements the filter can form a residual for (see [`residual`]).
-pub const FORMED_MEASUREMENTS: [&str; 3] = ["vel_ne", "pos_ne", "pos_h"];
 
 /// The running filter: navigator, error state, covariance and the per-step buffers.
 struct Engine<'a> {
@@ -358,7 +380,6 @@ impl<'a> Engine<'a> {
         let meas: Vec<(&'static str, usize)> = model
             .measurements()
             .iter()
-            .filter(|m| FORMED_MEASUREMENTS.contains(&m.name))
             .map(|m| (m.name, m.rows.len()))
             .collect();
         let max_rows = meas.iter().map(|m| m.1).max().unwrap_or(0);

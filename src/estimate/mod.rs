@@ -5,7 +5,6 @@
 pub mod align;
 pub mod allan;
 pub mod explain;
-pub mod explain_eval;
 pub mod filter;
 pub mod imu_check;
 pub mod init;

@@ -108,6 +108,62 @@ pub struct GradeInfo {
     pub term_rule: [GradeRule; crate::model::generated::common::TERM_COUNT],
 }
 
+/// Which aiding record a measurement is formed from (`aiding` in measurements.toml).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Aiding {
+    /// A position fix.
+    Position,
+    /// A velocity fix.
+    Velocity,
+}
+
+/// The filter's navigation state at a fix, as a measurement residual sees it (SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResidualState {
+    /// Geodetic latitude [rad].
+    pub lat: f64,
+    /// Longitude [rad].
+    pub lon: f64,
+    /// Height, up [m].
+    pub h: f64,
+    /// North velocity [m/s].
+    pub vn: f64,
+    /// East velocity [m/s].
+    pub ve: f64,
+    /// Down velocity [m/s].
+    pub vd: f64,
+    /// R_M + h at the state [m].
+    pub rm: f64,
+    /// R_N + h at the state [m].
+    pub rn: f64,
+}
+
+/// One aiding record as a residual reads it (`aid.lat`, …): the fields of the record the
+/// measurement names; the others are NaN, and the spec compiler refuses a residual that uses them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AidRecord {
+    /// Latitude of a position fix [rad].
+    pub lat: f64,
+    /// Longitude [rad].
+    pub lon: f64,
+    /// Height, up [m].
+    pub h: f64,
+    /// 1-σ north [m].
+    pub sigma_n: f64,
+    /// 1-σ east [m].
+    pub sigma_e: f64,
+    /// 1-σ down [m].
+    pub sigma_d: f64,
+    /// North velocity of a velocity fix [m/s].
+    pub vn: f64,
+    /// East velocity [m/s].
+    pub ve: f64,
+    /// Down velocity [m/s].
+    pub vd: f64,
+    /// 1-σ of each velocity component [m/s].
+    pub sigma_v: f64,
+}
+
 /// One component of a measurement.
 #[derive(Debug, Clone, Copy)]
 pub struct MeasRowInfo {
@@ -126,6 +182,8 @@ pub struct MeasurementInfo {
     pub doc: &'static str,
     /// Default noise 1-σ per component, SI.
     pub sigma: f64,
+    /// The aiding record it is formed from.
+    pub aiding: Aiding,
     /// Components.
     pub rows: &'static [MeasRowInfo],
     /// States the measurement references (all must be in a model for it to apply).

@@ -1,9 +1,8 @@
-//! Reports: the paper's reproduction and its statistics, PNG plots and progress bars (the
-//! last two with the `cli` feature).
+//! Reports: explain's words and Markdown, PNG plots and progress bars (the last two with the
+//! `cli` feature). Rendering only; the experiments are in `experiment`.
 
 pub mod explain;
 #[cfg(feature = "cli")]
 pub mod plot;
 #[cfg(feature = "cli")]
 pub mod progress;
-pub mod reproduce;

@@ -4,11 +4,10 @@
 //! against theory. Each case depends only on (seed, index), so any split of the indices over
 //! threads or machines gives the same cases; [`summarize`] of merged case lists equals one run.
 
-use crate::estimate::explain::{
-    self, inject, run_hidden_on, signature_information, simulate_case, ExplainData, ExplainOptions,
-};
+use crate::estimate::explain::{self, signature_information, ExplainData, ExplainOptions};
 use crate::estimate::filter::FilterConfig;
 use crate::estimate::stats;
+use crate::experiment::hidden::{inject, run_hidden_on, simulate_case};
 use crate::model::generated::common;
 use crate::model::Model;
 use crate::sim::hidden::{clear_effect, generate, CaseKind, GROUPS};

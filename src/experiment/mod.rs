@@ -1,0 +1,7 @@
+//! Experiments built on the library: the paper's reproduction (`reproduce`), hidden-effect cases
+//! end to end (`hidden`) and explain's evaluation campaign (`explain_eval`). They use the
+//! estimators; the estimators never use them.
+
+pub mod explain_eval;
+pub mod hidden;
+pub mod reproduce;
