@@ -10,7 +10,7 @@ use crate::io::units;
 use crate::model::jacobian::{jacobian, parse_points, PointSpec, Points};
 use crate::model::Model;
 use crate::sim::scenario::Scenario;
-use sinsmodel_units::{Dim, MAX_DIM_EXPONENT};
+use sinsmodel_units::fuzz_property::{bounded, finite};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -48,20 +48,6 @@ pub fn target(name: &str) -> Option<fn(&[u8])> {
         "matlab" => Some(matlab),
         _ => None,
     }
-}
-
-/// Panics naming `what` unless `v` is finite.
-fn finite(v: f64, what: &str) {
-    assert!(v.is_finite(), "accepted {what} = {v} is not finite");
-}
-
-/// Panics unless every exponent of `d` is within the documented bound (no wrapped arithmetic).
-fn bounded(d: Dim, what: &str) {
-    assert!(
-        d.0.iter().all(|e| e.abs() <= 2 * MAX_DIM_EXPONENT),
-        "accepted {what} has dimension exponents {:?} beyond ±{MAX_DIM_EXPONENT}",
-        d.0
-    );
 }
 
 /// The unit and quantity parser (`"0.01 deg/h"`, `"10 ug/g^2"`, `"1 deg/sqrt(h)"`).

@@ -3,7 +3,7 @@
 //! (`sinsmodel::fuzzing`): no panic, no hang, no NaN or infinity in anything accepted.
 
 use crate::spec::SPEC_FILES;
-use crate::units::{Dim, MAX_DIM_EXPONENT};
+use crate::units::fuzz_property::{bounded, finite};
 use crate::{Layout, Spec};
 use std::path::Path;
 
@@ -15,20 +15,6 @@ const REAL_SPEC: [&str; SPEC_FILES.len()] = [
     include_str!("../../model-spec/presets.toml"),
     include_str!("../../model-spec/grades.toml"),
 ];
-
-/// Panics naming `what` unless `v` is finite.
-fn finite(v: f64, what: &str) {
-    assert!(v.is_finite(), "accepted {what} = {v} is not finite");
-}
-
-/// Panics unless every exponent of `d` is within the documented bound (no wrapped arithmetic).
-fn bounded(d: Dim, what: &str) {
-    assert!(
-        d.0.iter().all(|e| e.abs() <= 2 * MAX_DIM_EXPONENT),
-        "accepted {what} has dimension exponents {:?} beyond ±{MAX_DIM_EXPONENT}",
-        d.0
-    );
-}
 
 /// The model-spec compiler's front end (TOML, units, expressions, presets).
 ///

@@ -347,6 +347,27 @@ pub fn parse_quantity_as(text: &str, expected_unit: &str) -> Result<f64, UnitErr
     check_si(q.si / u.to_si, q.si != 0.0, text.trim())
 }
 
+/// The fuzz targets' properties on numbers and dimensions, shared by the runtime's
+/// (`sinsmodel::fuzzing`) and the spec compiler's (`sinsmodel_codegen::fuzzing`) targets.
+pub mod fuzz_property {
+    use super::{Dim, MAX_DIM_EXPONENT};
+
+    /// Panics naming `what` unless `v` is finite.
+    pub fn finite(v: f64, what: &str) {
+        assert!(v.is_finite(), "accepted {what} = {v} is not finite");
+    }
+
+    /// Panics unless every exponent of `d` is within the documented bound (no wrapped
+    /// arithmetic).
+    pub fn bounded(d: Dim, what: &str) {
+        assert!(
+            d.0.iter().all(|e| e.abs() <= 2 * MAX_DIM_EXPONENT),
+            "accepted {what} has dimension exponents {:?} beyond ±{MAX_DIM_EXPONENT}",
+            d.0
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
