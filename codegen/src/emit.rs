@@ -356,15 +356,10 @@ pub fn common_module(spec: &Spec) -> String {
             None => quote!(None),
         });
         let terms = g.term_sigma.iter().map(|v| f64_lit(*v));
-        let rules = g.term_rule.iter().map(|r| match r {
-            crate::grades::GradeRule::Term => quote!(GradeRule::Term),
-            crate::grades::GradeRule::Group => quote!(GradeRule::Group),
-            crate::grades::GradeRule::Unlisted => quote!(GradeRule::Unlisted),
-        });
-        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*], term_rule: [#(#rules),*] })
+        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*] })
     });
     let tokens = quote! {
-        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, GradeRule, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
+        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
         use crate::nav::nav_point::NavPoint;
         use nalgebra::Vector3;
 

@@ -284,18 +284,7 @@ pub fn run(
 pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>, Vec<f64>)> {
     let m = common::MEASUREMENTS.iter().position(|x| x.name == meas)?;
     let info = &common::MEASUREMENTS[m];
-    let mut aid = AidRecord {
-        lat: f64::NAN,
-        lon: f64::NAN,
-        h: f64::NAN,
-        sigma_n: f64::NAN,
-        sigma_e: f64::NAN,
-        sigma_d: f64::NAN,
-        vn: f64::NAN,
-        ve: f64::NAN,
-        vd: f64::NAN,
-        sigma_v: f64::NAN,
-    };
+    let mut aid = AidRecord::UNSET;
     match info.aiding {
         Aiding::Position => {
             let (lat, lon, h, sig) = ep.pos?;

@@ -73,17 +73,6 @@ pub struct TermInfo {
     pub library: bool,
 }
 
-/// Where a term's prior under a sensor grade comes from (`model-spec/grades.toml`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum GradeRule {
-    /// The term's own `grade_sigma` entry in terms.toml.
-    Term,
-    /// The grade's entry for the term's group.
-    Group,
-    /// The grade's factor for unlisted groups times the term's navigation-grade prior.
-    Unlisted,
-}
-
 /// A sensor grade as declared in `model-spec/grades.toml`: white noise and the prior of every
 /// state (navigation states in `NAV_STATES` order, terms in `TERMS` order; SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,10 +91,9 @@ pub struct GradeInfo {
     pub accel_vrw_text: &'static str,
     /// Prior 1-σ of each navigation state [SI]; `None` keeps the spec's default.
     pub nav_sigma: [Option<f64>; crate::model::generated::common::NAV_COUNT],
-    /// Prior 1-σ of each term [SI].
+    /// Prior 1-σ of each term [SI] (where it comes from, term, group or the unlisted rule, is
+    /// the spec compiler's business: `sinsmodel_codegen::grades`).
     pub term_sigma: [f64; crate::model::generated::common::TERM_COUNT],
-    /// Where each term's prior comes from.
-    pub term_rule: [GradeRule; crate::model::generated::common::TERM_COUNT],
 }
 
 /// Which aiding record a measurement is formed from (`aiding` in measurements.toml).
@@ -162,6 +150,22 @@ pub struct AidRecord {
     pub vd: f64,
     /// 1-σ of each velocity component [m/s].
     pub sigma_v: f64,
+}
+
+impl AidRecord {
+    /// A record with no field set (all NaN), to be filled from one fix.
+    pub const UNSET: AidRecord = AidRecord {
+        lat: f64::NAN,
+        lon: f64::NAN,
+        h: f64::NAN,
+        sigma_n: f64::NAN,
+        sigma_e: f64::NAN,
+        sigma_d: f64::NAN,
+        vn: f64::NAN,
+        ve: f64::NAN,
+        vd: f64::NAN,
+        sigma_v: f64::NAN,
+    };
 }
 
 /// One component of a measurement.

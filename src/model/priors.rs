@@ -45,11 +45,12 @@ pub fn grades() -> &'static [GradeInfo] {
 
 /// The names `--grade` takes, as a message lists them: `navigation, tactical or mems`.
 pub fn grade_names() -> String {
-    let mut names: Vec<&str> = vec!["navigation"];
-    names.extend(grades().iter().map(|g| g.name));
+    let names: Vec<&str> = std::iter::once("navigation")
+        .chain(grades().iter().map(|g| g.name))
+        .collect();
     match names.split_last() {
         Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-        _ => names.join(""),
+        _ => "navigation".to_string(),
     }
 }
 
