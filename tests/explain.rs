@@ -4,8 +4,8 @@
 //! that knows the true model. Null cases must name nothing. The fast set: every library group
 //! once, two null cases, one case that needs two terms.
 
-use sinsmodel::estimate::explain::ExplainOptions;
 use sinsmodel::experiment::hidden::{run_hidden_case, HiddenOutcome};
+use sinsmodel::explain::ExplainOptions;
 use sinsmodel::model::generated::common;
 use sinsmodel::sim::hidden::{clear_effect, generate, CaseKind, HiddenCase};
 

@@ -269,5 +269,5 @@ fn fit_line(name: &str, f: &NoiseFit) -> String {
 }
 
 fn num(v: f64) -> String {
-    sinsmodel::estimate::explain::sig3(v)
+    sinsmodel::explain::sig3(v)
 }

@@ -60,7 +60,7 @@ fn peak_rss_mib() -> f64 {
 /// Job 3: explain on `seconds` of the demo's 2 kHz vibration data, baseline P31, every library
 /// candidate; against one plain P31 filter pass over the same data.
 fn explain_job(seconds: f64) -> Result<()> {
-    use sinsmodel::estimate::explain::{self, ExplainData, ExplainOptions};
+    use sinsmodel::explain::{self, ExplainData, ExplainOptions};
     let case = reproduce::explain_demo(seconds, 3);
     let sim = simulate(&Scenario::parse(&case.scenario, "bench explain")?, |_| {});
     let priors = Priors::default();
@@ -72,7 +72,7 @@ fn explain_job(seconds: f64) -> Result<()> {
     let plain = filter::run(&model, &cfg, &sim.imu, sim.start, &aid, None, |_| {});
     let t_plain = t.elapsed().as_secs_f64();
     let data = ExplainData {
-        imu: sinsmodel::estimate::explain::ImuInput::Memory(&sim.imu),
+        imu: sinsmodel::explain::ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: None,
         start: sim.start,

@@ -458,7 +458,7 @@ impl DataArgs {
     /// For a command that passes over the IMU file more than once (explain): reads the file
     /// through once (every sample validated, its end found; memory does not grow with it), then
     /// the aiding epochs inside it, the truth and the initial state. Each pass reads the file
-    /// again ([`sinsmodel::estimate::explain::ImuInput::File`]).
+    /// again ([`sinsmodel::explain::ImuInput::File`]).
     pub fn load_for_passes(&self) -> Result<Inputs> {
         let mut opened = self.open()?;
         while opened.imu.next()?.is_some() {}

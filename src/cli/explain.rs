@@ -6,9 +6,9 @@
 use super::data::DataArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use sinsmodel::estimate::explain::{self, ExplainData, ExplainOptions, Explanation};
 use sinsmodel::estimate::filter::FilterConfig;
 use sinsmodel::experiment::reproduce;
+use sinsmodel::explain::{self, ExplainData, ExplainOptions, Explanation};
 use sinsmodel::io::atomic_file::{self, OutputDir};
 use sinsmodel::model::Model;
 use sinsmodel::report::plot::{self, Bar, Scale, Series};
@@ -107,7 +107,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         args.data.print_noise()?;
         let inputs = args.data.load_for_passes()?;
         let data = ExplainData {
-            imu: sinsmodel::estimate::explain::ImuInput::File {
+            imu: sinsmodel::explain::ImuInput::File {
                 path: &inputs.imu,
                 format: inputs.imu_format.as_deref(),
                 clock_offset: inputs.clock_offset,
@@ -191,7 +191,7 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let priors = reproduce::Priors::default();
     let aid = reproduce::aiding_from_truth(&sim, &priors, case.velocity_updates, seed)?;
     let data = ExplainData {
-        imu: sinsmodel::estimate::explain::ImuInput::Memory(&sim.imu),
+        imu: sinsmodel::explain::ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,

@@ -349,7 +349,7 @@ fn nis_table(run: &filter::FilterRun) -> String {
             "  {:<6} {:>6} updates  mean NIS {:>9}  band {:.2}..{:.2}  {}\n",
             c.channel,
             c.count,
-            sinsmodel::estimate::explain::sig3(c.mean),
+            sinsmodel::explain::sig3(c.mean),
             c.band[0],
             c.band[1],
             match c.verdict() {

@@ -74,7 +74,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
             c.f_mean_mps2[2],
             c.f_spread_mps2,
             if c.is_static { ", static" } else { ", moving" },
-            sinsmodel::estimate::explain::sig3(c.gravity_ratio),
+            sinsmodel::explain::sig3(c.gravity_ratio),
             c.gravity_mps2
         );
         let d = 180.0 / std::f64::consts::PI;
@@ -83,7 +83,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
             c.w_mean_radps[0] * d * 3600.0,
             c.w_mean_radps[1] * d * 3600.0,
             c.w_mean_radps[2] * d * 3600.0,
-            sinsmodel::estimate::explain::sig3(c.earth_rate_ratio)
+            sinsmodel::explain::sig3(c.earth_rate_ratio)
         );
     } else {
         println!(
@@ -124,7 +124,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
             } else {
                 format!(
                     "Earth rate not resolved (the gyro bias makes |ω| {}× Earth rate: gyro units checked only for gross errors)",
-                    sinsmodel::estimate::explain::sig3(c.earth_rate_ratio)
+                    sinsmodel::explain::sig3(c.earth_rate_ratio)
                 )
             }
         );

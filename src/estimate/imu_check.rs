@@ -131,8 +131,8 @@ pub fn check(
             problems.push(format!(
                 "mean specific force |f| = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
                  while moving too: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong",
-                crate::estimate::explain::sig3(f.norm()),
-                crate::estimate::explain::sig3(gravity_ratio)
+                crate::explain::sig3(f.norm()),
+                crate::explain::sig3(gravity_ratio)
             ));
         }
         notes.push(format!(

@@ -4,7 +4,6 @@
 
 pub mod align;
 pub mod allan;
-pub mod explain;
 pub mod filter;
 pub mod imu_check;
 pub mod init;

@@ -4,10 +4,10 @@
 //! against theory. Each case depends only on (seed, index), so any split of the indices over
 //! threads or machines gives the same cases; [`summarize`] of merged case lists equals one run.
 
-use crate::estimate::explain::{self, signature_information, ExplainData, ExplainOptions};
 use crate::estimate::filter::FilterConfig;
 use crate::estimate::stats;
 use crate::experiment::hidden::{inject, run_hidden_on, simulate_case};
+use crate::explain::{self, signature_information, ExplainData, ExplainOptions};
 use crate::model::generated::common;
 use crate::model::Model;
 use crate::sim::hidden::{clear_effect, generate, CaseKind, GROUPS};
@@ -121,7 +121,7 @@ pub fn run_case(
             .ok_or_else(|| anyhow::anyhow!("hidden term `{name}` is not a spec term"))?;
         let baseline = Model::parse(&case.baseline)?;
         let data = ExplainData {
-            imu: crate::estimate::explain::ImuInput::Memory(&sim.imu),
+            imu: crate::explain::ImuInput::Memory(&sim.imu),
             aid: &aid,
             truth: Some(&sim.truth),
             start: sim.start,

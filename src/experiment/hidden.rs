@@ -3,11 +3,11 @@
 //! can reach. Shared by the tests and `explain-eval`; kept out of `estimate/` so the estimator
 //! never depends on the experiments built on it.
 
-use crate::estimate::explain::{
+use crate::estimate::filter::{self, AidingEpoch, FilterConfig};
+use crate::explain::{
     explain, innovation_loglik, parse_candidates, ExplainData, ExplainOptions, Explanation,
     ImuInput,
 };
-use crate::estimate::filter::{self, AidingEpoch, FilterConfig};
 use crate::io::imu::ImuData;
 use crate::model::catalog::Sensor;
 use crate::model::generated::common;

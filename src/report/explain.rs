@@ -2,13 +2,13 @@
 //! the `presets.toml` entry of the extended model. Figures and the HTML page are made by the
 //! command line (they need the plotting backend).
 
-use crate::estimate::explain::{sig3, Explanation};
+use crate::explain::{sig3, Explanation};
 use serde_json::{json, Value};
 
 /// The explain JSON (DESIGN §9 names; fields are added, never renamed). Non-finite numbers
 /// become `null`.
 pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
-    let pass = |p: &crate::estimate::explain::PassStats| {
+    let pass = |p: &crate::explain::PassStats| {
         json!({
             "model": p.model,
             "loglik": p.loglik,

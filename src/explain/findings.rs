@@ -1,0 +1,175 @@
+//! What explain returns: candidate tests, findings, the gain, the whole explanation.
+
+use super::diagnostics::PassStats;
+use serde::Serialize;
+
+/// One candidate's test in one pass.
+#[derive(Debug, Clone, Serialize)]
+pub struct CandidateTest {
+    /// Term name.
+    pub term: String,
+    /// Group (spec).
+    pub group: String,
+    /// Information J·σ_prior² (the llr a 1-σ-prior effect would produce).
+    pub information_prior_scaled: f64,
+    /// GLR estimate θ̂ (display unit) and its σ, alone (not conditioned on other candidates).
+    pub glr_estimate: f64,
+    /// σ of the GLR estimate (display unit).
+    pub glr_sigma: f64,
+    /// Log-likelihood ratio b²/J, alone.
+    pub llr: f64,
+    /// χ²₁ p-value of the llr (uncorrected).
+    pub p_value: f64,
+    /// Holm-adjusted p-value over the testable candidates of this pass.
+    pub p_holm: f64,
+    /// False when the data carry no information on the term.
+    pub testable: bool,
+    /// Baseline term whose regressor sequence is proportional to this one's (|cos| > `confound_cos`).
+    pub confounded_with: Option<String>,
+    /// Display unit.
+    pub unit: String,
+}
+
+/// A term explain adds to the model.
+#[derive(Debug, Clone, Serialize)]
+pub struct Finding {
+    /// Canonical term name.
+    pub term: String,
+    /// Estimate from the extended filter (display unit).
+    pub estimate: f64,
+    /// Its 1-σ (display unit).
+    pub sigma: f64,
+    /// Display unit.
+    pub unit: String,
+    /// Conditional log-likelihood ratio when it was selected.
+    pub llr: f64,
+    /// Holm-corrected p-value when it was selected.
+    pub p_value: f64,
+    /// Candidates it cannot be told from on these data (its equivalence class, itself excluded).
+    pub equivalent: Vec<String>,
+    /// What each equivalent term would have to be to explain the same data.
+    pub equivalent_estimates: Vec<EquivalentTerm>,
+    /// GLR estimate when selected (display unit).
+    pub glr_estimate: f64,
+    /// Its σ (display unit).
+    pub glr_sigma: f64,
+    /// Filter pass (1 = baseline) in which it was selected.
+    pub round: usize,
+    /// Baseline term it is not separable from at the regressor level, if any.
+    pub confounded_with: Option<String>,
+    /// Mean regressor over the run, in g- or deg/s-units (`regressor_unit`).
+    pub regressor_mean: f64,
+    /// Unit of `regressor_mean`, e.g. `g^2`.
+    pub regressor_unit: String,
+    /// What the term does on these data: estimate × mean regressor, in `effect_unit`.
+    pub effect: f64,
+    /// `mg` (accelerometer) or `deg/h` (gyro).
+    pub effect_unit: String,
+    /// Which excitation would separate it from its equivalents.
+    pub separate_by: Vec<String>,
+    /// Prior σ the extended filter used (display unit): the spec's (or `--prior`), widened to
+    /// 3 (|θ̂| + σ̂) when the GLR estimate θ̂ lies beyond 2 spec prior σ.
+    pub prior_sigma: f64,
+    /// True when the spec's prior σ was too small for what the data say.
+    pub prior_widened: bool,
+    /// The finding in words.
+    pub words: String,
+}
+
+/// A term the data cannot tell from a finding, and the value it would need.
+#[derive(Debug, Clone, Serialize)]
+pub struct EquivalentTerm {
+    /// Term name.
+    pub term: String,
+    /// GLR estimate in the finding's pass (display unit).
+    pub estimate: f64,
+    /// Its σ (display unit).
+    pub sigma: f64,
+    /// Display unit.
+    pub unit: String,
+    /// The estimate in units of the spec's prior σ (how plausible it is a priori).
+    pub prior_sigmas: f64,
+}
+
+/// Before/after gain of the extended model.
+#[derive(Debug, Clone, Serialize)]
+pub struct Gain {
+    /// Log-likelihood after − before.
+    pub loglik: f64,
+    /// Mean NIS before and after.
+    pub nis_mean_before: f64,
+    /// Mean NIS after.
+    pub nis_mean_after: f64,
+    /// Model error RMS (north, east combined as √(n²+e²)) before [arcsec] (with truth).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_error_rms_before: Option<f64>,
+    /// Same, after.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_error_rms_after: Option<f64>,
+}
+
+/// Everything explain found.
+#[derive(Debug, Clone, Serialize)]
+pub struct Explanation {
+    /// Baseline model states.
+    pub model: Vec<String>,
+    /// Baseline model string.
+    pub baseline_model: String,
+    /// Baseline pass.
+    pub baseline: PassStats,
+    /// Candidate tests of the baseline pass, best first.
+    pub candidates: Vec<CandidateTest>,
+    /// Terms added, in order.
+    pub findings: Vec<Finding>,
+    /// Candidates not testable on these data.
+    pub not_testable: Vec<String>,
+    /// Significant candidates not named because their value would be implausible.
+    pub implausible: Vec<Implausible>,
+    /// Terms the signatures selected but the extended filter did not confirm: (term, 2Δℓ of
+    /// the round, its BIC penalty k ln N).
+    pub unconfirmed: Vec<(String, f64, f64)>,
+    /// Candidates whose regressor is proportional on these data to a baseline term's on the
+    /// same sensor axis: (candidate, baseline term). Never named; the baseline term takes it up.
+    pub not_separable: Vec<(String, String)>,
+    /// Extended model string (baseline when nothing was found).
+    pub extended_model: String,
+    /// Extended model pass.
+    pub extended: PassStats,
+    /// Gain.
+    pub gain: Gain,
+    /// Filter passes made.
+    pub rounds: usize,
+    /// Options used.
+    pub alpha: f64,
+    /// Sentences for the terminal and the report.
+    pub summary: Vec<String>,
+    /// Normalised innovations (t, channel, ν/√S) of the baseline and extended passes, for plots.
+    #[serde(skip)]
+    pub innovations_before: Vec<(f64, String, f64)>,
+    /// Same for the extended pass.
+    #[serde(skip)]
+    pub innovations_after: Vec<(f64, String, f64)>,
+    /// Model error series (t [s], e_n, e_e [arcsec]) before and after (with truth).
+    #[serde(skip)]
+    pub model_error_before: Vec<(f64, f64, f64)>,
+    /// Same, after.
+    #[serde(skip)]
+    pub model_error_after: Vec<(f64, f64, f64)>,
+}
+
+/// A significant candidate explain does not name: its value would be implausibly large.
+#[derive(Debug, Clone, Serialize)]
+pub struct Implausible {
+    /// Term name.
+    pub term: String,
+    /// The value it would need (display unit).
+    pub estimate: f64,
+    /// σ of that value (display unit).
+    pub sigma: f64,
+    /// Display unit.
+    pub unit: String,
+    /// |estimate| in prior σ.
+    pub prior_sigmas: f64,
+    /// Conditional log-likelihood ratio.
+    pub llr: f64,
+}

@@ -1,0 +1,631 @@
+//! What a model gets wrong on measured data, which missing error term causes it, the extended
+//! model and its gain (DESIGN §8).
+//!
+//! 1. **Innovations.** The baseline filter's innovations per channel (`vel_n`, `vel_e`, `pos_n`,
+//!    `pos_e`, `pos_h`): mean NIS against its χ² band, the fraction outside the 95 % band,
+//!    Ljung–Box whiteness, mean normalised innovation and NIS per segment (segments where the
+//!    excitation level changes, else fixed windows), and with truth the predicted σ against the
+//!    actual estimation error.
+//! 2. **Signatures (Willsky–Jones GLR).** A constant parameter θ of a candidate term enters the
+//!    error dynamics as x_{k+1} = Φ_k x_k + Γ_k θ, Γ_k = dt (I + dt/2 A) a_θ with a_θ the term's
+//!    column of A at the step's regressor mean (the same second-order discretisation as Φ). Its
+//!    effect on the baseline filter's estimation error, D_{k+1} = Φ_k (I − K_k H_k) D_k + Γ_k,
+//!    reaches the innovations as G_k = H_k D_k (sequentially per scalar update, with the
+//!    filter's own gains), so ν_k = ν_k⁰ + G_k θ. All candidates ride along one filter pass
+//!    (two sparse A-products per candidate and step). Information J = Σ Gᵀ S⁻¹ G and score
+//!    b = Σ Gᵀ S⁻¹ ν give θ̂ = b/J, σ = J^−½, llr = b²/J ~ χ²₁ under H0.
+//! 3. **Selection.** Forward selection on the joint J and b (conditional llr by Schur
+//!    complements), each step tested against α / (candidates left) (Holm); candidates whose
+//!    conditional signatures correlate at |ρ| > 0.9 with the chosen one form its equivalence
+//!    class and leave the pool. The chosen terms are added and the filter is re-run with them
+//!    (the signatures are linearisations: re-testing the rest through the extended filter keeps
+//!    a large first finding from masking or inventing a second). Stops when nothing passes.
+//!    A candidate whose information is zero on these data is "not testable"; one whose regressor
+//!    sequence is proportional (|cos| > 0.999) to a baseline term's on the same sensor axis is
+//!    flagged as not separable from it.
+//! 4. **Gain.** The extended model's innovations (NIS, whiteness, log-likelihood) and, with
+//!    truth, the paper's model error e = φ̂ − φ before and after.
+
+mod diagnostics;
+mod findings;
+mod selection;
+mod signatures;
+mod words;
+
+pub use diagnostics::{innovation_loglik, ChannelStats, PassStats, SegmentStats, TruthCheck};
+pub use findings::{CandidateTest, EquivalentTerm, Explanation, Finding, Gain, Implausible};
+pub use selection::prior_sigma;
+pub use words::{separation_hint, sig3};
+
+use crate::estimate::filter::{self, channel_name, AidingEpoch, FilterConfig, FilterRun};
+use crate::io::imu::ImuData;
+use crate::io::truth::TruthRow;
+use crate::model::catalog::{Sensor, StateRef};
+use crate::model::generated::common;
+use crate::model::{did_you_mean, Model};
+use crate::nav::strapdown::NavState;
+use diagnostics::pass_stats;
+use selection::{candidate_tests, forward_select, Selected};
+use signatures::Signatures;
+use words::{finding_words, regressor_in_natural_units, summary};
+
+/// Standard gravity [m/s²] for expressing regressors in g.
+pub(crate) const G0: f64 = 9.806_65;
+/// Arcseconds per radian.
+pub(crate) const ARCSEC: f64 = 180.0 / std::f64::consts::PI * 3600.0;
+
+/// Settings of a run of explain.
+#[derive(Debug, Clone)]
+pub struct ExplainOptions {
+    /// Family-wise false-alarm level of the candidate tests (Holm-corrected).
+    pub alpha: f64,
+    /// |ρ| above which two signatures form an equivalence class.
+    pub rho_equivalent: f64,
+    /// Most filter passes (baseline + re-tests after each addition).
+    pub max_rounds: usize,
+    /// Prior-scaled information J·σ² below which a candidate is "not testable".
+    pub min_information: f64,
+    /// |cos| between a candidate's and a same-axis baseline term's regressor sequences above
+    /// which the candidate is not separable from that term (0.999: within 2.6°).
+    pub confound_cos: f64,
+    /// A candidate whose estimate would exceed this many prior σ is not named but reported as
+    /// implausible (a weakly observable signature fitting some other mismatch).
+    pub max_prior_sigmas: f64,
+    /// Prior σ of candidate terms that replace the spec's (term index, σ in SI): the sensor
+    /// class of the data (`--prior` on the command line).
+    pub candidate_sigma: Vec<(usize, f64)>,
+    /// Test only: when a candidate passes, name a pseudo-random one of the pool instead of the
+    /// best, unconfirmed (a selector naming terms at random, which the evaluation must catch).
+    pub broken_selector: bool,
+}
+
+impl Default for ExplainOptions {
+    fn default() -> Self {
+        ExplainOptions {
+            alpha: 0.01,
+            rho_equivalent: 0.9,
+            max_rounds: 4,
+            min_information: 1e-6,
+            confound_cos: 0.999,
+            max_prior_sigmas: 100.0,
+            candidate_sigma: Vec::new(),
+            broken_selector: false,
+        }
+    }
+}
+
+/// Where explain's IMU samples come from: memory (simulations), or a file read again on every
+/// pass, so that memory does not grow with the file.
+#[derive(Clone, Copy)]
+pub enum ImuInput<'a> {
+    /// Samples in memory.
+    Memory(&'a ImuData),
+    /// A file and its format description (`--imu`, `--imu-format`).
+    File {
+        /// The IMU file.
+        path: &'a std::path::Path,
+        /// Its format description, when given.
+        format: Option<&'a std::path::Path>,
+        /// GPST − IMU clock offset [s] (`--clock-offset`), when given.
+        clock_offset: Option<f64>,
+        /// Samples at or before this time [s] are skipped (a run that starts later than the
+        /// file, `--init auto`).
+        skip_through: f64,
+    },
+}
+
+impl ImuInput<'_> {
+    /// A fresh pass over the samples.
+    pub fn samples(&self) -> anyhow::Result<Box<dyn filter::Samples + '_>> {
+        Ok(match *self {
+            ImuInput::Memory(d) => Box::new(filter::SliceSamples::new(&d.samples)),
+            ImuInput::File {
+                path,
+                format,
+                clock_offset,
+                skip_through,
+            } => {
+                let mut s =
+                    crate::io::imu_stream::ImuStream::open_with(path, format, clock_offset)?.0;
+                s.skip_through(skip_through)?;
+                Box::new(s)
+            }
+        })
+    }
+}
+
+/// The data explain works on (the same as the filter's).
+#[derive(Clone, Copy)]
+pub struct ExplainData<'a> {
+    /// IMU increments, FRD.
+    pub imu: ImuInput<'a>,
+    /// Aiding epochs.
+    pub aid: &'a [AidingEpoch],
+    /// Truth, when known (simulations).
+    pub truth: Option<&'a [TruthRow]>,
+    /// Initial navigation state.
+    pub start: NavState,
+}
+
+/// Parses a candidate list: names and prefix groups (`kaq_*,kas_y,d_*`), or `None` for the
+/// default: every spec term the baseline lacks. Unknown names are an error listing the nearest.
+pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usize>, String> {
+    let in_base = |t: usize| baseline.states.contains(&StateRef::Term(t));
+    let Some(spec) = spec else {
+        return Ok((0..common::TERM_COUNT).filter(|&t| !in_base(t)).collect());
+    };
+    let mut out = Vec::new();
+    if spec.split(',').all(|s| s.trim().is_empty()) {
+        return Err(
+            "--candidates: the list is empty (give names or prefix groups, e.g. `kaq_*,d_x`, or leave the option out for every term)"
+                .into(),
+        );
+    }
+    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let matched: Vec<usize> = match item.strip_suffix('*') {
+            Some(prefix) => (0..common::TERM_COUNT)
+                .filter(|&t| common::TERMS[t].name.starts_with(prefix))
+                .collect(),
+            None => (0..common::TERM_COUNT)
+                .filter(|&t| common::TERMS[t].name == item)
+                .collect(),
+        };
+        if matched.is_empty() {
+            return Err(format!(
+                "--candidates: unknown term `{item}`{}",
+                did_you_mean(item.trim_end_matches('*'))
+            ));
+        }
+        for t in matched {
+            if !out.contains(&t) {
+                out.push(t);
+            }
+        }
+    }
+    Ok(out)
+}
+
+struct Pass {
+    run: FilterRun,
+    sig: Signatures,
+    stats: PassStats,
+}
+
+fn run_pass(
+    model: &Model,
+    cands: &[usize],
+    data: &ExplainData,
+    cfg: &FilterConfig,
+    progress: &mut dyn FnMut(f64),
+) -> anyhow::Result<Pass> {
+    let mut sig = Signatures::new(model, cands);
+    let mut samples = data.imu.samples()?;
+    let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
+    let mut io = filter::StreamIo {
+        samples: &mut *samples,
+        aiding: &mut data.aid.iter().copied(),
+        truth: truth
+            .as_mut()
+            .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
+    };
+    let run = filter::run_stream(
+        model,
+        cfg,
+        data.start,
+        &mut io,
+        progress,
+        &mut |_| {},
+        &mut sig,
+        &mut |_| Ok(()),
+        true,
+    )?;
+    run.check()
+        .map_err(|e| anyhow::anyhow!("{} pass: {e}", model.name))?;
+    let stats = pass_stats(model, &run, &sig.level, data.truth);
+    sig.dispersion = stats.nis_mean;
+    Ok(Pass { run, sig, stats })
+}
+
+/// Runs explain: baseline pass, selection, re-tests, extended pass, gain. `config_for` gives the
+/// filter configuration of a model (the same data options for all passes); `progress(pass,
+/// fraction)` reports each pass.
+pub fn explain(
+    baseline: &Model,
+    cands: &[usize],
+    data: &ExplainData,
+    config_for: &dyn Fn(&Model) -> anyhow::Result<FilterConfig>,
+    opts: &ExplainOptions,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Explanation> {
+    let cands: Vec<usize> = cands
+        .iter()
+        .copied()
+        .filter(|&t| !baseline.states.contains(&StateRef::Term(t)))
+        .collect();
+    let cfg = config_for(baseline)?;
+    let base = run_pass(baseline, &cands, data, &cfg, &mut |f| progress(1, f))?;
+    let base_stats = base.stats.clone();
+    let innovations_before = normalised(&base.run);
+    let model_error_before = model_error_series(&base.run);
+    let (tests, eligible) = candidate_tests(&base.sig, opts);
+    let not_testable: Vec<String> = tests
+        .iter()
+        .filter(|t| !t.testable)
+        .map(|t| t.term.clone())
+        .collect();
+    let not_separable: Vec<(String, String)> = tests
+        .iter()
+        .filter(|t| t.testable)
+        .filter_map(|t| Some((t.term.clone(), t.confounded_with.clone()?)))
+        .collect();
+    let ctx = Context {
+        baseline,
+        data,
+        config_for,
+        opts,
+    };
+    let r = select_and_retest(&ctx, cands, base, &eligible, progress)?;
+    let findings = complete_findings(&ctx, &r)?;
+    let mut implausible = r.implausible;
+    implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
+    // the extended pass is the last one run (the baseline itself when nothing was found)
+    let extended_stats = r.pass.stats.clone();
+    let gain = Gain {
+        loglik: extended_stats.loglik - base_stats.loglik,
+        nis_mean_before: base_stats.nis_mean,
+        nis_mean_after: extended_stats.nis_mean,
+        model_error_rms_before: base_stats.model_error_rms_arcsec.map(|e| e[0].hypot(e[1])),
+        model_error_rms_after: extended_stats
+            .model_error_rms_arcsec
+            .map(|e| e[0].hypot(e[1])),
+    };
+    let mut ranked = tests;
+    ranked.sort_by(|a, b| b.llr.total_cmp(&a.llr));
+    let mut expl = Explanation {
+        model: baseline.names.iter().map(|s| s.to_string()).collect(),
+        baseline_model: baseline.name.clone(),
+        baseline: base_stats,
+        candidates: ranked,
+        findings,
+        not_testable,
+        implausible,
+        unconfirmed: r.unconfirmed,
+        not_separable,
+        extended_model: r.model.name.clone(),
+        extended: extended_stats,
+        gain,
+        rounds: r.rounds,
+        alpha: opts.alpha,
+        summary: Vec::new(),
+        innovations_before,
+        innovations_after: normalised(&r.pass.run),
+        model_error_before,
+        model_error_after: model_error_series(&r.pass.run),
+    };
+    expl.summary = summary(&expl);
+    Ok(expl)
+}
+
+/// What every phase of one explain run shares: the baseline, the data, the filter set-up of a
+/// model and the options.
+struct Context<'a> {
+    baseline: &'a Model,
+    data: &'a ExplainData<'a>,
+    config_for: &'a dyn Fn(&Model) -> anyhow::Result<FilterConfig>,
+    opts: &'a ExplainOptions,
+}
+
+impl Context<'_> {
+    /// Filter configuration of an extended model: an added term starts from its candidate prior
+    /// (the data's sensor class), widened where the data put it beyond.
+    fn extended_config(&self, m: &Model, widened: &[(usize, f64)]) -> anyhow::Result<FilterConfig> {
+        let mut cfg = (self.config_for)(m)?;
+        for &(t, sigma) in &self.opts.candidate_sigma {
+            if !self.baseline.states.contains(&StateRef::Term(t)) {
+                if let Some(i) = m.index_of(common::TERMS[t].name) {
+                    cfg.prior_sigma[i] = sigma;
+                }
+            }
+        }
+        for &(t, sigma) in widened {
+            if let Some(i) = m.index_of(common::TERMS[t].name) {
+                cfg.prior_sigma[i] = cfg.prior_sigma[i].max(sigma);
+            }
+        }
+        Ok(cfg)
+    }
+}
+
+/// A term the selection named in a round, before the extended filter has estimated it.
+struct Named {
+    /// Term index.
+    term: usize,
+    /// Conditional llr and Holm p-value when selected.
+    llr: f64,
+    p_value: f64,
+    /// Its equivalence class with the value each member would need.
+    equivalent_estimates: Vec<EquivalentTerm>,
+    /// GLR estimate and σ when selected (display unit).
+    glr_estimate: f64,
+    glr_sigma: f64,
+    /// Filter pass (1 = baseline) in which it was selected.
+    round: usize,
+    /// Baseline term it is not separable from at the regressor level, if any.
+    confounded_with: Option<String>,
+    /// Which excitation separates it from each equivalent term.
+    separate_by: Vec<String>,
+}
+
+impl Named {
+    /// The record of selection `s` of a pass with signatures `sig` and candidate tests `tests`.
+    fn new(
+        s: &Selected,
+        sig: &Signatures,
+        tests: &[CandidateTest],
+        round: usize,
+        opts: &ExplainOptions,
+    ) -> Named {
+        let t = sig.cands[s.idx];
+        Named {
+            term: t,
+            llr: s.llr,
+            p_value: s.p,
+            equivalent_estimates: s
+                .class
+                .iter()
+                .map(|&(c, estimate, sigma)| {
+                    let tc = sig.cands[c];
+                    let info = &common::TERMS[tc];
+                    EquivalentTerm {
+                        term: info.name.to_string(),
+                        estimate,
+                        sigma,
+                        unit: info.display.to_string(),
+                        prior_sigmas: estimate * info.display_to_si / prior_sigma(tc, opts),
+                    }
+                })
+                .collect(),
+            glr_estimate: s.glr,
+            glr_sigma: s.glr_sigma,
+            round,
+            confounded_with: tests[s.idx].confounded_with.clone(),
+            separate_by: s
+                .class
+                .iter()
+                .map(|c| separation_hint(t, sig.cands[c.0]))
+                .collect(),
+        }
+    }
+}
+
+/// The outcome of the rounds of selection and re-test.
+struct Rounds {
+    /// The last model the filter confirmed (the baseline when nothing was).
+    model: Model,
+    /// Its pass.
+    pass: Pass,
+    /// Terms named, in order.
+    named: Vec<Named>,
+    /// Terms whose extended-filter prior was widened: (term, least prior σ, SI).
+    widened: Vec<(usize, f64)>,
+    /// Terms the filter did not confirm: (term, 2Δℓ, penalty).
+    unconfirmed: Vec<(String, f64, f64)>,
+    /// Significant candidates with implausible values.
+    implausible: Vec<Implausible>,
+    /// Filter passes made.
+    rounds: usize,
+}
+
+/// Selection on the baseline pass, then rounds of adding the selected terms, re-running the
+/// filter (which must confirm them by more than their BIC penalty) and selecting again.
+fn select_and_retest(
+    ctx: &Context,
+    cands: Vec<usize>,
+    base: Pass,
+    eligible: &[bool],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Rounds> {
+    let opts = ctx.opts;
+    let (mut selected_now, implausible) =
+        forward_select(&base.sig, eligible, base.run.innovations.len(), opts);
+    let mut r = Rounds {
+        model: ctx.baseline.clone(),
+        pass: base,
+        named: Vec::new(),
+        widened: Vec::new(),
+        unconfirmed: Vec::new(),
+        implausible,
+        rounds: 1,
+    };
+    let mut excluded: Vec<usize> = Vec::new(); // term indices in a class or added
+    let mut pool_terms = cands;
+    while !selected_now.is_empty() {
+        let mut added = Vec::new();
+        let (named_before, widened_before) = (r.named.len(), r.widened.len());
+        let tests_now = candidate_tests(&r.pass.sig, opts).0;
+        for s in &selected_now {
+            let named = Named::new(s, &r.pass.sig, &tests_now, r.rounds, opts);
+            let t = named.term;
+            excluded.push(t);
+            excluded.extend(s.class.iter().map(|c| r.pass.sig.cands[c.0]));
+            // the extended filter's prior must hold what the data say: a GLR estimate beyond
+            // 2 prior σ widens it to 3 (|θ̂| + σ̂)
+            let info_t = &common::TERMS[t];
+            if s.glr.abs() * info_t.display_to_si > 2.0 * prior_sigma(t, opts) {
+                r.widened
+                    .push((t, 3.0 * (s.glr.abs() + s.glr_sigma) * info_t.display_to_si));
+            }
+            r.named.push(named);
+            added.push(t);
+        }
+        let mut text = r.model.name.clone();
+        for &t in &added {
+            text.push('+');
+            text.push_str(common::TERMS[t].name);
+        }
+        let next_model = Model::parse(&text)?;
+        pool_terms.retain(|t| !excluded.contains(t));
+        let last_round = r.rounds >= opts.max_rounds;
+        let cfg = ctx.extended_config(&next_model, &r.widened)?;
+        let round = r.rounds + 1;
+        let next_pass = run_pass(
+            &next_model,
+            if last_round { &[] } else { &pool_terms },
+            ctx.data,
+            &cfg,
+            &mut |f| progress(round, f),
+        )?;
+        r.rounds = round;
+        // the filter must confirm what the signatures predicted: the added terms must raise the
+        // log-likelihood by more than their BIC penalty (k ln N); else the linearisation did not
+        // hold (or the misfit is something else) and the round is undone
+        let gain = next_pass.stats.loglik - r.pass.stats.loglik;
+        let penalty = added.len() as f64 * (next_pass.run.innovations.len().max(2) as f64).ln();
+        if 2.0 * gain <= penalty && !opts.broken_selector {
+            r.unconfirmed.extend(
+                added
+                    .iter()
+                    .map(|&t| (common::TERMS[t].name.to_string(), 2.0 * gain, penalty)),
+            );
+            r.named.truncate(named_before);
+            r.widened.truncate(widened_before);
+            break;
+        }
+        r.model = next_model;
+        r.pass = next_pass;
+        if last_round {
+            break;
+        }
+        let (_, eligible_now) = candidate_tests(&r.pass.sig, opts);
+        let (sel, imp) = forward_select(
+            &r.pass.sig,
+            &eligible_now,
+            r.pass.run.innovations.len(),
+            opts,
+        );
+        selected_now = sel;
+        for i in imp {
+            if !r.implausible.iter().any(|x| x.term == i.term) {
+                r.implausible.push(i);
+            }
+        }
+    }
+    Ok(r)
+}
+
+/// The findings of the rounds: each named term with the extended filter's estimate, its prior,
+/// its mean regressor and effect on these data, and the words.
+fn complete_findings(ctx: &Context, r: &Rounds) -> anyhow::Result<Vec<Finding>> {
+    let terms: Vec<usize> = r.named.iter().map(|n| n.term).collect();
+    let means = if terms.is_empty() {
+        Vec::new()
+    } else {
+        regressor_means(ctx.data, &terms)?
+    };
+    let last = r.pass.run.records.last();
+    let used_priors = ctx.extended_config(&r.model, &r.widened)?.prior_sigma;
+    let mut out = Vec::new();
+    for (n, &c) in r.named.iter().zip(&means) {
+        let t = n.term;
+        let info = &common::TERMS[t];
+        let to_display = 1.0 / info.display_to_si;
+        let (mut estimate, mut sigma, mut prior, mut widened) = (0.0, 0.0, 0.0, false);
+        if let (Some(i), Some(rec)) = (r.model.index_of(info.name), last) {
+            estimate = rec.x[i] * to_display;
+            sigma = rec.sigma[i] * to_display;
+            prior = used_priors[i] * to_display;
+            widened = used_priors[i] > prior_sigma(t, ctx.opts);
+        }
+        let (regressor_mean, regressor_unit) = regressor_in_natural_units(info.regressor, c);
+        let effect_si = estimate / to_display * c;
+        let (effect, effect_unit) = match info.sensor {
+            Sensor::Accel => (effect_si / G0 * 1e3, "mg"),
+            Sensor::Gyro => (effect_si * 180.0 / std::f64::consts::PI * 3600.0, "deg/h"),
+        };
+        let mut f = Finding {
+            term: info.name.to_string(),
+            estimate,
+            sigma,
+            unit: info.display.to_string(),
+            llr: n.llr,
+            p_value: n.p_value,
+            equivalent: n
+                .equivalent_estimates
+                .iter()
+                .map(|e| e.term.clone())
+                .collect(),
+            equivalent_estimates: n.equivalent_estimates.clone(),
+            glr_estimate: n.glr_estimate,
+            glr_sigma: n.glr_sigma,
+            round: n.round,
+            confounded_with: n.confounded_with.clone(),
+            regressor_mean,
+            regressor_unit,
+            effect,
+            effect_unit: effect_unit.into(),
+            separate_by: n.separate_by.clone(),
+            prior_sigma: prior,
+            prior_widened: widened,
+            words: String::new(),
+        };
+        f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+        out.push(f);
+    }
+    Ok(out)
+}
+
+/// Mean over the run of each term's regressor (SI), in one pass over the IMU samples (the
+/// extended pass has no candidates, so it is computed from the samples directly).
+fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f64>> {
+    let mut prev = data.start.t;
+    let mut sums = vec![0.0; terms.len()];
+    let mut c = 0usize;
+    let mut samples = data.imu.samples()?;
+    while let Some(smp) = samples.next_sample()? {
+        let dt = smp.t - prev;
+        prev = smp.t;
+        if dt > 0.0 {
+            let (f, w) = (smp.dv / dt, smp.dtheta / dt);
+            for (sum, &t) in sums.iter_mut().zip(terms) {
+                *sum += common::regressor_value(common::TERMS[t].regressor, &f, &w);
+            }
+            c += 1;
+        }
+    }
+    Ok(sums.into_iter().map(|s| s / c.max(1) as f64).collect())
+}
+
+fn normalised(run: &FilterRun) -> Vec<(f64, String, f64)> {
+    run.innovations
+        .iter()
+        .map(|i| (i.t, channel_name(i.meas, i.component), i.nu / i.s.sqrt()))
+        .collect()
+}
+
+fn model_error_series(run: &FilterRun) -> Vec<(f64, f64, f64)> {
+    run.records
+        .iter()
+        .filter_map(|r| {
+            r.phi_true.map(|pt| {
+                (
+                    r.t,
+                    (r.phi_est.x - pt.x) * ARCSEC,
+                    (r.phi_est.y - pt.y) * ARCSEC,
+                )
+            })
+        })
+        .collect()
+}
+
+/// Information (SI, 1/θ²) the signature of term `term` carries through `model`'s filter on
+/// these data: λ = θ² I is the noncentrality of its test (independent of θ and of the data's
+/// values, so it can be computed before the term is put into the data).
+pub fn signature_information(
+    model: &Model,
+    term: usize,
+    data: &ExplainData,
+    cfg: &FilterConfig,
+) -> anyhow::Result<f64> {
+    let pass = run_pass(model, &[term], data, cfg, &mut |_| {})?;
+    Ok(pass.sig.info[0])
+}

@@ -1,0 +1,417 @@
+//! Selection on a pass's joint information: conditional llr (Schur complements), Holm, equivalence classes.
+
+use super::findings::{CandidateTest, Implausible};
+use super::signatures::Signatures;
+use super::ExplainOptions;
+use crate::estimate::stats;
+use crate::model::generated::common;
+use nalgebra::DMatrix;
+
+/// Prior-scaled quantities of a pass: J' = D J D, b' = D b with D = diag(σ_prior).
+pub(super) fn scaled(
+    sig: &Signatures,
+    opts: &ExplainOptions,
+) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
+    let m = sig.cands.len();
+    let sd: Vec<f64> = sig
+        .cands
+        .iter()
+        .map(|&t| prior_sigma(t, opts).max(f64::MIN_POSITIVE))
+        .collect();
+    // quasi-likelihood: innovations φ times larger than S predicts scale the information and
+    // score by 1/φ, so an inconsistent baseline does not make every candidate significant
+    let phi = sig.dispersion.max(1.0);
+    let j = DMatrix::from_fn(m, m, |a, b| sig.info[a * m + b] * sd[a] * sd[b] / phi);
+    let b = (0..m).map(|a| sig.score[a] * sd[a] / phi).collect();
+    (j, b, sd)
+}
+
+/// Prior σ of term `t` (SI): the override in `opts`, else the spec's.
+pub fn prior_sigma(t: usize, opts: &ExplainOptions) -> f64 {
+    opts.candidate_sigma
+        .iter()
+        .find(|x| x.0 == t)
+        .map(|x| x.1)
+        .unwrap_or(common::TERMS[t].sigma)
+}
+
+/// Conditional information, score and correlation of candidate `c` given the set `s`.
+pub(super) fn conditional(j: &DMatrix<f64>, b: &[f64], s: &[usize], c: usize) -> (f64, f64) {
+    if s.is_empty() {
+        return (j[(c, c)], b[c]);
+    }
+    let jss = DMatrix::from_fn(s.len(), s.len(), |x, y| j[(s[x], s[y])]);
+    let Some(inv) = jss.clone().try_inverse() else {
+        return (0.0, 0.0);
+    };
+    let jcs = DMatrix::from_fn(1, s.len(), |_, y| j[(c, s[y])]);
+    let bs = DMatrix::from_fn(s.len(), 1, |x, _| b[s[x]]);
+    let i_c = j[(c, c)] - (&jcs * &inv * jcs.transpose())[(0, 0)];
+    let b_c = b[c] - (&jcs * &inv * bs)[(0, 0)];
+    (i_c, b_c)
+}
+
+pub(super) fn conditional_rho(j: &DMatrix<f64>, s: &[usize], a: usize, c: usize) -> f64 {
+    let cross = if s.is_empty() {
+        j[(a, c)]
+    } else {
+        let jss = DMatrix::from_fn(s.len(), s.len(), |x, y| j[(s[x], s[y])]);
+        match jss.try_inverse() {
+            Some(inv) => {
+                let ja = DMatrix::from_fn(1, s.len(), |_, y| j[(a, s[y])]);
+                let jc = DMatrix::from_fn(s.len(), 1, |x, _| j[(s[x], c)]);
+                j[(a, c)] - (&ja * &inv * &jc)[(0, 0)]
+            }
+            None => return 0.0,
+        }
+    };
+    let (ia, _) = conditional(j, &vec![0.0; j.nrows()], s, a);
+    let (ic, _) = conditional(j, &vec![0.0; j.nrows()], s, c);
+    if ia <= 0.0 || ic <= 0.0 {
+        return 0.0;
+    }
+    cross / (ia * ic).sqrt()
+}
+
+/// A candidate the selection names, with its equivalence class.
+pub(super) struct Selected {
+    pub(super) idx: usize,
+    pub(super) llr: f64,
+    pub(super) p: f64,
+    pub(super) glr: f64,
+    pub(super) glr_sigma: f64,
+    /// The other members: (candidate index, conditional GLR estimate, σ, display unit).
+    pub(super) class: Vec<(usize, f64, f64)>,
+}
+
+/// Forward selection on one pass's joint information (prior-scaled) over the `eligible`
+/// candidates, with `innovations` scalar innovations in the pass.
+///
+/// Each step takes the candidate with the largest conditional llr; it must pass Holm's test at
+/// α over the candidates left *and* lower the BIC (llr > ln N). Candidates join its equivalence
+/// class when their conditional signatures correlate at |ρ| > `rho_equivalent` *and* the data
+/// do not prefer the best one by more than the α-level χ²₁ quantile (with much information,
+/// |ρ| = 0.97 can still separate two terms). Within a class the data cannot choose, so the
+/// member the spec's priors find most plausible (fewest prior σ) is named and the rest listed
+/// with the value each would need.
+pub(super) fn forward_select(
+    sig: &Signatures,
+    eligible: &[bool],
+    innovations: usize,
+    opts: &ExplainOptions,
+) -> (Vec<Selected>, Vec<Implausible>) {
+    let (j, b, sd) = scaled(sig, opts);
+    select(&j, &b, &sd, &sig.cands, eligible, innovations, opts)
+}
+
+/// [`forward_select`] on prior-scaled information `j`, score `b` and prior σ `sd` of the
+/// candidate terms `cands` (term indices).
+fn select(
+    j: &DMatrix<f64>,
+    b: &[f64],
+    sd: &[f64],
+    cands: &[usize],
+    eligible: &[bool],
+    innovations: usize,
+    opts: &ExplainOptions,
+) -> (Vec<Selected>, Vec<Implausible>) {
+    let m = cands.len();
+    let margin = stats::chi2_isf(opts.alpha, 1.0);
+    let bic = (innovations.max(2) as f64).ln();
+    let mut pool: Vec<usize> = (0..m).filter(|&c| eligible[c]).collect();
+    let mut chosen: Vec<usize> = Vec::new();
+    let mut out = Vec::new();
+    let mut implausible = Vec::new();
+    while !pool.is_empty() {
+        // (llr, information, score) of c given the chosen set
+        let cond = |c: usize, chosen: &[usize]| -> Option<(f64, f64, f64)> {
+            let (ic, bc) = conditional(j, b, chosen, c);
+            (ic > 1e-12 * j[(c, c)].max(f64::MIN_POSITIVE)).then(|| (bc * bc / ic, ic, bc))
+        };
+        let mut best: Option<(usize, f64)> = None;
+        for &c in &pool {
+            if let Some((llr, _, _)) = cond(c, &chosen) {
+                if best.is_none_or(|x| llr > x.1) {
+                    best = Some((c, llr));
+                }
+            }
+        }
+        let Some((c, llr)) = best else {
+            break;
+        };
+        let p = stats::chi2_sf(llr, 1.0);
+        if p * pool.len() as f64 > opts.alpha || llr <= bic {
+            break;
+        }
+        let (c, llr) = if opts.broken_selector {
+            let k = (chosen.len() * 7 + pool.len() * 13 + 5) % pool.len();
+            (pool[k], cond(pool[k], &chosen).map(|x| x.0).unwrap_or(llr))
+        } else {
+            (c, llr)
+        };
+        let mut members: Vec<(usize, f64, f64)> = vec![]; // (cand, θ' prior-scaled, info)
+        for &a in &pool {
+            let equivalent = a == c
+                || (conditional_rho(j, &chosen, a, c).abs() > opts.rho_equivalent
+                    && cond(a, &chosen).is_some_and(|(la, _, _)| llr - la < margin));
+            if equivalent {
+                if let Some((_, ia, ba)) = cond(a, &chosen) {
+                    members.push((a, ba / ia, ia));
+                }
+            }
+        }
+        // name the most plausible member: the fewest prior σ
+        members.sort_by(|x, y| x.1.abs().total_cmp(&y.1.abs()));
+        let (named, theta, info) = members[0];
+        let display = |a: usize, th: f64, ia: f64| {
+            let to_display = sd[a] / common::TERMS[cands[a]].display_to_si;
+            (th * to_display, to_display / ia.sqrt())
+        };
+        let (glr, glr_sigma) = display(named, theta, info);
+        let named_llr = cond(named, &chosen).map(|x| x.0).unwrap_or(llr);
+        if theta.abs() > opts.max_prior_sigmas {
+            // even the most plausible member would need an implausible value: not named
+            for &(a, th, ia) in &members {
+                let (e, s) = display(a, th, ia);
+                implausible.push(Implausible {
+                    term: common::TERMS[cands[a]].name.to_string(),
+                    estimate: e,
+                    sigma: s,
+                    unit: common::TERMS[cands[a]].display.to_string(),
+                    prior_sigmas: th.abs(),
+                    llr: cond(a, &chosen).map(|x| x.0).unwrap_or(0.0),
+                });
+            }
+            pool.retain(|a| !members.iter().any(|m| m.0 == *a));
+            continue;
+        }
+        out.push(Selected {
+            idx: named,
+            llr: named_llr,
+            p: (stats::chi2_sf(named_llr, 1.0) * pool.len() as f64).min(1.0),
+            glr,
+            glr_sigma,
+            class: members[1..]
+                .iter()
+                .map(|&(a, th, ia)| {
+                    let (e, s) = display(a, th, ia);
+                    (a, e, s)
+                })
+                .collect(),
+        });
+        chosen.push(named);
+        pool.retain(|a| !members.iter().any(|m| m.0 == *a));
+    }
+    (out, implausible)
+}
+
+/// Every candidate's test alone in this pass, and which may be named: testable and not
+/// proportional at the regressor level to a baseline term of the same sensor axis (that term's
+/// state already absorbs it; what is left of its signature is the filter's transient).
+pub(super) fn candidate_tests(
+    sig: &Signatures,
+    opts: &ExplainOptions,
+) -> (Vec<CandidateTest>, Vec<bool>) {
+    let (j, b, sd) = scaled(sig, opts);
+    let m = sig.cands.len();
+    let nb = sig.base_terms.len();
+    // testability is a property of the data's excitation, not of the dispersion
+    let phi = sig.dispersion.max(1.0);
+    let testable: Vec<bool> = (0..m)
+        .map(|c| j[(c, c)] * phi > opts.min_information)
+        .collect();
+    let p: Vec<f64> = (0..m)
+        .map(|c| {
+            if testable[c] {
+                stats::chi2_sf(b[c] * b[c] / j[(c, c)], 1.0)
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let tp: Vec<f64> = (0..m).filter(|&c| testable[c]).map(|c| p[c]).collect();
+    let adj = stats::holm(&tp);
+    let mut k = 0;
+    let mut tests = Vec::new();
+    for c in 0..m {
+        let term = &common::TERMS[sig.cands[c]];
+        let to_display = 1.0 / term.display_to_si;
+        let p_holm = if testable[c] {
+            k += 1;
+            adj[k - 1]
+        } else {
+            1.0
+        };
+        let confounded_with = (0..nb)
+            .filter(|&q| sig.cross[c * nb + q] != 0.0)
+            .map(|q| {
+                let cos = sig.cross[c * nb + q] / (sig.cand_sq[c] * sig.base_sq[q]).sqrt();
+                (q, cos)
+            })
+            .filter(|(_, cos)| cos.abs() > opts.confound_cos)
+            .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
+            .map(|(q, _)| common::TERMS[sig.base_terms[q].1].name.to_string());
+        let jcc = j[(c, c)];
+        tests.push(CandidateTest {
+            term: term.name.to_string(),
+            group: term.group.to_string(),
+            information_prior_scaled: jcc,
+            glr_estimate: if testable[c] {
+                b[c] / jcc * sd[c] * to_display
+            } else {
+                0.0
+            },
+            glr_sigma: if testable[c] {
+                sd[c] / jcc.sqrt() * to_display
+            } else {
+                f64::INFINITY
+            },
+            llr: if testable[c] { b[c] * b[c] / jcc } else { 0.0 },
+            p_value: p[c],
+            p_holm,
+            testable: testable[c],
+            confounded_with,
+            unit: term.display.to_string(),
+        });
+    }
+    let eligible = tests
+        .iter()
+        .map(|t| t.testable && t.confounded_with.is_none())
+        .collect();
+    (tests, eligible)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// llr of the joint fit over the set `s`: bᵀ J⁻¹ b restricted to `s`.
+    fn joint_llr(j: &DMatrix<f64>, b: &[f64], s: &[usize]) -> f64 {
+        if s.is_empty() {
+            return 0.0;
+        }
+        let jss = DMatrix::from_fn(s.len(), s.len(), |x, y| j[(s[x], s[y])]);
+        let bs = DMatrix::from_fn(s.len(), 1, |x, _| b[s[x]]);
+        (bs.transpose() * jss.try_inverse().unwrap() * &bs)[(0, 0)]
+    }
+
+    fn spd(m: usize, seed: u64) -> DMatrix<f64> {
+        let mut x = seed;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let a = DMatrix::from_fn(m, m + 2, |_, _| next());
+        &a * a.transpose() + DMatrix::identity(m, m) * 0.1
+    }
+
+    #[test]
+    fn conditional_llr_is_the_joint_fits_increase() {
+        let j = spd(5, 7);
+        let b = [1.3, -0.4, 2.2, 0.7, -1.9];
+        for (s, c) in [
+            (vec![], 2),
+            (vec![0], 2),
+            (vec![1, 3], 4),
+            (vec![0, 2, 4], 1),
+        ] {
+            let (ic, bc) = conditional(&j, &b, &s, c);
+            let mut sc = s.clone();
+            sc.push(c);
+            let gain = joint_llr(&j, &b, &sc) - joint_llr(&j, &b, &s);
+            assert!(
+                (bc * bc / ic - gain).abs() < 1e-9 * gain.abs().max(1.0),
+                "{s:?} {c}"
+            );
+        }
+    }
+
+    #[test]
+    fn conditional_rho_of_a_candidate_with_itself_is_one() {
+        let j = spd(4, 3);
+        assert!((conditional_rho(&j, &[1], 2, 2) - 1.0).abs() < 1e-12);
+        let r = conditional_rho(&j, &[0], 2, 3);
+        assert!(r.abs() < 1.0);
+    }
+
+    fn opts() -> ExplainOptions {
+        ExplainOptions::default()
+    }
+
+    #[test]
+    fn a_strong_candidate_is_named_and_weak_independent_ones_are_not() {
+        let j = DMatrix::identity(3, 3) * 100.0;
+        // θ' = b/J: 0.5 prior σ (llr 25), 0.01 (llr 0.01), 0.02 (llr 0.04)
+        let b = [50.0, 1.0, 2.0];
+        let (sel, imp) = select(&j, &b, &[1.0; 3], &[0, 1, 2], &[true; 3], 1000, &opts());
+        assert!(imp.is_empty());
+        assert_eq!(sel.len(), 1);
+        assert_eq!(sel[0].idx, 0);
+        assert!((sel[0].llr - 25.0).abs() < 1e-9);
+        assert!(sel[0].class.is_empty());
+        // Holm: p × (candidates in the pool)
+        assert!((sel[0].p - 3.0 * stats::chi2_sf(25.0, 1.0)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn holm_and_bic_stop_the_selection() {
+        let j = DMatrix::identity(4, 4);
+        // llr 9: p = 0.0027 < α = 0.01 alone, but × 4 candidates = 0.0108 > α
+        let b = [3.0, 0.0, 0.0, 0.0];
+        let (sel, _) = select(&j, &b, &[1.0; 4], &[0, 1, 2, 3], &[true; 4], 10, &opts());
+        assert!(sel.is_empty());
+        let (sel, _) = select(
+            &j,
+            &b,
+            &[1.0; 4],
+            &[0, 1, 2, 3],
+            &[true, false, false, false],
+            10,
+            &opts(),
+        );
+        assert_eq!(sel.len(), 1, "alone it passes α");
+        // with 10⁵ innovations the BIC asks llr > ln N = 11.5
+        let (sel, _) = select(
+            &j,
+            &b,
+            &[1.0; 4],
+            &[0, 1, 2, 3],
+            &[true, false, false, false],
+            100_000,
+            &opts(),
+        );
+        assert!(sel.is_empty());
+    }
+
+    #[test]
+    fn equivalent_candidates_form_a_class_named_by_the_fewest_prior_sigmas() {
+        // two signatures at ρ = 0.999; the second needs twice the prior σ of the first
+        let rho: f64 = 0.999;
+        let (i0, i1): (f64, f64) = (400.0, 100.0);
+        let j = DMatrix::from_row_slice(
+            2,
+            2,
+            &[i0, rho * (i0 * i1).sqrt(), rho * (i0 * i1).sqrt(), i1],
+        );
+        let theta0 = 0.5;
+        let b = [i0 * theta0, rho * (i0 * i1).sqrt() * theta0];
+        let (sel, _) = select(&j, &b, &[1.0; 2], &[0, 1], &[true; 2], 1000, &opts());
+        assert_eq!(sel.len(), 1);
+        assert_eq!(sel[0].idx, 0);
+        assert_eq!(sel[0].class.len(), 1);
+        assert_eq!(sel[0].class[0].0, 1);
+        assert!(sel[0].class[0].1.abs() > sel[0].glr.abs());
+    }
+
+    #[test]
+    fn a_value_beyond_the_plausible_prior_sigmas_is_not_named() {
+        let j = DMatrix::identity(1, 1) * 1e-2;
+        let b = [10.0]; // θ' = 1000 prior σ, llr 10⁴
+        let (sel, imp) = select(&j, &b, &[1.0], &[0], &[true], 1000, &opts());
+        assert!(sel.is_empty());
+        assert_eq!(imp.len(), 1);
+        assert!((imp[0].prior_sigmas - 1000.0).abs() < 1e-9);
+    }
+}

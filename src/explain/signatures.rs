@@ -1,0 +1,243 @@
+//! Candidate signatures (Willsky–Jones GLR) riding along one filter pass.
+
+use crate::estimate::filter::Observer;
+use crate::model::catalog::StateRef;
+use crate::model::generated::common;
+use crate::model::{Model, RegressorAccumulator};
+use crate::nav::nav_point::NavPoint;
+use nalgebra::Vector3;
+
+/// Candidate signatures riding along one filter pass.
+pub(super) struct Signatures {
+    pub(super) n: usize,
+    /// Candidate term indices.
+    pub(super) cands: Vec<usize>,
+    /// Baseline instrument terms: (model index, term index).
+    pub(super) base_terms: Vec<(usize, usize)>,
+    /// Accumulator of the candidates' and baseline terms' regressors (ids below).
+    pub(super) acc: RegressorAccumulator,
+    pub(super) r_mean: Vec<f64>,
+    /// D, state-major: D[i·m + c] is state i of candidate c's signature (the inner loops run
+    /// over the candidates, so one A entry serves all of them).
+    pub(super) d: Vec<f64>,
+    pub(super) w: Vec<f64>,
+    pub(super) aw: Vec<f64>,
+    pub(super) g: Vec<f64>,
+    /// Position in `r_mean` of each candidate's and each baseline term's regressor.
+    pub(super) cand_r: Vec<usize>,
+    pub(super) base_r_idx: Vec<usize>,
+    /// Baseline terms' regressor means of the current step.
+    pub(super) base_r: Vec<f64>,
+    /// For each candidate, (model index, row of its term column) of the rows it reaches.
+    pub(super) cand_rows: Vec<Vec<(usize, usize)>>,
+    /// Mean NIS of the pass (the dispersion φ of the quasi-likelihood; 1 when consistent).
+    pub(super) dispersion: f64,
+    /// Information J (m × m) and score b (m).
+    pub(super) info: Vec<f64>,
+    pub(super) score: Vec<f64>,
+    /// Σ over steps of each candidate's regressor mean, and steps counted.
+    pub(super) reg_sum: Vec<f64>,
+    pub(super) steps: usize,
+    /// Σ r_c r_b, Σ r_c², Σ r_b² over steps for candidates vs same-axis baseline terms.
+    pub(super) cross: Vec<f64>,
+    pub(super) cand_sq: Vec<f64>,
+    pub(super) base_sq: Vec<f64>,
+    /// Excitation level per step: (t [s], rms of the specific force about its step mean [m/s²]).
+    pub(super) level: Vec<(f64, f64)>,
+    pub(super) f_sum: Vector3<f64>,
+    pub(super) f2_sum: f64,
+    pub(super) count: usize,
+}
+
+pub(super) fn reg_id(t: usize) -> usize {
+    common::TERMS[t].regressor
+}
+
+impl Signatures {
+    pub(super) fn new(model: &Model, cands: &[usize]) -> Signatures {
+        let n = model.n();
+        let base_terms: Vec<(usize, usize)> = model
+            .states
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| match *s {
+                StateRef::Term(t) => Some((i, t)),
+                StateRef::Nav(_) => None,
+            })
+            .collect();
+        let mut r_ids = Vec::new();
+        for t in cands.iter().copied().chain(base_terms.iter().map(|b| b.1)) {
+            if !r_ids.contains(&reg_id(t)) {
+                r_ids.push(reg_id(t));
+            }
+        }
+        let mut nav_pos = [None; common::NAV_COUNT];
+        for (i, s) in model.states.iter().enumerate() {
+            if let StateRef::Nav(k) = *s {
+                nav_pos[k] = Some(i);
+            }
+        }
+        let m = cands.len();
+        let nb = base_terms.len();
+        let pos = |t: usize| r_ids.iter().position(|&x| x == reg_id(t)).unwrap_or(0);
+        let cand_r = cands.iter().map(|&t| pos(t)).collect();
+        let base_r_idx = base_terms.iter().map(|b| pos(b.1)).collect();
+        let cand_rows = cands
+            .iter()
+            .map(|&t| {
+                common::TERM_ROWS[t]
+                    .iter()
+                    .filter_map(|&row| nav_pos[row].map(|i| (i, row)))
+                    .collect()
+            })
+            .collect();
+        Signatures {
+            n,
+            cands: cands.to_vec(),
+            base_terms,
+            acc: RegressorAccumulator::new(r_ids.clone()),
+            r_mean: vec![0.0; r_ids.len()],
+            d: vec![0.0; m * n],
+            w: vec![0.0; m * n],
+            aw: vec![0.0; m * n],
+            g: vec![0.0; m],
+            cand_r,
+            base_r_idx,
+            base_r: vec![0.0; nb],
+            cand_rows,
+            dispersion: 1.0,
+            info: vec![0.0; m * m],
+            score: vec![0.0; m],
+            reg_sum: vec![0.0; m],
+            steps: 0,
+            cross: vec![0.0; m * nb],
+            cand_sq: vec![0.0; m],
+            base_sq: vec![0.0; nb],
+            level: Vec::new(),
+            f_sum: Vector3::zeros(),
+            f2_sum: 0.0,
+            count: 0,
+        }
+    }
+}
+
+/// out = A · v for m column vectors stored state-major (v[j·m + c]), over A's pattern.
+pub(super) fn sparse_mul_block(
+    a: &[f64],
+    n: usize,
+    m: usize,
+    pattern: &[(usize, usize)],
+    v: &[f64],
+    out: &mut [f64],
+) {
+    out.iter_mut().for_each(|x| *x = 0.0);
+    for &(i, j) in pattern {
+        let aij = a[i * n + j];
+        let (src, dst) = (&v[j * m..(j + 1) * m], &mut out[i * m..(i + 1) * m]);
+        for (o, x) in dst.iter_mut().zip(src) {
+            *o += aij * x;
+        }
+    }
+}
+
+impl Observer for Signatures {
+    fn sample(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
+        self.acc.add(f, w);
+        self.f_sum += f;
+        self.f2_sum += f.norm_squared();
+        self.count += 1;
+    }
+
+    fn step(&mut self, t: f64, dt: f64, np: &NavPoint, a: &[f64], pattern: &[(usize, usize)]) {
+        let (n, m) = (self.n, self.cands.len());
+        self.acc.mean_into(&mut self.r_mean);
+        self.acc.reset();
+        if self.count > 0 {
+            let c = self.count as f64;
+            let mean = self.f_sum / c;
+            let var = (self.f2_sum / c - mean.norm_squared()).max(0.0);
+            self.level.push((t, var.sqrt()));
+        }
+        self.f_sum = Vector3::zeros();
+        self.f2_sum = 0.0;
+        self.count = 0;
+        self.steps += 1;
+        let nb = self.base_terms.len();
+        for k in 0..nb {
+            let r = self.r_mean[self.base_r_idx[k]];
+            self.base_r[k] = r;
+            self.base_sq[k] += r * r;
+        }
+        if m == 0 {
+            return;
+        }
+        // W = A D + [a_c], then D ← D + dt (W + dt/2 A W)
+        sparse_mul_block(a, n, m, pattern, &self.d, &mut self.w);
+        for c in 0..m {
+            let t_c = self.cands[c];
+            let rv = self.r_mean[self.cand_r[c]];
+            self.reg_sum[c] += rv;
+            self.cand_sq[c] += rv * rv;
+            let info = &common::TERMS[t_c];
+            for (k, &(_, bt)) in self.base_terms.iter().enumerate() {
+                let bi = &common::TERMS[bt];
+                if bi.sensor == info.sensor && bi.axis == info.axis {
+                    self.cross[c * nb + k] += rv * self.base_r[k];
+                }
+            }
+            let mut col = [0.0; common::NAV_COUNT];
+            common::term_column(t_c, np, rv, &mut col);
+            for &(i, row) in &self.cand_rows[c] {
+                self.w[i * m + c] += col[row];
+            }
+        }
+        sparse_mul_block(a, n, m, pattern, &self.w, &mut self.aw);
+        let h = 0.5 * dt;
+        for ((di, wi), awi) in self.d.iter_mut().zip(&self.w).zip(&self.aw) {
+            *di += dt * (wi + h * awi);
+        }
+    }
+
+    fn scalar_update(
+        &mut self,
+        _t: f64,
+        _meas: &'static str,
+        _component: usize,
+        h: &[f64],
+        k: &[f64],
+        nu: f64,
+        s: f64,
+    ) {
+        let (n, m) = (self.n, self.cands.len());
+        if m == 0 {
+            return;
+        }
+        // G = H D (per candidate), then D ← D − K G
+        self.g.iter_mut().for_each(|x| *x = 0.0);
+        for (j, &hj) in h.iter().enumerate().take(n) {
+            if hj != 0.0 {
+                for (g, d) in self.g.iter_mut().zip(&self.d[j * m..(j + 1) * m]) {
+                    *g += hj * d;
+                }
+            }
+        }
+        for (i, &ki) in k.iter().enumerate().take(n) {
+            if ki != 0.0 {
+                for (d, g) in self.d[i * m..(i + 1) * m].iter_mut().zip(&self.g) {
+                    *d -= ki * g;
+                }
+            }
+        }
+        let inv_s = 1.0 / s;
+        for a in 0..m {
+            let ga = self.g[a] * inv_s;
+            if ga == 0.0 {
+                continue;
+            }
+            self.score[a] += ga * nu;
+            for b in 0..m {
+                self.info[a * m + b] += ga * self.g[b];
+            }
+        }
+    }
+}

@@ -1,0 +1,382 @@
+//! Explain in words: regressor degree and signals, separation hints, findings, the summary.
+
+use super::findings::{Explanation, Finding};
+use super::G0;
+use crate::model::catalog::Sensor;
+use crate::model::generated::common;
+use nalgebra::Vector3;
+
+/// Homogeneous degree of a regressor in the IMU signals (1 for f_x, |f_x|; 2 for f_x², f_x f_y,
+/// ω²; 0 for a constant), found numerically.
+pub(super) fn regressor_degree(id: usize) -> i32 {
+    let f = Vector3::new(3.1, -2.3, 1.7);
+    let w = Vector3::new(0.7, -0.4, 0.9);
+    let r1 = common::regressor_value(id, &f, &w);
+    let r2 = common::regressor_value(id, &(f * 2.0), &(w * 2.0));
+    if r1 == 0.0 || r2 == 0.0 {
+        return 0;
+    }
+    (r2 / r1).abs().log2().round() as i32
+}
+
+/// Which body signals a regressor depends on (`f.x` … `w.z`).
+pub(super) fn regressor_signals(id: usize) -> Vec<&'static str> {
+    let names = ["f.x", "f.y", "f.z", "w.x", "w.y", "w.z"];
+    let base_f = Vector3::new(3.1, -2.3, 1.7);
+    let base_w = Vector3::new(0.7, -0.4, 0.9);
+    let r0 = common::regressor_value(id, &base_f, &base_w);
+    (0..6)
+        .filter(|&k| {
+            let (mut f, mut w) = (base_f, base_w);
+            if k < 3 {
+                f[k] *= 1.37;
+            } else {
+                w[k - 3] *= 1.37;
+            }
+            (common::regressor_value(id, &f, &w) - r0).abs() > 1e-12 * r0.abs().max(1.0)
+        })
+        .map(|k| names[k])
+        .collect()
+}
+
+/// What excitation would separate two terms, from their sensors and regressors.
+pub fn separation_hint(a: usize, b: usize) -> String {
+    let (ta, tb) = (&common::TERMS[a], &common::TERMS[b]);
+    let (da, db) = (
+        regressor_degree(ta.regressor),
+        regressor_degree(tb.regressor),
+    );
+    let (sa, sb) = (
+        regressor_signals(ta.regressor),
+        regressor_signals(tb.regressor),
+    );
+    let ra = common::REGRESSORS[ta.regressor];
+    let rb = common::REGRESSORS[tb.regressor];
+    if ta.sensor != tb.sensor {
+        return format!(
+            "a {} term and a {} term: a longer run or a re-orientation separates them (a gyro error grows the tilt ∝ t after onset, an accelerometer error the velocity)",
+            sensor_word(ta.sensor),
+            sensor_word(tb.sensor)
+        );
+    }
+    if sa != sb {
+        let only = |x: &[&str], y: &[&str]| -> Vec<String> {
+            x.iter()
+                .filter(|s| !y.contains(s))
+                .map(|s| s.to_string())
+                .collect()
+        };
+        let mut diff = only(&sa, &sb);
+        diff.extend(only(&sb, &sa));
+        return format!(
+            "an excitation that changes {} while the other signals stay (a re-orientation, or vibration along that axis) separates {} ({ra}) from {} ({rb})",
+            diff.join(" and "),
+            ta.name,
+            tb.name
+        );
+    }
+    if da != db {
+        return format!(
+            "two vibration amplitudes separate {} (∝ A^{da}, regressor {ra}) from {} (∝ A^{db}, regressor {rb})",
+            ta.name, tb.name
+        );
+    }
+    if ta.axis != tb.axis {
+        return format!(
+            "a re-orientation (another attitude) separates the {} and {} axes",
+            ["x", "y", "z"][ta.axis],
+            ["x", "y", "z"][tb.axis]
+        );
+    }
+    format!(
+        "an excitation where {ra} and {rb} are not proportional (e.g. a sign change: attitude or vibration phase)"
+    )
+}
+
+pub(super) fn sensor_word(s: Sensor) -> &'static str {
+    match s {
+        Sensor::Gyro => "gyro",
+        Sensor::Accel => "accelerometer",
+    }
+}
+
+/// Mean regressor in natural units: g^k (accelerations) or (deg/s)^k (rates); with its unit.
+pub(super) fn regressor_in_natural_units(id: usize, mean_si: f64) -> (f64, String) {
+    let deg = regressor_degree(id);
+    let sig = regressor_signals(id);
+    if deg == 0 {
+        return (mean_si, "1".into());
+    }
+    if sig.iter().all(|s| s.starts_with('f')) {
+        (
+            mean_si / G0.powi(deg),
+            if deg == 1 {
+                "g".into()
+            } else {
+                format!("g^{deg}")
+            },
+        )
+    } else if sig.iter().all(|s| s.starts_with('w')) {
+        let d = std::f64::consts::PI / 180.0;
+        (
+            mean_si / d.powi(deg),
+            if deg == 1 {
+                "deg/s".into()
+            } else {
+                format!("(deg/s)^{deg}")
+            },
+        )
+    } else {
+        (mean_si, "SI".into())
+    }
+}
+
+pub(super) fn finding_words(
+    f: &Finding,
+    info: &crate::model::catalog::TermInfo,
+    prior_display: f64,
+) -> String {
+    let sensor = sensor_word(info.sensor);
+    let axis = ["x", "y", "z"][info.axis];
+    let reg = common::REGRESSORS[info.regressor];
+    let group = info
+        .group
+        .trim_start_matches("accel ")
+        .trim_start_matches("gyro ");
+    let mut s = format!(
+        "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {} along {axis}",
+        f.term,
+        sig3(f.estimate),
+        sig3(f.sigma),
+        f.unit,
+        sig3(f.regressor_mean),
+        f.regressor_unit,
+        sig3(f.effect),
+        f.effect_unit,
+        if info.sensor == Sensor::Accel { "bias" } else { "drift" },
+    );
+    if !f.equivalent.is_empty() {
+        let others: Vec<String> = f
+            .equivalent_estimates
+            .iter()
+            .map(|e| {
+                format!(
+                    "{} (would need {} ± {} {} by the signatures, {} prior σ)",
+                    e.term,
+                    sig3(e.estimate),
+                    sig3(e.sigma),
+                    e.unit,
+                    sig3(e.prior_sigmas.abs())
+                )
+            })
+            .collect();
+        s.push_str(&format!(
+            "; the data cannot separate it from {} (equivalence class; named: the one the spec's priors find most plausible); {}",
+            others.join(", "),
+            f.separate_by.join("; ")
+        ));
+    }
+    if f.prior_widened {
+        s.push_str(&format!(
+            "; at {} prior σ ({} {}) the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
+            sig3(f.estimate.abs() / prior_display),
+            sig3(prior_display),
+            f.unit,
+            sig3(f.prior_sigma),
+            f.unit,
+            f.term,
+            sig3(f.prior_sigma),
+            f.unit
+        ));
+    }
+    if let Some(b) = &f.confounded_with {
+        s.push_str(&format!(
+            "; on these data its regressor is proportional to that of the baseline term {b}, so part of it may be taken up there"
+        ));
+    }
+    s
+}
+
+/// A number with three significant digits, plain (no exponent) where that reads well.
+pub fn sig3(v: f64) -> String {
+    if !v.is_finite() {
+        return "not determined".into();
+    }
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.2e}")
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else if a >= 10.0 {
+        format!("{v:.1}")
+    } else if a >= 1.0 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+pub(super) fn channel_word(c: &str) -> String {
+    match c {
+        "vel_n" => "north velocity".into(),
+        "vel_e" => "east velocity".into(),
+        "pos_n" => "north position".into(),
+        "pos_e" => "east position".into(),
+        "pos_h" => "height".into(),
+        other => other.to_string(),
+    }
+}
+
+/// The plain-words summary: what the baseline gets wrong, what was found, the gain.
+pub(super) fn summary(e: &Explanation) -> Vec<String> {
+    let mut out = Vec::new();
+    // data times (GPS seconds on real data) are counted from the first update when large
+    let t_ref = if e.baseline.t_start.abs() > 1e5 {
+        e.baseline.t_start.floor()
+    } else {
+        0.0
+    };
+    let mut consistent = true;
+    for ch in &e.baseline.channels {
+        let inconsistent = ch.nis_mean > ch.nis_band[1] * 1.5
+            || ch
+                .whiteness_p
+                .is_some_and(|p| p * e.baseline.channels.len() as f64 <= 0.01);
+        if !inconsistent {
+            continue;
+        }
+        consistent = false;
+        let worst = ch
+            .segments
+            .iter()
+            .max_by(|a, b| a.nis_mean.total_cmp(&b.nis_mean));
+        match worst {
+            Some(sg) if sg.nis_mean > ch.nis_band[1] => out.push(format!(
+                "{} innovations are {}× larger than the model predicts during {:.0}–{:.0} s{} (mean NIS {}), biased by {:+.1}σ; the model does not explain the data there.",
+                channel_word(&ch.channel),
+                sig3(sg.nis_mean.sqrt()),
+                sg.t0 - t_ref,
+                sg.t1 - t_ref,
+                if t_ref != 0.0 { " from the first update" } else { "" },
+                sig3(sg.nis_mean),
+                sg.bias_sigma
+            )),
+            _ => out.push(format!(
+                "{} innovations are correlated in time (Ljung–Box p {}): the model misses a slow effect.",
+                channel_word(&ch.channel),
+                ch.whiteness_p.map(sig3).unwrap_or_default()
+            )),
+        }
+    }
+    for ch in &e.baseline.channels {
+        if ch.nis_mean < 0.5 * ch.nis_band[0] {
+            consistent = false;
+            out.push(format!(
+                "{} innovations are {}× smaller than the model predicts (mean NIS {}): its measurement or process noise is set too high for these data.",
+                channel_word(&ch.channel),
+                sig3((1.0 / ch.nis_mean.max(1e-12)).sqrt()),
+                sig3(ch.nis_mean)
+            ));
+        }
+    }
+    if consistent {
+        out.push(format!(
+            "The baseline {} is consistent with the data: mean NIS {} and white innovations in every channel.",
+            e.baseline_model,
+            sig3(e.baseline.nis_mean)
+        ));
+    }
+    if e.findings.is_empty() {
+        let nameable = e
+            .candidates
+            .iter()
+            .filter(|c| c.testable && c.confounded_with.is_none())
+            .count();
+        let masked = e
+            .candidates
+            .iter()
+            .filter(|c| c.testable && c.confounded_with.is_some() && c.p_holm <= e.alpha)
+            .count();
+        let mut line = format!(
+            "No candidate that could be named is significant at α = {} (Holm over the {} testable ones that are separable from the baseline)",
+            e.alpha, nameable
+        );
+        if masked > 0 {
+            line.push_str(&format!(
+                "; {masked} significant alone are not separable from a baseline term (listed below)"
+            ));
+        }
+        line.push('.');
+        out.push(line);
+    }
+    for f in &e.findings {
+        out.push(format!("Found: {}.", f.words));
+    }
+    if !e.findings.is_empty() {
+        let mut s = format!(
+            "Extended model {}: mean NIS {} → {}, log-likelihood {:+.1}",
+            e.extended_model,
+            sig3(e.gain.nis_mean_before),
+            sig3(e.gain.nis_mean_after),
+            e.gain.loglik
+        );
+        if let (Some(b), Some(a)) = (e.gain.model_error_rms_before, e.gain.model_error_rms_after) {
+            s.push_str(&format!(
+                "; model error (truth) {} → {} arcsec RMS ({}× smaller)",
+                sig3(b),
+                sig3(a),
+                sig3(b / a)
+            ));
+        }
+        s.push('.');
+        out.push(s);
+    }
+    if !e.implausible.is_empty() {
+        let list: Vec<String> = e
+            .implausible
+            .iter()
+            .map(|i| {
+                format!(
+                    "{} (would need {} ± {} {}, {} prior σ)",
+                    i.term,
+                    sig3(i.estimate),
+                    sig3(i.sigma),
+                    i.unit,
+                    sig3(i.prior_sigmas)
+                )
+            })
+            .collect();
+        out.push(format!(
+            "Significant but not named, their values would be implausible (a weak signature fitting some other mismatch; if your sensor can have such errors, widen its prior with --prior): {}.",
+            list.join(", ")
+        ));
+    }
+    if !e.unconfirmed.is_empty() {
+        let names: Vec<&str> = e.unconfirmed.iter().map(|u| u.0.as_str()).collect();
+        let (g, p) = (e.unconfirmed[0].1, e.unconfirmed[0].2);
+        out.push(format!(
+            "The signatures pointed at {} but the filter with them did not confirm it (2Δ log-likelihood {} against a BIC penalty of {}): not named; the misfit is something the candidates do not describe.",
+            names.join(", "),
+            sig3(g),
+            sig3(p)
+        ));
+    }
+    if !e.not_separable.is_empty() {
+        let list: Vec<String> = e
+            .not_separable
+            .iter()
+            .map(|(c, b)| format!("{c} (like {b})"))
+            .collect();
+        out.push(format!(
+            "Not separable from a baseline term on these data (its regressor is proportional to that term's, whose state takes it up): {}.",
+            list.join(", ")
+        ));
+    }
+    if !e.not_testable.is_empty() {
+        out.push(format!(
+            "Not testable on these data (no information): {}.",
+            e.not_testable.join(", ")
+        ));
+    }
+    out
+}
