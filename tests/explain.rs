@@ -62,6 +62,14 @@ fn check_found(kind: CaseKind, seed: u64) {
             .iter()
             .any(|(h, _)| &f.term == h || f.equivalent.iter().any(|x| x == h));
         assert!(related, "{}: named {} too", case.description, f.term);
+        // a hidden library term is a cause, never reported as a stand-in for something else
+        assert!(
+            f.stand_in.is_none(),
+            "{}: {} called a stand-in: {:?}",
+            case.description,
+            f.term,
+            f.stand_in
+        );
     }
     let (recovery, what) = out
         .gain_recovery()

@@ -276,7 +276,7 @@ fn finish(
     println!(
         "report: {} (and report.html, explain.json{} there)",
         args.out.join("report.md").display(),
-        if e.findings.is_empty() {
+        if report::extended_preset(&e).is_none() {
             ""
         } else {
             ", extended.toml"

@@ -35,6 +35,10 @@ pub struct CandidateTest {
 pub struct Finding {
     /// Canonical term name.
     pub term: String,
+    /// What kind of cause: `sensor` (a term of the IMU's error model), `measurement` (a term
+    /// of the aiding: time offset, lever arm) or `noise` (a white-noise or bias-instability
+    /// level).
+    pub kind: &'static str,
     /// Estimate from the extended filter (display unit).
     pub estimate: f64,
     /// Its 1-σ (display unit).
@@ -74,6 +78,17 @@ pub struct Finding {
     pub prior_widened: bool,
     /// The finding in words.
     pub words: String,
+    /// 2Δℓ the extended filter gained in the round that added it, its share when several
+    /// terms were added in one round (weighted by their conditional llr).
+    pub two_delta_loglik: f64,
+    /// Fraction of the baseline's excess mean NIS (mean NIS − 1) its round removed (same
+    /// weighting); absent when the baseline's mean NIS is within its 95 % band.
+    pub misfit_share: Option<f64>,
+    /// |estimate| in units of its prior σ (the spec's, or `--prior`), before any widening.
+    pub prior_sigmas: f64,
+    /// Why it probably stands in for an effect the candidates do not describe (it needs
+    /// ≫ its prior, or it explains little of the misfit); absent for a finding read as a cause.
+    pub stand_in: Option<String>,
 }
 
 /// A term the data cannot tell from a finding, and the value it would need.
@@ -143,6 +158,9 @@ pub struct Explanation {
     pub alpha: f64,
     /// Sentences for the terminal and the report.
     pub summary: Vec<String>,
+    /// Fraction of the baseline's excess mean NIS the extended model leaves; absent when the
+    /// baseline's mean NIS is within its 95 % band.
+    pub misfit_unexplained: Option<f64>,
     /// Normalised innovations (t, channel, ν/√S) of the baseline and extended passes, for plots.
     #[serde(skip)]
     pub innovations_before: Vec<(f64, String, f64)>,

@@ -38,6 +38,7 @@ pub use selection::prior_sigma;
 pub use words::{separation_hint, sig3};
 
 use crate::estimate::filter::{self, channel_name, AidingEpoch, FilterConfig, FilterRun};
+use crate::estimate::stats;
 use crate::io::imu::ImuData;
 use crate::io::truth::TruthRow;
 use crate::model::catalog::{Sensor, StateRef};
@@ -74,6 +75,12 @@ pub struct ExplainOptions {
     /// Prior σ of candidate terms that replace the spec's (term index, σ in SI): the sensor
     /// class of the data (`--prior` on the command line).
     pub candidate_sigma: Vec<(usize, f64)>,
+    /// A finding whose estimate exceeds this many prior σ is reported as probably standing in
+    /// for an effect the candidates do not describe.
+    pub stand_in_prior_sigmas: f64,
+    /// A finding that removes less than this fraction of the baseline's excess mean NIS, while
+    /// more than half of it is left, is reported as probably standing in (same reason).
+    pub stand_in_share: f64,
     /// Test only: when a candidate passes, name a pseudo-random one of the pool instead of the
     /// best, unconfirmed (a selector naming terms at random, which the evaluation must catch).
     pub broken_selector: bool,
@@ -88,6 +95,8 @@ impl Default for ExplainOptions {
             min_information: 1e-6,
             confound_cos: 0.999,
             max_prior_sigmas: 100.0,
+            stand_in_prior_sigmas: 30.0,
+            stand_in_share: 0.2,
             candidate_sigma: Vec::new(),
             broken_selector: false,
         }
@@ -265,7 +274,7 @@ pub fn explain(
         opts,
     };
     let r = select_and_retest(&ctx, cands, base, &eligible, progress)?;
-    let findings = complete_findings(&ctx, &r)?;
+    let findings = complete_findings(&ctx, &r, &base_stats)?;
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
     // the extended pass is the last one run (the baseline itself when nothing was found)
@@ -279,6 +288,8 @@ pub fn explain(
             .model_error_rms_arcsec
             .map(|e| e[0].hypot(e[1])),
     };
+    let misfit_unexplained =
+        baseline_excess(&base_stats).map(|e| (extended_stats.nis_mean - 1.0) / e);
     let mut ranked = tests;
     ranked.sort_by(|a, b| b.llr.total_cmp(&a.llr));
     let mut expl = Explanation {
@@ -297,6 +308,7 @@ pub fn explain(
         rounds: r.rounds,
         alpha: opts.alpha,
         summary: Vec::new(),
+        misfit_unexplained: misfit_unexplained.map(|u| u.max(0.0)),
         innovations_before,
         innovations_after: normalised(&r.pass.run),
         model_error_before,
@@ -354,6 +366,9 @@ struct Named {
     confounded_with: Option<String>,
     /// Which excitation separates it from each equivalent term.
     separate_by: Vec<String>,
+    /// Its share of its round's gain: 2Δℓ, and the mean NIS removed.
+    two_delta_loglik: f64,
+    nis_removed: f64,
 }
 
 impl Named {
@@ -394,6 +409,8 @@ impl Named {
                 .iter()
                 .map(|c| separation_hint(t, sig.cands[c.0]))
                 .collect(),
+            two_delta_loglik: 0.0,
+            nis_removed: 0.0,
         }
     }
 }
@@ -491,6 +508,18 @@ fn select_and_retest(
             r.widened.truncate(widened_before);
             break;
         }
+        // the round's gain, shared among its terms by their conditional llr
+        let llr_sum: f64 = r.named[named_before..].iter().map(|n| n.llr).sum();
+        let nis_removed = r.pass.stats.nis_mean - next_pass.stats.nis_mean;
+        for n in &mut r.named[named_before..] {
+            let w = if llr_sum > 0.0 {
+                n.llr / llr_sum
+            } else {
+                1.0 / added.len() as f64
+            };
+            n.two_delta_loglik = 2.0 * gain * w;
+            n.nis_removed = nis_removed * w;
+        }
         r.model = next_model;
         r.pass = next_pass;
         if last_round {
@@ -515,7 +544,9 @@ fn select_and_retest(
 
 /// The findings of the rounds: each named term with the extended filter's estimate, its prior,
 /// its mean regressor and effect on these data, and the words.
-fn complete_findings(ctx: &Context, r: &Rounds) -> anyhow::Result<Vec<Finding>> {
+fn complete_findings(ctx: &Context, r: &Rounds, base: &PassStats) -> anyhow::Result<Vec<Finding>> {
+    let excess = baseline_excess(base);
+    let unexplained = excess.map(|e| (r.pass.stats.nis_mean - 1.0) / e);
     let terms: Vec<usize> = r.named.iter().map(|n| n.term).collect();
     let means = if terms.is_empty() {
         Vec::new()
@@ -544,6 +575,7 @@ fn complete_findings(ctx: &Context, r: &Rounds) -> anyhow::Result<Vec<Finding>> 
         };
         let mut f = Finding {
             term: info.name.to_string(),
+            kind: "sensor",
             estimate,
             sigma,
             unit: info.display.to_string(),
@@ -567,11 +599,45 @@ fn complete_findings(ctx: &Context, r: &Rounds) -> anyhow::Result<Vec<Finding>> 
             prior_sigma: prior,
             prior_widened: widened,
             words: String::new(),
+            two_delta_loglik: n.two_delta_loglik,
+            misfit_share: excess.map(|e| n.nis_removed / e),
+            prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
+            stand_in: None,
         };
+        f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
         f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         out.push(f);
     }
     Ok(out)
+}
+
+/// The baseline's excess mean NIS (mean NIS − 1) when it lies above the 95 % band of its count
+/// (an excess to explain), else `None`.
+fn baseline_excess(base: &PassStats) -> Option<f64> {
+    let n: usize = base.channels.iter().map(|c| c.count).sum();
+    let band = stats::mean_chi2_band(1.0, n.max(1), 1.959_964);
+    (base.nis_mean > band[1]).then_some(base.nis_mean - 1.0)
+}
+
+/// Why finding `f` probably stands in for something the candidates do not describe, if it
+/// does: it needs more than `stand_in_prior_sigmas` of its prior, or its round removed less
+/// than `stand_in_share` of the baseline's excess misfit while more than half of it is left
+/// (`unexplained`).
+fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
+    let mut why = Vec::new();
+    if f.prior_sigmas > opts.stand_in_prior_sigmas {
+        why.push(format!("it needs {} prior σ", sig3(f.prior_sigmas)));
+    }
+    if let (Some(share), Some(left)) = (f.misfit_share, unexplained) {
+        if share < opts.stand_in_share && left > 0.5 {
+            why.push(format!(
+                "it removes {} % of the baseline's excess misfit and {} % of it is left",
+                sig3(100.0 * share.max(0.0)),
+                sig3(100.0 * left)
+            ));
+        }
+    }
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// Mean over the run of each term's regressor (SI), in one pass over the IMU samples (the
@@ -628,4 +694,85 @@ pub fn signature_information(
 ) -> anyhow::Result<f64> {
     let pass = run_pass(model, &[term], data, cfg, &mut |_| {})?;
     Ok(pass.sig.info[0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn finding(prior_sigmas: f64, misfit_share: Option<f64>) -> Finding {
+        Finding {
+            term: "size_x".into(),
+            kind: "sensor",
+            estimate: 0.0,
+            sigma: 0.0,
+            unit: "mm".into(),
+            llr: 0.0,
+            p_value: 0.0,
+            equivalent: vec![],
+            equivalent_estimates: vec![],
+            glr_estimate: 0.0,
+            glr_sigma: 0.0,
+            round: 1,
+            confounded_with: None,
+            regressor_mean: 0.0,
+            regressor_unit: String::new(),
+            effect: 0.0,
+            effect_unit: String::new(),
+            separate_by: vec![],
+            prior_sigma: 0.0,
+            prior_widened: false,
+            words: String::new(),
+            two_delta_loglik: 0.0,
+            misfit_share,
+            prior_sigmas,
+            stand_in: None,
+        }
+    }
+
+    #[test]
+    fn a_finding_far_beyond_its_prior_or_explaining_little_is_a_stand_in() {
+        let o = ExplainOptions::default();
+        // within its prior and explaining most of the misfit: a cause
+        assert!(stand_in_reason(&finding(3.0, Some(0.9)), Some(0.05), &o).is_none());
+        // the baseline was consistent (no excess to share): judged by its prior alone
+        assert!(stand_in_reason(&finding(3.0, None), None, &o).is_none());
+        let far = stand_in_reason(&finding(91.0, Some(0.9)), Some(0.05), &o).unwrap();
+        assert!(far.contains("91.0 prior σ"), "{far}");
+        let little = stand_in_reason(&finding(2.0, Some(0.08)), Some(0.9), &o).unwrap();
+        assert!(
+            little.contains("8.00 %") && little.contains("90.0 %"),
+            "{little}"
+        );
+        // explaining little is a stand-in only while most of the misfit is left
+        assert!(stand_in_reason(&finding(2.0, Some(0.08)), Some(0.3), &o).is_none());
+    }
+
+    #[test]
+    fn the_excess_to_explain_needs_a_mean_nis_above_its_band() {
+        let pass = |nis: f64, count: usize| PassStats {
+            model: "P28".into(),
+            t_start: 0.0,
+            loglik: 0.0,
+            nis_mean: nis,
+            whiteness_p: 1.0,
+            channels: vec![ChannelStats {
+                channel: "vel_n".into(),
+                count,
+                nis_mean: nis,
+                nis_band: [0.0, 0.0],
+                fraction_outside_95: 0.0,
+                ljung_box_q: None,
+                whiteness_p: None,
+                segments: vec![],
+            }],
+            model_error_rms_arcsec: None,
+            truth_check: vec![],
+        };
+        assert_eq!(baseline_excess(&pass(1.02, 1000)), None);
+        let e = baseline_excess(&pass(5.59, 1000)).unwrap();
+        assert!((e - 4.59).abs() < 1e-12);
+        // with 10 innovations a mean NIS of 1.5 is within the band
+        assert_eq!(baseline_excess(&pass(1.5, 10)), None);
+    }
 }

@@ -176,7 +176,7 @@ pub(super) fn finding_words(
             f.separate_by.join("; ")
         ));
     }
-    if f.prior_widened {
+    if f.prior_widened && f.stand_in.is_none() {
         s.push_str(&format!(
             "; at {} prior σ ({} {}) the extended filter starts it with σ {} {} (`--prior '{}={} {}'`)",
             sig3(f.estimate.abs() / prior_display),
@@ -192,6 +192,18 @@ pub(super) fn finding_words(
     if let Some(b) = &f.confounded_with {
         s.push_str(&format!(
             "; on these data its regressor is proportional to that of the baseline term {b}, so part of it may be taken up there"
+        ));
+    }
+    if let Some(share) = f.misfit_share {
+        s.push_str(&format!(
+            "; it explains {} % of the baseline's excess misfit (2Δℓ {})",
+            sig3(100.0 * share),
+            sig3(f.two_delta_loglik)
+        ));
+    }
+    if let Some(why) = &f.stand_in {
+        s.push_str(&format!(
+            ". It probably stands in for an effect the candidates do not describe ({why}): an IMU–GNSS time offset, an antenna lever arm, noise stated too small or an aiding error fit many sensor terms this way; do not read it as a property of the sensor"
         ));
     }
     s
@@ -310,7 +322,11 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
         out.push(line);
     }
     for f in &e.findings {
-        out.push(format!("Found: {}.", f.words));
+        if f.stand_in.is_some() {
+            out.push(format!("Fitted, but not a cause: {}.", f.words));
+        } else {
+            out.push(format!("Found: {}.", f.words));
+        }
     }
     if !e.findings.is_empty() {
         let mut s = format!(
@@ -330,6 +346,20 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
         }
         s.push('.');
         out.push(s);
+    }
+    if let Some(left) = e.misfit_unexplained {
+        if e.findings.is_empty() || left > 0.1 {
+            out.push(format!(
+                "Left unexplained: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter){}.",
+                sig3(100.0 * left),
+                sig3(e.extended.nis_mean),
+                if left > 0.5 {
+                    "; most of the misfit is something the candidates do not describe"
+                } else {
+                    ""
+                }
+            ));
+        }
     }
     if !e.implausible.is_empty() {
         let list: Vec<String> = e

@@ -31,6 +31,9 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         gain["model_error_rms_after"] = json!(a);
         gain["model_error_unit"] = json!("arcsec");
     }
+    if let Some(u) = e.misfit_unexplained {
+        gain["misfit_unexplained"] = json!(u);
+    }
     json!({
         "data": data,
         "model": e.model,
@@ -58,7 +61,10 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
 /// The `presets.toml` entry that makes the extended model a compiled preset (`None` when
 /// nothing was found).
 pub fn extended_preset(e: &Explanation) -> Option<String> {
-    if e.findings.is_empty() {
+    // a finding that probably stands in for something else is no term to compile in
+    let causes: Vec<&crate::explain::Finding> =
+        e.findings.iter().filter(|f| f.stand_in.is_none()).collect();
+    if causes.is_empty() {
         return None;
     }
     let mut parts = e.baseline_model.split('+');
@@ -72,14 +78,20 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
             terms.push(p.to_string());
         }
     }
-    terms.extend(e.findings.iter().map(|f| f.term.clone()));
+    terms.extend(causes.iter().map(|f| f.term.clone()));
     let list: Vec<String> = terms.iter().map(|t| format!("\"{t}\"")).collect();
     let mut s = format!(
         "# The extended model explain found, as a compiled preset: append to model-spec/presets.toml\n\
          # and rebuild; then `--model {base}_explained{}`.\n",
         if vertical { "+vertical" } else { "" }
     );
-    for f in e.findings.iter().filter(|f| f.prior_widened) {
+    for f in e.findings.iter().filter(|f| f.stand_in.is_some()) {
+        s.push_str(&format!(
+            "# {} is left out: it probably stands in for an effect the candidates do not describe.\n",
+            f.term
+        ));
+    }
+    for f in causes.iter().filter(|f| f.prior_widened) {
         s.push_str(&format!(
             "# {} lies beyond its spec prior σ; run the filter with --prior '{}={} {}'.\n",
             f.term,
@@ -91,7 +103,7 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
     s.push_str(&format!(
         "[[preset]]\nname = \"{base}_explained\"\ndoc = \"{} extended with {} (found by sinsmodel explain)\"\nbase = \"{base}\"\nterms = [{}]\n",
         e.baseline_model,
-        e.findings
+        causes
             .iter()
             .map(|f| f.term.as_str())
             .collect::<Vec<_>>()
@@ -207,7 +219,12 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     }
     for f in &e.findings {
         s.push_str(&format!(
-            "- **{}** = {} ± {} {} (llr {:.1}, p {}; pass {}). {}\n",
+            "- {}**{}** = {} ± {} {} (llr {:.1}, p {}; pass {}). {}\n",
+            if f.stand_in.is_some() {
+                "*fitted, not a cause:* "
+            } else {
+                ""
+            },
             f.term,
             num(f.estimate),
             num(f.sigma),
@@ -219,7 +236,7 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
         ));
     }
     s.push_str(&format!("\nExtended model: `{}`", e.extended_model));
-    if !e.findings.is_empty() {
+    if extended_preset(e).is_some() {
         s.push_str(" (its `presets.toml` entry is in `extended.toml`)");
     }
     s.push_str(".\n\n## 4. Gain\n\n| | baseline | extended |\n|---|---|---|\n");
