@@ -402,5 +402,95 @@ fn measured_data() {
     assert!(before > 2.0, "baseline NIS {before}");
     assert!(after <= before, "NIS {before} -> {after}");
     assert!(v["gain"]["loglik"].as_f64().unwrap() >= 0.0);
+    // the drive's largest misfit is an IMU–GNSS time offset (docs/explain.md §2): named as a
+    // measurement finding, positive (the fixes describe the trajectory a little later than
+    // their stamps), tens of milliseconds to a few tenths of a second
+    let findings = v["findings"].as_array().unwrap();
+    let dt = findings
+        .iter()
+        .find(|f| f["term"] == "dt_gnss")
+        .unwrap_or_else(|| panic!("no time offset named: {stderr}"));
+    assert_eq!(dt["kind"], "measurement");
+    assert!(dt["stand_in"].is_null(), "{dt}");
+    let ms = dt["estimate"].as_f64().unwrap();
+    assert!((30.0..300.0).contains(&ms), "dt_gnss {ms} ms");
+    // no size effect read as a cause: one that is named is labelled a stand-in, or is a few
+    // centimetres at most
+    for f in findings {
+        if f["term"].as_str().unwrap().starts_with("size_") && f["stand_in"].is_null() {
+            let mm = f["estimate"].as_f64().unwrap().abs();
+            assert!(mm < 50.0, "{} = {mm} mm read as a cause", f["term"]);
+        }
+    }
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// GNSS terms belong to a GNSS receiver: with a static aid they are no candidates, and the
+/// known values are checked for units and physics.
+#[test]
+fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
+    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
+    let rlg = format!("{shared}/psins-lasergyro/lasergyro.imu");
+    let out = tmp("gnss-static");
+    let base = [
+        "explain",
+        "--model",
+        "P28",
+        "--imu",
+        &rlg,
+        "--static-aid",
+        "34.246048,108.909664,380",
+        "--init",
+        "34.246048,108.909664,380,0.3878,1.0026,90.603",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--candidates", "dt_gnss,d_x"]);
+    let (ok, _, stderr) = sinsmodel(&args);
+    assert!(!ok);
+    assert!(
+        stderr.contains("dt_gnss are GNSS terms") && stderr.contains("without --aid"),
+        "{stderr}"
+    );
+    let mut args = base.to_vec();
+    args.extend(["--lever-arm", "0.1,0,-1"]);
+    let (ok, _, stderr) = sinsmodel(&args);
+    assert!(!ok);
+    assert!(stderr.contains("need --aid"), "{stderr}");
+    let d = format!("{shared}/gnss-imu-drive");
+    let drive = |extra: &[&str]| {
+        let imu = format!("{d}/imu_1934.csv");
+        let pos = format!("{d}/gnss_1934_sf.pos");
+        let mut a = vec![
+            "filter",
+            "--model",
+            "P28+vertical",
+            "--imu",
+            &imu,
+            "--aid",
+            &pos,
+            "--init",
+            "40.0966268,-105.1474483,1601.476,-178.192,6.687,-181.028",
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        let refs: Vec<&str> = a.iter().map(|s| s.as_str()).collect();
+        sinsmodel(&refs)
+    };
+    for (extra, why) in [
+        (&["--gnss-delay", "92"][..], "with its unit"),
+        (&["--gnss-delay", "92 s"][..], "ms read as s?"),
+        (&["--lever-arm", "0.1,0.2"][..], "got 2 values"),
+        (&["--lever-arm", "600,0,0"][..], "mm read as m?"),
+    ] {
+        let (ok, _, stderr) = drive(extra);
+        assert!(!ok, "{extra:?} accepted");
+        assert!(stderr.contains(why), "{extra:?}: {stderr}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
 }

@@ -65,6 +65,12 @@ class MisprintsAreCaught(unittest.TestCase):
     def test_wrong_radius_in_h_is_named_in_h(self):
         self.check_fails(7, "P31", "H[pos_ne][0][dlat]")
 
+    def test_time_offset_without_coriolis_is_named_in_h(self):
+        self.check_fails(8, "P31+dt_gnss", "H[vel_ne][0][dt_gnss]")
+
+    def test_reversed_lever_arm_velocity_is_named_in_h(self):
+        self.check_fails(9, "P31+lever_y", "H[vel_ne][0][lever_y]")
+
     def test_every_spec_term_is_checked_by_default(self):
         models = vj.default_models()
         named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}

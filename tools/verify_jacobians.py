@@ -144,6 +144,18 @@ def translate_regressor(text, term):
     return tr(tree.body)
 
 
+# GNSS measurement terms, written independently of the spec: what each one does to the fix.
+# ("time_offset",): the fix stamped t is the trajectory at t + theta [s];
+# ("lever", k): the antenna sits at IMU position + C l, l = theta along body axis k [m]; its
+# velocity adds C (w_b x l) (w_b the body rate; the navigation-frame rate is left out).
+GNSS_PHYSICS = {
+    "dt_gnss": ("time_offset",),
+    "lever_x": ("lever", 0),
+    "lever_y": ("lever", 1),
+    "lever_z": ("lever", 2),
+}
+
+
 def load_spec_terms(spec_dir=SPEC_DIR):
     """Every term of the spec as name -> (sensor, axis index, regressor function), the library
     names, and the presets (name -> state list, `base` + `terms` resolved)."""
@@ -152,6 +164,16 @@ def load_spec_terms(spec_dir=SPEC_DIR):
     terms, library = {}, []
     for t in raw.get("term", []):
         name = t["name"]
+        if t["sensor"] == "gnss":
+            # a measurement term: its physics is this file's own (GNSS_PHYSICS), never the spec's H
+            if name not in GNSS_PHYSICS:
+                raise SpecTranslationError(
+                    f"GNSS term `{name}` is unknown to the checker's independent measurement model "
+                    f"(it knows {' '.join(sorted(GNSS_PHYSICS))}): write its physics in GNSS_PHYSICS")
+            terms[name] = ("gnss", None, None)
+            if t.get("library", False):
+                library.append(name)
+            continue
         if t["sensor"] not in ("gyro", "accel") or t["axis"] not in ("x", "y", "z"):
             raise SpecTranslationError(f"term `{name}`: sensor `{t['sensor']}` / axis `{t['axis']}` unknown to the checker")
         terms[name] = (t["sensor"], "xyz".index(t["axis"]), translate_regressor(t["regressor"], name))
@@ -214,6 +236,8 @@ def build_jacobian_function():
     df = [0, 0, 0]
     for k, name in enumerate(TERM_NAMES):
         sensor, axis, reg = TERMS[name]
+        if sensor == "gnss":
+            continue
         contrib = theta[k] * reg(f_b, w_b)
         if sensor == "gyro":
             dw[axis] = dw[axis] + contrib
@@ -233,7 +257,25 @@ def build_jacobian_function():
     jac = ca.jacobian(err_dot, x)
     # measurements: north/east position error in metres, velocity error, height error
     dlon = x[7]
-    z = ca.vertcat(dv[0], dv[1], (rm0 + h) * dlat, (rn0 + h) * ca.cos(lat) * dlon, dh)
+    # the GNSS fix: the antenna (IMU position + C l) on the trajectory at t + dt
+    dt = 0
+    lever = [0, 0, 0]
+    for k, name in enumerate(TERM_NAMES):
+        if TERMS[name][0] != "gnss":
+            continue
+        kind = GNSS_PHYSICS[name]
+        if kind[0] == "time_offset":
+            dt = dt + theta[k]
+        else:
+            lever[kind[1]] = lever[kind[1]] + theta[k]
+    arm = ca.vertcat(*lever)
+    c_arm = c @ arm
+    v_arm = c @ ca.cross(w_b, arm)
+    z = ca.vertcat(dv[0] - dt * vd_t[0] - v_arm[0],
+                   dv[1] - dt * vd_t[1] - v_arm[1],
+                   (rm0 + h) * (dlat - dt * latd_t) - c_arm[0],
+                   (rn0 + h) * ca.cos(lat) * (dlon - dt * lond_t) - c_arm[1],
+                   dh - dt * hd_t + c_arm[2])
     jac_h = ca.jacobian(z, x)
     x0 = ca.DM.zeros(len(ALL_STATES))
     fun = ca.Function("sins_error_jacobian", [p, x], [jac, jac_h])
@@ -272,6 +314,15 @@ def corrupt(kind, out, pt):
     elif kind == 7 and "pos_ne" in out["h"]:
         # not a paper misprint: the radius mix-up of an H (R_N + h for R_M + h on dp_n)
         out["h"]["pos_ne"][0][idx["dlat"]] = rn
+    elif kind == 8 and "vel_ne" in out["h"] and "dt_gnss" in idx:
+        # a time offset's velocity rows without the Coriolis and transport terms (f_n alone)
+        cm = np.array(dcm_from_euler(*[math.radians(e) for e in pt["euler_deg"]]))
+        f_n = cm @ np.array(pt["f_b"], dtype=float)
+        out["h"]["vel_ne"][0][idx["dt_gnss"]] = -float(f_n[0])
+    elif kind == 9 and "vel_ne" in out["h"] and "lever_y" in idx:
+        # a lever arm's velocity rows with the cross product reversed (l x w for w x l)
+        col = idx["lever_y"]
+        out["h"]["vel_ne"][0][col] = -out["h"]["vel_ne"][0][col]
 
 
 def random_points(n, rng):
@@ -425,7 +476,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne]; the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed; the check must fail")
     args = ap.parse_args()
 
     models = args.models or default_models()

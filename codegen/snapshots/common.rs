@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 51;
+pub const TERM_COUNT: usize = 55;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -853,6 +853,62 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         doc: "z accelerometer lever arm along z",
         library: true,
     },
+    TermInfo {
+        name: "dt_gnss",
+        sensor: Sensor::Gnss,
+        axis: 0,
+        regressor: 0,
+        unit: "s",
+        display: "ms",
+        display_to_si: 0.001,
+        sigma: 0.1,
+        noise: 0.0,
+        group: "GNSS time offset",
+        doc: "IMU-GNSS time offset: the fix stamped t is the trajectory at t + dt_gnss",
+        library: true,
+    },
+    TermInfo {
+        name: "lever_x",
+        sensor: Sensor::Gnss,
+        axis: 0,
+        regressor: 0,
+        unit: "m",
+        display: "m",
+        display_to_si: 1.0,
+        sigma: 1.0,
+        noise: 0.0,
+        group: "GNSS lever arm",
+        doc: "GNSS antenna lever arm along body x (forward), IMU to antenna",
+        library: true,
+    },
+    TermInfo {
+        name: "lever_y",
+        sensor: Sensor::Gnss,
+        axis: 0,
+        regressor: 0,
+        unit: "m",
+        display: "m",
+        display_to_si: 1.0,
+        sigma: 1.0,
+        noise: 0.0,
+        group: "GNSS lever arm",
+        doc: "GNSS antenna lever arm along body y (right)",
+        library: true,
+    },
+    TermInfo {
+        name: "lever_z",
+        sensor: Sensor::Gnss,
+        axis: 0,
+        regressor: 0,
+        unit: "m",
+        display: "m",
+        display_to_si: 1.0,
+        sigma: 1.0,
+        noise: 0.0,
+        group: "GNSS lever arm",
+        doc: "GNSS antenna lever arm along body z (down)",
+        library: true,
+    },
 ];
 
 /// Structural non-zeros of the full navigation block.
@@ -952,6 +1008,10 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[],
+    &[],
+    &[],
+    &[],
 ];
 
 /// Number of distinct regressors.
@@ -1070,6 +1130,10 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.01,
             0.01,
             0.01,
+            0.1,
+            1.0,
+            1.0,
+            1.0,
         ],
     },
     GradeInfo {
@@ -1142,6 +1206,10 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.01,
             0.01,
             0.01,
+            0.1,
+            1.0,
+            1.0,
+            1.0,
         ],
     },
 ];
@@ -1883,6 +1951,18 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             // A[dv_d][size_z] = C33 * <-(w.x.powi(2) + w.y.powi(2))>
             col[DV_D] = c33 * r;
         }
+        51 => {
+            // dt_gnss: Gnss x axis, regressor 1
+        }
+        52 => {
+            // lever_x: Gnss x axis, regressor 1
+        }
+        53 => {
+            // lever_y: Gnss x axis, regressor 1
+        }
+        54 => {
+            // lever_z: Gnss x axis, regressor 1
+        }
         _ => panic!("term index {term} out of range"),
     }
 }
@@ -1938,18 +2018,78 @@ pub fn measurement_entries(
 ) {
     match m {
         0 => {
+            let lat = nav.lat;
+            let vn = nav.v_ned[0];
+            let ve = nav.v_ned[1];
+            let vd = nav.v_ned[2];
+            let rm = nav.rm;
+            let rn = nav.rn;
+            let omega = nav.omega;
+            let f_n = nav.f_ned[0];
+            let f_e = nav.f_ned[1];
+            let c11 = nav.c[0][0];
+            let c12 = nav.c[0][1];
+            let c13 = nav.c[0][2];
+            let c21 = nav.c[1][0];
+            let c22 = nav.c[1][1];
+            let c23 = nav.c[1][2];
+            let w_x = nav.w_b[0];
+            let w_y = nav.w_b[1];
+            let w_z = nav.w_b[2];
             emit(0, "dv_n", 1.0);
+            emit(
+                0,
+                "dt_gnss",
+                -(f_n - (2.0 * omega * lat.sin() + ve * lat.tan() / rn) * ve
+                    + vn * vd / rm),
+            );
+            emit(0, "lever_x", -(c12 * w_z - c13 * w_y));
+            emit(0, "lever_y", -(c13 * w_x - c11 * w_z));
+            emit(0, "lever_z", -(c11 * w_y - c12 * w_x));
             emit(1, "dv_e", 1.0);
+            emit(
+                1,
+                "dt_gnss",
+                -(f_e + (2.0 * omega * lat.sin() + ve * lat.tan() / rn) * vn
+                    + ve * vd / rn + 2.0 * omega * lat.cos() * vd),
+            );
+            emit(1, "lever_x", -(c22 * w_z - c23 * w_y));
+            emit(1, "lever_y", -(c23 * w_x - c21 * w_z));
+            emit(1, "lever_z", -(c21 * w_y - c22 * w_x));
         }
         1 => {
             let lat = nav.lat;
+            let vn = nav.v_ned[0];
+            let ve = nav.v_ned[1];
             let rm = nav.rm;
             let rn = nav.rn;
+            let c11 = nav.c[0][0];
+            let c12 = nav.c[0][1];
+            let c13 = nav.c[0][2];
+            let c21 = nav.c[1][0];
+            let c22 = nav.c[1][1];
+            let c23 = nav.c[1][2];
             emit(0, "dlat", rm);
+            emit(0, "dt_gnss", -vn);
+            emit(0, "lever_x", -c11);
+            emit(0, "lever_y", -c12);
+            emit(0, "lever_z", -c13);
             emit(1, "dlon", rn * lat.cos());
+            emit(1, "dt_gnss", -ve);
+            emit(1, "lever_x", -c21);
+            emit(1, "lever_y", -c22);
+            emit(1, "lever_z", -c23);
         }
         2 => {
+            let vd = nav.v_ned[2];
+            let c31 = nav.c[2][0];
+            let c32 = nav.c[2][1];
+            let c33 = nav.c[2][2];
             emit(0, "dh", 1.0);
+            emit(0, "dt_gnss", vd);
+            emit(0, "lever_x", c31);
+            emit(0, "lever_y", c32);
+            emit(0, "lever_z", c33);
         }
         _ => panic!("measurement index {m} out of range"),
     }

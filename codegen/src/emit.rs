@@ -27,6 +27,9 @@ fn nav_accessor(sym: &str) -> TokenStream {
         "f_n" => quote!(nav.f_ned[0]),
         "f_e" => quote!(nav.f_ned[1]),
         "f_d" => quote!(nav.f_ned[2]),
+        "w_x" => quote!(nav.w_b[0]),
+        "w_y" => quote!(nav.w_b[1]),
+        "w_z" => quote!(nav.w_b[2]),
         s if s.len() == 3
             && s.starts_with('c')
             && s[1..].chars().all(|c| ('1'..='3').contains(&c)) =>
@@ -180,6 +183,7 @@ pub fn common_module(spec: &Spec) -> String {
         let sensor = match t.sensor {
             Sensor::Gyro => quote!(Sensor::Gyro),
             Sensor::Accel => quote!(Sensor::Accel),
+            Sensor::Gnss => quote!(Sensor::Gnss),
         };
         let axis = t.axis;
         let reg = t.regressor;
@@ -235,9 +239,10 @@ pub fn common_module(spec: &Spec) -> String {
     });
     let n_nav_nnz = nav_entries.len();
     let term_rows = spec.terms.iter().map(|t| {
-        let rows = match t.sensor {
+        let rows: &[usize] = match t.sensor {
             Sensor::Gyro => &spec.compose.gyro_rows,
             Sensor::Accel => &spec.compose.accel_rows,
+            Sensor::Gnss => &[],
         };
         let rows = rows.iter().map(|r| const_name(&spec.nav_states[*r].name));
         quote!(&[#(#rows),*])
@@ -274,7 +279,14 @@ pub fn common_module(spec: &Spec) -> String {
             let (rn, ru) = (&r.name, &r.unit);
             quote!(MeasRowInfo { name: #rn, unit: #ru })
         });
-        let states: BTreeSet<&str> = m.rows.iter().flat_map(|r| r.h.iter().map(|h| h.state.as_str())).collect();
+        // the states a model must have for the measurement: its navigation states (a GNSS
+        // term's entries apply when the term is in the model)
+        let states: BTreeSet<&str> = m
+            .rows
+            .iter()
+            .flat_map(|r| r.h.iter().map(|h| h.state.as_str()))
+            .filter(|s| spec.nav_index(s).is_some())
+            .collect();
         let states = states.into_iter();
         let aiding = match m.aiding {
             crate::spec::Aiding::Position => quote!(Aiding::Position),

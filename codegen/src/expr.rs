@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 /// Navigation quantities an A or H expression may use, with what they are (SI units).
 /// The generated code binds each one from `NavPoint` (see `nav_accessor`).
-pub const NAV_SYMBOLS: [(&str, &str); 22] = [
+pub const NAV_SYMBOLS: [(&str, &str); 25] = [
     ("lat", "geodetic latitude [rad]"),
     ("h", "height above the ellipsoid, up [m]"),
     ("vn", "north velocity [m/s]"),
@@ -38,7 +38,30 @@ pub const NAV_SYMBOLS: [(&str, &str); 22] = [
         "normal gravity derivative by latitude [m/s^2/rad]",
     ),
     ("dg_dh", "normal gravity derivative by height [1/s^2]"),
+    (
+        "w_x",
+        "body angular rate about x, the step mean of w^b_ib [rad/s]",
+    ),
+    ("w_y", "body angular rate about y [rad/s]"),
+    ("w_z", "body angular rate about z [rad/s]"),
 ];
+
+/// Dimension of a navigation symbol (an H entry's unit is checked with it), doubled exponents
+/// of [m, s, rad] as in [`crate::units::Dim`].
+fn nav_symbol_dim(name: &str) -> Option<crate::units::Dim> {
+    use crate::units::Dim;
+    Some(match name {
+        "lat" => Dim([0, 0, 2]),
+        "h" | "rm" | "rn" => Dim([2, 0, 0]),
+        "vn" | "ve" | "vd" => Dim([2, -2, 0]),
+        "omega" | "w_x" | "w_y" | "w_z" => crate::units::DIM_RATE,
+        "f_n" | "f_e" | "f_d" => crate::units::DIM_ACCEL,
+        "dg_dlat" => Dim([2, -4, -2]),
+        "dg_dh" => Dim([0, -4, 0]),
+        c if c.len() == 3 && c.starts_with('c') => crate::units::DIM_ONE,
+        _ => return None,
+    })
+}
 
 /// Navigation-state quantities a measurement residual may use: the filter's state at the fix
 /// time (SI units), with the WGS-84 radii at that state.
@@ -99,7 +122,8 @@ impl Expr {
         out
     }
 
-    /// Physical dimension of a regressor expression (f in m/s², w in rad/s); errors name a sum
+    /// Physical dimension of a regressor expression (f in m/s², w in rad/s) or of a navigation
+    /// expression (each symbol's SI unit); errors name a sum
     /// of unlike dimensions, a fractional power or a trigonometric function of a dimensioned value.
     pub fn dimension(&self) -> Result<crate::units::Dim, String> {
         dimension(&self.ast)
@@ -176,7 +200,11 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
             syn::Expr::Path(p) if p.path.is_ident("w") => Ok(DIM_RATE),
             _ => Err(format!("no dimension for `{}`", f.to_token_stream())),
         },
-        syn::Expr::Path(p) => Err(format!("no dimension for `{}`", p.to_token_stream())),
+        syn::Expr::Path(p) => p
+            .path
+            .get_ident()
+            .and_then(|i| nav_symbol_dim(&i.to_string()))
+            .ok_or_else(|| format!("no dimension for `{}`", p.to_token_stream())),
         syn::Expr::Binary(b) => {
             let (l, r) = (dimension(&b.left)?, dimension(&b.right)?);
             let in_range = |d: Result<crate::units::Dim, String>| {
@@ -185,7 +213,9 @@ fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
             match b.op {
                 syn::BinOp::Mul(_) => in_range(l.times(r)),
                 syn::BinOp::Div(_) => in_range(l.per(r)),
-                _ if l == r => Ok(l),
+                // radians are compared loosely (an SI radian is dimensionless: omega [rad/s]
+                // and v/R [1/s] add)
+                _ if l.0[0] == r.0[0] && l.0[1] == r.0[1] => Ok(l),
                 _ => Err(format!(
                     "`{}` adds or subtracts unlike dimensions [{l}] and [{r}]",
                     b.to_token_stream()

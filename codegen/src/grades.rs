@@ -140,6 +140,8 @@ pub(crate) fn load(
                 let k = match t.sensor {
                     Sensor::Gyro => *g.unlisted.gyro.get_ref(),
                     Sensor::Accel => *g.unlisted.accel.get_ref(),
+                    // the IMU's grade says nothing about the aiding: its own prior
+                    Sensor::Gnss => 1.0,
                 };
                 (t.sigma * k, GradeRule::Unlisted)
             };

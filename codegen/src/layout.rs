@@ -138,13 +138,18 @@ impl Layout {
     }
 
     /// Symbolic non-zeros of H for measurement `m` (rows = components), or `None` when the
-    /// measurement references a state this model lacks.
+    /// measurement references a navigation state this model lacks. Entries of GNSS terms the
+    /// model lacks are left out (the measurement exists without them).
     pub fn h_entries(&self, spec: &Spec, m: usize) -> Option<Vec<SymEntry>> {
         let meas = &spec.measurements[m];
         let mut out = Vec::new();
         for (row, r) in meas.rows.iter().enumerate() {
             for h in &r.h {
-                let col = self.index_of(spec, &h.state)?;
+                let col = match self.index_of(spec, &h.state) {
+                    Some(c) => c,
+                    None if spec.term_index(&h.state).is_some() => continue,
+                    None => return None,
+                };
                 let ast = &h.expr.ast;
                 out.push(SymEntry {
                     row,
@@ -175,6 +180,8 @@ pub fn term_column(spec: &Spec, t: usize, rval: TokenStream) -> Vec<(usize, SymE
     let (rows, sign) = match term.sensor {
         Sensor::Gyro => (&spec.compose.gyro_rows, spec.compose.gyro_sign),
         Sensor::Accel => (&spec.compose.accel_rows, spec.compose.accel_sign),
+        // a GNSS term enters the measurements, not A
+        Sensor::Gnss => return Vec::new(),
     };
     let mut out = Vec::new();
     for (k, &nav_row) in rows.iter().enumerate() {

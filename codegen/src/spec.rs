@@ -57,6 +57,9 @@ pub enum Sensor {
     Gyro,
     /// Accelerometer: the term adds to the measured specific force [m/s²].
     Accel,
+    /// GNSS aiding: the term enters the measurements (its H entries), not A — a time offset,
+    /// an antenna lever arm.
+    Gnss,
 }
 
 /// A navigation error state (attitude, velocity, position).
@@ -140,6 +143,8 @@ pub struct Term {
     pub library: bool,
     /// Priors this term declares for named grades: (grade, 1-σ [SI], line in terms.toml).
     pub grade_sigma: Vec<(String, f64, usize)>,
+    /// A GNSS term's H entries: (measurement row name, expression), merged into the rows.
+    pub h: Vec<(String, Expr)>,
 }
 
 /// One H entry of a measurement row.
@@ -308,8 +313,12 @@ struct RawTerms {
 struct RawTerm {
     name: Spanned<String>,
     sensor: Spanned<String>,
-    axis: Spanned<String>,
-    regressor: Spanned<String>,
+    #[serde(default)]
+    axis: Option<Spanned<String>>,
+    #[serde(default)]
+    regressor: Option<Spanned<String>>,
+    #[serde(default)]
+    h: Vec<RawTermH>,
     unit: Spanned<String>,
     display: Spanned<String>,
     sigma: Spanned<String>,
@@ -321,6 +330,14 @@ struct RawTerm {
     library: bool,
     #[serde(default)]
     grade_sigma: std::collections::BTreeMap<String, Spanned<String>>,
+}
+
+/// One H entry of a GNSS term: the measurement row it enters and its value.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTermH {
+    row: Spanned<String>,
+    expr: Spanned<String>,
 }
 
 #[derive(Deserialize)]
@@ -494,7 +511,8 @@ impl Spec {
         let compose = load_compose(&nav_src, &raw_nav.compose, &nav_states)?;
         let sensor_noise = load_sensor_noise(&nav_src, &raw_nav.sensor_noise)?;
         let (terms, regressors) = load_terms(&terms_src, &raw_terms.term, &mut names)?;
-        let measurements = load_measurements(&meas_src, &raw_meas.measurement, &names)?;
+        let mut measurements = load_measurements(&meas_src, &raw_meas.measurement, &names)?;
+        merge_term_h(&terms_src, &raw_terms.term, &terms, &mut measurements)?;
         let presets = load_presets(
             &preset_src,
             &raw_presets.preset,
@@ -721,31 +739,60 @@ fn load_terms(
         let sensor = match t.sensor.get_ref().as_str() {
             "gyro" => Sensor::Gyro,
             "accel" => Sensor::Accel,
+            "gnss" => Sensor::Gnss,
             other => {
                 return Err(src.error(
                     t.sensor.span(),
                     &item,
-                    format!("unknown sensor `{other}` (expected `gyro` or `accel`)"),
+                    format!("unknown sensor `{other}` (expected `gyro`, `accel` or `gnss`)"),
                 ))
             }
         };
-        let axis = match t.axis.get_ref().as_str() {
-            "x" => 0,
-            "y" => 1,
-            "z" => 2,
-            other => {
-                return Err(src.error(
-                    t.axis.span(),
-                    &item,
-                    format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
-                ))
-            }
-        };
-        let rexpr = expr::parse(t.regressor.get_ref(), ExprKind::Regressor)
-            .map_err(|m| src.error(t.regressor.span(), &item, format!("regressor: {m}")))?;
         let unit = units::parse_unit(t.unit.get_ref())
             .map_err(|e| src.error(t.unit.span(), &item, format!("unit: {e}")))?;
-        check_term_dimension(src, t, &item, sensor, &rexpr, unit.dim)?;
+        let axis = match &t.axis {
+            None if sensor == Sensor::Gnss => 0,
+            None => return Err(src.error(
+                t.name.span(),
+                &item,
+                "missing `axis` (`x`, `y` or `z`: the sensing axis of the gyro or accelerometer)",
+            )),
+            Some(a) => match a.get_ref().as_str() {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                other => {
+                    return Err(src.error(
+                        a.span(),
+                        &item,
+                        format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
+                    ))
+                }
+            },
+        };
+        let (rexpr, h) = match sensor {
+            Sensor::Gnss => gnss_term_h(src, t, &item)?,
+            _ => {
+                let Some(r) = &t.regressor else {
+                    return Err(src.error(
+                        t.name.span(),
+                        &item,
+                        "missing `regressor` (the body-frame signal the error is proportional to, e.g. `f.x.powi(2)`, or `1` for a bias)",
+                    ));
+                };
+                if let Some(e) = t.h.first() {
+                    return Err(src.error(
+                        e.row.span(),
+                        &item,
+                        "`h` belongs to `sensor = \"gnss\"` terms (a gyro or accelerometer term enters A through its regressor)",
+                    ));
+                }
+                let rexpr = expr::parse(r.get_ref(), ExprKind::Regressor)
+                    .map_err(|m| src.error(r.span(), &item, format!("regressor: {m}")))?;
+                check_term_dimension(src, t, r, &item, sensor, &rexpr, unit.dim)?;
+                (rexpr, Vec::new())
+            }
+        };
         let key = rexpr.key();
         let regressor = match regressors.iter().position(|r| r.expr.key() == key) {
             Some(i) => i,
@@ -804,9 +851,102 @@ fn load_terms(
                     Ok((g.clone(), si, src.line_of(q.span().start)))
                 })
                 .collect::<Result<_, SpecError>>()?,
+            h,
         });
     }
     Ok((terms, regressors))
+}
+
+/// A GNSS term: no regressor (it does not enter A; the constant `1` stands for it), and at
+/// least one H entry, each a navigation expression over the rows of measurements.toml.
+fn gnss_term_h(
+    src: &Source,
+    t: &RawTerm,
+    item: &str,
+) -> Result<(Expr, Vec<(String, Expr)>), SpecError> {
+    if let Some(r) = &t.regressor {
+        return Err(src.error(
+            r.span(),
+            item,
+            "a `gnss` term enters the measurements, not A: remove `regressor` and give its `h` entries",
+        ));
+    }
+    if t.h.is_empty() {
+        return Err(src.error(
+            t.name.span(),
+            item,
+            "a `gnss` term needs `h = [{ row = \"dp_n\", expr = \"...\" }, ...]`: the measurement rows it enters",
+        ));
+    }
+    let mut h = Vec::new();
+    for e in &t.h {
+        let ex = expr::parse(e.expr.get_ref(), ExprKind::Navigation)
+            .map_err(|m| src.error(e.expr.span(), item, format!("h[{}]: {m}", e.row.get_ref())))?;
+        h.push((e.row.get_ref().clone(), ex));
+    }
+    let one = expr::parse("1", ExprKind::Regressor).expect("the constant regressor parses");
+    Ok((one, h))
+}
+
+/// Merges every GNSS term's H entries into the measurement rows they name, checking that the
+/// row exists, is entered once, and that the term's unit times the entry's dimension is the
+/// row's unit.
+fn merge_term_h(
+    src: &Source,
+    raw: &[RawTerm],
+    terms: &[Term],
+    measurements: &mut [Measurement],
+) -> Result<(), SpecError> {
+    for (t, rt) in terms.iter().zip(raw) {
+        let item = format!("term `{}`", t.name);
+        for ((row_name, e), re) in t.h.iter().zip(&rt.h) {
+            let Some(row) = measurements
+                .iter_mut()
+                .flat_map(|m| m.rows.iter_mut())
+                .find(|r| &r.name == row_name)
+            else {
+                let rows: Vec<&str> = measurements
+                    .iter()
+                    .flat_map(|m| m.rows.iter().map(|r| r.name.as_str()))
+                    .collect();
+                return Err(src.error(
+                    re.row.span(),
+                    &item,
+                    format!(
+                        "h: unknown measurement row `{row_name}` (rows: {})",
+                        rows.join(" ")
+                    ),
+                ));
+            };
+            if row.h.iter().any(|x| x.state == t.name) {
+                return Err(src.error(
+                    re.row.span(),
+                    &item,
+                    format!("h: row `{row_name}` entered twice"),
+                ));
+            }
+            let at = |m: String| src.error(re.expr.span(), &item, format!("h[{row_name}]: {m}"));
+            let dim = e.dimension().map_err(at)?;
+            let term_unit = units::parse_unit(&t.unit).map_err(|e| at(e.to_string()))?;
+            let row_unit = units::parse_unit(&row.unit).map_err(|e| at(e.to_string()))?;
+            let got = term_unit.dim.times(dim).map_err(at)?;
+            if got.0[0] != row_unit.dim.0[0] || got.0[1] != row_unit.dim.0[1] {
+                return Err(src.error(
+                    re.expr.span(),
+                    &item,
+                    format!(
+                        "h[{row_name}]: unit `{}` times `{}` [{dim}] is {got}, but the row is in {}",
+                        t.unit, e.source, row.unit
+                    ),
+                ));
+            }
+            row.h.push(HEntry {
+                state: t.name.clone(),
+                expr: e.clone(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Unit × regressor dimension = the sensor's dimension. Radians are compared loosely (an SI
@@ -814,6 +954,7 @@ fn load_terms(
 fn check_term_dimension(
     src: &Source,
     t: &RawTerm,
+    reg_text: &Spanned<String>,
     item: &str,
     sensor: Sensor,
     regressor: &Expr,
@@ -821,10 +962,11 @@ fn check_term_dimension(
 ) -> Result<(), SpecError> {
     let reg_dim = regressor
         .dimension()
-        .map_err(|m| src.error(t.regressor.span(), item, format!("regressor: {m}")))?;
+        .map_err(|m| src.error(reg_text.span(), item, format!("regressor: {m}")))?;
     let (sensor_unit, sensor_name) = match sensor {
         Sensor::Gyro => ("rad/s", "a gyro error"),
         Sensor::Accel => ("m/s^2", "an accelerometer error"),
+        Sensor::Gnss => unreachable!("a gnss term has no regressor"),
     };
     let want = units::parse_unit(sensor_unit)
         .expect("sensor unit parses")
@@ -839,7 +981,7 @@ fn check_term_dimension(
             format!(
                 "unit `{}` times regressor `{}` [{}] is {}, but {sensor_name} is in {sensor_unit}: the unit should be {} ",
                 t.unit.get_ref(),
-                t.regressor.get_ref(),
+                reg_text.get_ref(),
                 reg_dim,
                 got,
                 want.per(reg_dim).map_or_else(|e| format!("(none: {e})"), |d| d.to_string())

@@ -445,3 +445,57 @@ fn residual_errors_name_the_measurement_and_the_record() {
         "residual_sigma: unknown symbol `omega`",
     );
 }
+
+#[test]
+fn gnss_terms_are_checked() {
+    // an H entry whose unit does not match the row: a time offset [s] times a velocity is m,
+    // but a velocity row is in m/s
+    expect_error(
+        "terms.toml",
+        "{ row = \"dv_n\", expr = \"-(f_n - (2.0 * omega * lat.sin() + ve * lat.tan() / rn) * ve + vn * vd / rm)\" }",
+        "{ row = \"dv_n\", expr = \"-vn\" }",
+        "{ row = \"dv_n\", expr = \"-vn\" }",
+        "term `dt_gnss`",
+        "but the row is in m/s",
+    );
+    expect_error(
+        "terms.toml",
+        "{ row = \"dp_e\", expr = \"-ve\" }",
+        "{ row = \"dp_x\", expr = \"-ve\" }",
+        "dp_x",
+        "term `dt_gnss`",
+        "unknown measurement row `dp_x`",
+    );
+    expect_error(
+        "terms.toml",
+        "{ row = \"dp_e\", expr = \"-ve\" }",
+        "{ row = \"dp_n\", expr = \"-ve\" }",
+        "{ row = \"dp_n\", expr = \"-ve\" }",
+        "term `dt_gnss`",
+        "entered twice",
+    );
+    expect_error(
+        "terms.toml",
+        "sensor = \"gnss\"\nunit = \"s\"",
+        "sensor = \"gnss\"\nregressor = \"1\"\nunit = \"s\"",
+        "regressor = \"1\"",
+        "term `dt_gnss`",
+        "enters the measurements, not A",
+    );
+    expect_error(
+        "terms.toml",
+        "regressor = \"-(w.x.powi(2) + w.y.powi(2))\"",
+        "regressor = \"-(w.x.powi(2) + w.y.powi(2))\"\nh = [{ row = \"dp_n\", expr = \"1.0\" }]",
+        "h = [{ row = \"dp_n\"",
+        "term `size_z`",
+        "`h` belongs to `sensor = \"gnss\"` terms",
+    );
+    expect_error(
+        "terms.toml",
+        "{ row = \"dp_n\", expr = \"-c11\" }",
+        "{ row = \"dp_n\", expr = \"-c11 * f.x\" }",
+        "-c11 * f.x",
+        "term `lever_x`",
+        "h[dp_n]",
+    );
+}

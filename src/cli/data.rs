@@ -9,6 +9,7 @@ use sinsmodel::io::imu::ImuData;
 use sinsmodel::io::truth::{TruthLookup, TruthRow};
 use sinsmodel::io::{aiding, truth};
 use sinsmodel::model::catalog::GradeInfo;
+use sinsmodel::model::generated::common;
 use sinsmodel::model::priors::{self, StatePattern};
 use sinsmodel::model::Model;
 use sinsmodel::nav::attitude::dcm_from_euler;
@@ -138,6 +139,14 @@ pub struct DataArgs {
     /// epochs inside are dropped and the drift at its end is reported (repeatable).
     #[arg(long, allow_hyphen_values = true)]
     outage: Vec<String>,
+    /// Known IMU–GNSS time offset with its unit (`92 ms`, `0.092 s`): a fix stamped t is the
+    /// trajectory at t + OFFSET (the spec term dt_gnss), applied in the residuals; needs --aid.
+    #[arg(long, allow_hyphen_values = true)]
+    gnss_delay: Option<String>,
+    /// Known GNSS antenna lever arm, IMU to antenna in the body frame (FRD): X,Y,Z [m] (the spec
+    /// terms lever_x lever_y lever_z), applied in the residuals; needs --aid.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    lever_arm: Option<Vec<f64>>,
 }
 
 /// A GNSS outage window on the data's clock [s].
@@ -338,6 +347,62 @@ impl DataArgs {
             || self.force
             || self.grade.is_some()
             || !self.outage.is_empty()
+            || self.gnss_delay.is_some()
+            || self.lever_arm.is_some()
+    }
+
+    /// True when the aiding comes from a GNSS file (`--aid`): GNSS terms (time offset, lever
+    /// arm) mean something only then.
+    pub fn has_gnss(&self) -> bool {
+        self.aid.is_some()
+    }
+
+    /// The known GNSS term values of `--gnss-delay` and `--lever-arm`: (term index, SI), each
+    /// checked for syntax and physics.
+    pub fn known_gnss(&self) -> Result<Vec<(usize, f64)>> {
+        let term = |name: &str, option: &str| -> Result<usize> {
+            common::TERMS
+                .iter()
+                .position(|t| t.name == name)
+                .with_context(|| {
+                    format!("{option}: the spec has no term `{name}` (model-spec/terms.toml)")
+                })
+        };
+        let mut out = Vec::new();
+        if let Some(text) = &self.gnss_delay {
+            let dt = sinsmodel::io::units::parse_quantity_as(text, "s").with_context(|| {
+                format!("--gnss-delay `{text}`: expected a time with its unit, e.g. `92 ms` or `0.092 s`")
+            })?;
+            if !dt.is_finite() || dt.abs() > 1.0 {
+                bail!(
+                    "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second difference belongs in --clock-offset)"
+                );
+            }
+            out.push((term("dt_gnss", "--gnss-delay")?, dt));
+        }
+        if let Some(l) = &self.lever_arm {
+            if l.len() != 3 {
+                bail!(
+                    "--lever-arm: expected X,Y,Z in metres (body frame, FRD), got {} values",
+                    l.len()
+                );
+            }
+            for (k, (&v, axis)) in l.iter().zip(["x", "y", "z"]).enumerate() {
+                if !v.is_finite() || v.abs() > 10.0 {
+                    bail!(
+                        "--lever-arm: {axis} = {v} m is beyond ±10 m; a vehicle's IMU-to-antenna arm is metres at most (mm read as m?)"
+                    );
+                }
+                out.push((
+                    term(["lever_x", "lever_y", "lever_z"][k], "--lever-arm")?,
+                    v,
+                ));
+            }
+        }
+        if !out.is_empty() && !self.has_gnss() {
+            bail!("--gnss-delay and --lever-arm describe a GNSS receiver: they need --aid (a GNSS file)");
+        }
+        Ok(out)
     }
 
     /// The input files named by the options (so outputs never land on them).
@@ -965,6 +1030,19 @@ impl DataArgs {
             m => bail!("--mode `{m}`: expected open or closed"),
         };
         cfg.step_s = args.step_given()?.unwrap_or(DEFAULT_STEP_S);
+        cfg.known_gnss = args.known_gnss()?;
+        if !args.has_gnss() {
+            if let Some(t) = model.states.iter().find_map(|s| match *s {
+                sinsmodel::model::catalog::StateRef::Term(k)
+                    if common::TERMS[k].sensor == sinsmodel::model::catalog::Sensor::Gnss =>
+                {
+                    Some(common::TERMS[k].name)
+                }
+                _ => None,
+            }) {
+                bail!("--model {}: {t} is a GNSS term (it enters the fixes of a GNSS receiver); without --aid there is none", model.name);
+            }
+        }
         if !model.vertical {
             cfg.vertical = Vertical::Fixed;
         }

@@ -10,6 +10,8 @@ use sinsmodel::estimate::filter::FilterConfig;
 use sinsmodel::experiment::reproduce;
 use sinsmodel::explain::{self, ExplainData, ExplainOptions, Explanation};
 use sinsmodel::io::atomic_file::{self, OutputDir};
+use sinsmodel::model::catalog::Sensor;
+use sinsmodel::model::generated::common;
 use sinsmodel::model::Model;
 use sinsmodel::report::plot::{self, Bar, Scale, Series};
 use sinsmodel::report::{explain as report, progress};
@@ -93,8 +95,23 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
             .as_deref()
             .context("--model BASELINE is required with data (e.g. --model P31)")?;
         let baseline = Model::parse(model_text)?;
-        let cands = explain::parse_candidates(args.candidates.as_deref(), &baseline)
+        let mut cands = explain::parse_candidates(args.candidates.as_deref(), &baseline)
             .map_err(anyhow::Error::msg)?;
+        if !args.data.has_gnss() {
+            // a static aid or ZUPTs have no antenna and no receiver clock
+            let gnss: Vec<&str> = cands
+                .iter()
+                .filter(|&&t| common::TERMS[t].sensor == Sensor::Gnss)
+                .map(|&t| common::TERMS[t].name)
+                .collect();
+            if args.candidates.is_some() && !gnss.is_empty() {
+                bail!(
+                    "--candidates: {} are GNSS terms (they enter the fixes of a GNSS receiver); without --aid there is none",
+                    gnss.join(", ")
+                );
+            }
+            cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
+        }
         let skipped = already_in_baseline(args.candidates.as_deref(), &baseline);
         // every option is checked before the (long) run
         args.data.check_prior_names(&baseline)?;

@@ -64,15 +64,25 @@ fn list_text() -> String {
                 if t.library { " (library)" } else { "" }
             ));
         }
+        let (sensor, axis, reg) = match t.sensor {
+            sinsmodel::model::catalog::Sensor::Gyro => (
+                "gyro",
+                ["x", "y", "z"][t.axis],
+                common::REGRESSORS[t.regressor],
+            ),
+            sinsmodel::model::catalog::Sensor::Accel => (
+                "accel",
+                ["x", "y", "z"][t.axis],
+                common::REGRESSORS[t.regressor],
+            ),
+            sinsmodel::model::catalog::Sensor::Gnss => ("gnss", "-", "enters H"),
+        };
         s.push_str(&format!(
             "  {:<9} {} {}  <{}>  [{}]  sigma {} {}\n",
             t.name,
-            match t.sensor {
-                sinsmodel::model::catalog::Sensor::Gyro => "gyro",
-                sinsmodel::model::catalog::Sensor::Accel => "accel",
-            },
-            ["x", "y", "z"][t.axis],
-            common::REGRESSORS[t.regressor],
+            sensor,
+            axis,
+            reg,
             t.unit,
             format_sig(t.sigma / t.display_to_si),
             t.display
@@ -159,11 +169,13 @@ pub fn show_text(m: &Model) -> String {
 /// A point where no structural non-zero of H vanishes by accident.
 fn generic_point() -> sinsmodel::nav::nav_point::NavPoint {
     let c = sinsmodel::nav::attitude::dcm_from_euler(0.1, 0.2, 0.3);
-    sinsmodel::nav::nav_point::NavPoint::new(
+    let mut np = sinsmodel::nav::nav_point::NavPoint::new(
         0.5,
         100.0,
         nalgebra::Vector3::new(1.0, 2.0, 0.5),
         &c,
         &nalgebra::Vector3::new(0.3, -0.2, -9.8),
-    )
+    );
+    np.set_rate(&nalgebra::Vector3::new(0.05, -0.03, 0.2));
+    np
 }

@@ -64,6 +64,10 @@ pub struct FilterConfig {
     pub keep_covariance: bool,
     /// Propagate P with dense nalgebra matrices instead of the sparse kernels (benchmark baseline).
     pub dense_reference: bool,
+    /// Known values of GNSS terms, applied in the residuals (z − H θ): (term index, value SI),
+    /// e.g. the antenna lever arm [m] and the IMU–GNSS time offset [s] given on the command line.
+    /// A term that is also a state of the model then estimates what is left.
+    pub known_gnss: Vec<(usize, f64)>,
 }
 
 impl FilterConfig {
@@ -94,6 +98,7 @@ impl FilterConfig {
             },
             keep_covariance: false,
             dense_reference: false,
+            known_gnss: Vec::new(),
         }
     }
 
@@ -327,10 +332,15 @@ struct Engine<'a> {
     acc: crate::model::RegressorAccumulator,
     r_mean: Vec<f64>,
     f_sum: Vector3<f64>,
+    /// Σ of the step's body rates [rad/s] (its mean is the point's w_b).
+    w_sum: Vector3<f64>,
     in_step: usize,
     step_t0: f64,
     /// (model index, term index) of every instrument term.
     terms: Vec<(usize, usize)>,
+    /// Model indices of the GNSS terms (they enter H; their closed-loop corrections apply to
+    /// the residuals).
+    gnss_terms: Vec<usize>,
     /// Closed-loop corrections per state (SI), applied to later increments.
     correction: Vec<f64>,
     np: NavPoint,
@@ -366,6 +376,15 @@ impl<'a> Engine<'a> {
                 StateRef::Nav(_) => None,
             })
             .collect();
+        let gnss_terms = model
+            .states
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| match *s {
+                StateRef::Term(k) if common::TERMS[k].sensor == Sensor::Gnss => Some(i),
+                _ => None,
+            })
+            .collect();
         let meas: Vec<(&'static str, usize)> = model
             .measurements()
             .iter()
@@ -385,9 +404,11 @@ impl<'a> Engine<'a> {
             acc: model.accumulator(),
             r_mean: vec![0.0; model.regressor_ids.len()],
             f_sum: Vector3::zeros(),
+            w_sum: Vector3::zeros(),
             in_step: 0,
             step_t0: start.t,
             terms,
+            gnss_terms,
             correction: vec![0.0; n],
             np: NavPoint::new(start.lat, start.h, start.v, &start.dcm(), &Vector3::zeros()),
             meas,
@@ -416,6 +437,8 @@ impl<'a> Engine<'a> {
                     match info.sensor {
                         Sensor::Gyro => dth[info.axis] -= self.correction[i] * r * dt,
                         Sensor::Accel => dvel[info.axis] -= self.correction[i] * r * dt,
+                        // a GNSS term's correction applies to the residuals (`update`)
+                        Sensor::Gnss => {}
                     }
                 }
             }
@@ -427,6 +450,7 @@ impl<'a> Engine<'a> {
         self.acc.add(&f_c, &w_c);
         obs.sample(&f_c, &w_c);
         self.f_sum += f_c;
+        self.w_sum += w_c;
         self.in_step += 1;
     }
 
@@ -437,6 +461,7 @@ impl<'a> Engine<'a> {
         let step_dt = t - self.step_t0;
         let f_mean = self.f_sum / self.in_step as f64;
         self.np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
+        self.np.set_rate(&(self.w_sum / self.in_step as f64));
         for &(i, j) in self.model.a_pattern() {
             self.a[i * n + j] = 0.0;
         }
@@ -465,6 +490,7 @@ impl<'a> Engine<'a> {
         obs.step(t, step_dt, &self.np, &self.a, self.model.a_pattern());
         self.acc.reset();
         self.f_sum = Vector3::zeros();
+        self.w_sum = Vector3::zeros();
         self.in_step = 0;
         self.step_t0 = t;
     }
@@ -475,14 +501,30 @@ impl<'a> Engine<'a> {
         let (n, s) = (self.n, self.nav.state);
         let f_ned = Vector3::from(self.np.f_ned);
         let c = s.dcm();
-        let np = NavPoint::new(s.lat, s.h, s.v, &c, &(c.transpose() * f_ned));
+        let mut np = NavPoint::new(s.lat, s.h, s.v, &c, &(c.transpose() * f_ned));
+        np.w_b = self.np.w_b;
         // the epoch is applied at the first sample at or after its time: the navigation state
         // is taken back to the fix time (a GNSS fix between two IMU samples, a jittered clock)
         let s_fix = state_at(&s, ep.t, &f_ned);
         for &(name, rows) in &self.meas {
-            let Some((z, sigma)) = residual(name, &s_fix, ep) else {
+            let Some((mut z, sigma)) = residual(name, &s_fix, ep) else {
                 continue;
             };
+            // known GNSS terms (lever arm, time offset): z − H θ_known
+            if !self.cfg.known_gnss.is_empty() {
+                let mi = common::MEASUREMENTS
+                    .iter()
+                    .position(|x| x.name == name)
+                    .expect("a spec measurement");
+                let known = &self.cfg.known_gnss;
+                common::measurement_entries(mi, &np, &mut |comp, state, v| {
+                    for &(t, theta) in known {
+                        if common::TERMS[t].name == state {
+                            z[comp] -= v * theta;
+                        }
+                    }
+                });
+            }
             let h = &mut self.h[..rows * n];
             h.iter_mut().for_each(|v| *v = 0.0);
             self.model
@@ -490,6 +532,13 @@ impl<'a> Engine<'a> {
                 .expect("the model supports the measurements it lists");
             for (comp, (&zc, &sc)) in z.iter().zip(&sigma).enumerate() {
                 let h_row = &self.h[comp * n..(comp + 1) * n];
+                // GNSS terms fed back (closed loop) are known values: z − H θ_fed
+                let zc = zc
+                    - self
+                        .gnss_terms
+                        .iter()
+                        .map(|&i| h_row[i] * self.correction[i])
+                        .sum::<f64>();
                 if !(zc.is_finite() && sc.is_finite()) {
                     self.nonfinite += 1;
                     self.first_nonfinite_t.get_or_insert(ep.t);

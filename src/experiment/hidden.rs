@@ -109,6 +109,7 @@ pub fn run_hidden_on(
 
 /// Adds term `term` with value `theta` (SI) to IMU increments: the sensor's output along its
 /// axis gains θ · regressor(f, ω) · Δt, the regressor formed from each increment's mean rates.
+/// A GNSS term changes nothing here (the simulator puts it into the aiding).
 pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
     let info = &common::TERMS[term];
     let mut prev = start_t;
@@ -122,6 +123,8 @@ pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
         match info.sensor {
             Sensor::Accel => smp.dv[info.axis] += theta * r * dt,
             Sensor::Gyro => smp.dtheta[info.axis] += theta * r * dt,
+            // a GNSS term is in the aiding, not in the IMU's increments
+            Sensor::Gnss => {}
         }
     }
 }

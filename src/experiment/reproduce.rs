@@ -210,7 +210,8 @@ pub fn aiding_from_truth(
     let sp = units::parse_quantity_as(&priors.sigma_p, "m")?;
     let mut rng = Rng::new(seed ^ 0xa1d);
     let mut out = Vec::new();
-    for row in sim.truth.iter().skip(1) {
+    // the truth as the receiver reports it (GNSS terms of the scenario applied)
+    for row in sim.gnss_truth.iter().skip(1) {
         let rm = crate::nav::earth::radius_meridian(row.lat) + row.h;
         let rn = crate::nav::earth::radius_transverse(row.lat) + row.h;
         let vel = velocity.then(|| {

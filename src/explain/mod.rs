@@ -572,10 +572,16 @@ fn complete_findings(ctx: &Context, r: &Rounds, base: &PassStats) -> anyhow::Res
         let (effect, effect_unit) = match info.sensor {
             Sensor::Accel => (effect_si / G0 * 1e3, "mg"),
             Sensor::Gyro => (effect_si * 180.0 / std::f64::consts::PI * 3600.0, "deg/h"),
+            // a GNSS term acts on the aiding as itself
+            Sensor::Gnss => (estimate, info.display),
         };
         let mut f = Finding {
             term: info.name.to_string(),
-            kind: "sensor",
+            kind: if info.sensor == Sensor::Gnss {
+                "measurement"
+            } else {
+                "sensor"
+            },
             estimate,
             sigma,
             unit: info.display.to_string(),
@@ -620,16 +626,18 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 }
 
 /// Why finding `f` probably stands in for something the candidates do not describe, if it
-/// does: it needs more than `stand_in_prior_sigmas` of its prior, or its round removed less
-/// than `stand_in_share` of the baseline's excess misfit while more than half of it is left
-/// (`unexplained`).
+/// does: it needs more than `stand_in_prior_sigmas` of its prior, or, beyond 3 prior σ, its
+/// round removed less than `stand_in_share` of the baseline's excess misfit while more than
+/// half of it is left (`unexplained`).
 fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
     let mut why = Vec::new();
     if f.prior_sigmas > opts.stand_in_prior_sigmas {
         why.push(format!("it needs {} prior σ", sig3(f.prior_sigmas)));
     }
     if let (Some(share), Some(left)) = (f.misfit_share, unexplained) {
-        if share < opts.stand_in_share && left > 0.5 {
+        // a value within a few prior σ that explains little is a small effect beside a larger
+        // unexplained one, not a stand-in
+        if share < opts.stand_in_share && left > 0.5 && f.prior_sigmas > 3.0 {
             why.push(format!(
                 "it removes {} % of the baseline's excess misfit and {} % of it is left",
                 sig3(100.0 * share.max(0.0)),
@@ -739,13 +747,15 @@ mod tests {
         assert!(stand_in_reason(&finding(3.0, None), None, &o).is_none());
         let far = stand_in_reason(&finding(91.0, Some(0.9)), Some(0.05), &o).unwrap();
         assert!(far.contains("91.0 prior σ"), "{far}");
-        let little = stand_in_reason(&finding(2.0, Some(0.08)), Some(0.9), &o).unwrap();
+        let little = stand_in_reason(&finding(5.0, Some(0.08)), Some(0.9), &o).unwrap();
         assert!(
             little.contains("8.00 %") && little.contains("90.0 %"),
             "{little}"
         );
-        // explaining little is a stand-in only while most of the misfit is left
-        assert!(stand_in_reason(&finding(2.0, Some(0.08)), Some(0.3), &o).is_none());
+        // explaining little is a stand-in only while most of the misfit is left …
+        assert!(stand_in_reason(&finding(5.0, Some(0.08)), Some(0.3), &o).is_none());
+        // … and beyond 3 prior σ (within them: a small effect beside a larger one)
+        assert!(stand_in_reason(&finding(0.6, Some(0.06)), Some(0.53), &o).is_none());
     }
 
     #[test]

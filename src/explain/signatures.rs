@@ -1,7 +1,7 @@
 //! Candidate signatures (Willsky–Jones GLR) riding along one filter pass.
 
 use crate::estimate::filter::Observer;
-use crate::model::catalog::StateRef;
+use crate::model::catalog::{Sensor, StateRef};
 use crate::model::generated::common;
 use crate::model::{Model, RegressorAccumulator};
 use crate::nav::nav_point::NavPoint;
@@ -47,6 +47,10 @@ pub(super) struct Signatures {
     pub(super) f_sum: Vector3<f64>,
     pub(super) f2_sum: f64,
     pub(super) count: usize,
+    /// Candidates that enter H instead of A (GNSS terms): (candidate index, term name).
+    pub(super) gnss: Vec<(usize, &'static str)>,
+    /// The navigation point of the last step (a GNSS candidate's H entry is evaluated there).
+    pub(super) np: Option<NavPoint>,
 }
 
 pub(super) fn reg_id(t: usize) -> usize {
@@ -117,6 +121,13 @@ impl Signatures {
             f_sum: Vector3::zeros(),
             f2_sum: 0.0,
             count: 0,
+            gnss: cands
+                .iter()
+                .enumerate()
+                .filter(|(_, &t)| common::TERMS[t].sensor == Sensor::Gnss)
+                .map(|(c, &t)| (c, common::TERMS[t].name))
+                .collect(),
+            np: None,
         }
     }
 }
@@ -150,6 +161,9 @@ impl Observer for Signatures {
 
     fn step(&mut self, t: f64, dt: f64, np: &NavPoint, a: &[f64], pattern: &[(usize, usize)]) {
         let (n, m) = (self.n, self.cands.len());
+        if !self.gnss.is_empty() {
+            self.np = Some(*np);
+        }
         self.acc.mean_into(&mut self.r_mean);
         self.acc.reset();
         if self.count > 0 {
@@ -201,8 +215,8 @@ impl Observer for Signatures {
     fn scalar_update(
         &mut self,
         _t: f64,
-        _meas: &'static str,
-        _component: usize,
+        meas: &'static str,
+        component: usize,
         h: &[f64],
         k: &[f64],
         nu: f64,
@@ -212,8 +226,20 @@ impl Observer for Signatures {
         if m == 0 {
             return;
         }
-        // G = H D (per candidate), then D ← D − K G
+        // G = H D (per candidate), plus a GNSS candidate's own H entry, then D ← D − K G
         self.g.iter_mut().for_each(|x| *x = 0.0);
+        if let (false, Some(np)) = (self.gnss.is_empty(), &self.np) {
+            if let Some(mi) = common::MEASUREMENTS.iter().position(|x| x.name == meas) {
+                let (g, gnss) = (&mut self.g, &self.gnss);
+                common::measurement_entries(mi, np, &mut |row, state, v| {
+                    if row == component {
+                        if let Some(&(c, _)) = gnss.iter().find(|x| x.1 == state) {
+                            g[c] += v;
+                        }
+                    }
+                });
+            }
+        }
         for (j, &hj) in h.iter().enumerate().take(n) {
             if hj != 0.0 {
                 for (g, d) in self.g.iter_mut().zip(&self.d[j * m..(j + 1) * m]) {

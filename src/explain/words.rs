@@ -52,6 +52,12 @@ pub fn separation_hint(a: usize, b: usize) -> String {
     );
     let ra = common::REGRESSORS[ta.regressor];
     let rb = common::REGRESSORS[tb.regressor];
+    if ta.sensor == Sensor::Gnss || tb.sensor == Sensor::Gnss {
+        return format!(
+            "{} and {} act on the fixes through the velocity, acceleration or attitude at each one: turns and speed changes in other directions, or a longer run with them, separate them",
+            ta.name, tb.name
+        );
+    }
     if ta.sensor != tb.sensor {
         return format!(
             "a {} term and a {} term: a longer run or a re-orientation separates them (a gyro error grows the tilt ∝ t after onset, an accelerometer error the velocity)",
@@ -97,6 +103,7 @@ pub(super) fn sensor_word(s: Sensor) -> &'static str {
     match s {
         Sensor::Gyro => "gyro",
         Sensor::Accel => "accelerometer",
+        Sensor::Gnss => "GNSS",
     }
 }
 
@@ -136,6 +143,9 @@ pub(super) fn finding_words(
     info: &crate::model::catalog::TermInfo,
     prior_display: f64,
 ) -> String {
+    if info.sensor == Sensor::Gnss {
+        return gnss_finding_words(f, info);
+    }
     let sensor = sensor_word(info.sensor);
     let axis = ["x", "y", "z"][info.axis];
     let reg = common::REGRESSORS[info.regressor];
@@ -203,7 +213,54 @@ pub(super) fn finding_words(
     }
     if let Some(why) = &f.stand_in {
         s.push_str(&format!(
-            ". It probably stands in for an effect the candidates do not describe ({why}): an IMU–GNSS time offset, an antenna lever arm, noise stated too small or an aiding error fit many sensor terms this way; do not read it as a property of the sensor"
+            ". It probably stands in for an effect the candidates do not describe ({why}): noise stated too small, an aiding error or a sensor effect outside the library fit sensor terms this way; do not read it as a property of the sensor"
+        ));
+    }
+    s
+}
+
+/// A GNSS term's finding in words: what it is, its value, and the shared tail (class, share
+/// of the misfit, stand-in).
+fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> String {
+    let mut s = format!(
+        "{} {} = {} ± {} {} (extended filter; {})",
+        info.group,
+        f.term,
+        sig3(f.estimate),
+        sig3(f.sigma),
+        f.unit,
+        info.doc
+    );
+    if !f.equivalent.is_empty() {
+        let others: Vec<String> = f
+            .equivalent_estimates
+            .iter()
+            .map(|e| {
+                format!(
+                    "{} (would need {} ± {} {})",
+                    e.term,
+                    sig3(e.estimate),
+                    sig3(e.sigma),
+                    e.unit
+                )
+            })
+            .collect();
+        s.push_str(&format!(
+            "; the data cannot separate it from {}; {}",
+            others.join(", "),
+            f.separate_by.join("; ")
+        ));
+    }
+    if let Some(share) = f.misfit_share {
+        s.push_str(&format!(
+            "; it explains {} % of the baseline's excess misfit (2Δℓ {})",
+            sig3(100.0 * share),
+            sig3(f.two_delta_loglik)
+        ));
+    }
+    if let Some(why) = &f.stand_in {
+        s.push_str(&format!(
+            ". It probably stands in for an effect the candidates do not describe ({why})"
         ));
     }
     s

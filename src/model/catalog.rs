@@ -10,6 +10,8 @@ pub enum Sensor {
     Gyro,
     /// Accelerometer: adds to the measured specific force [m/s²].
     Accel,
+    /// GNSS aiding: enters the measurements (H), not A — a time offset, an antenna lever arm.
+    Gnss,
 }
 
 /// A navigation error state as declared in `model-spec/navigation.toml`.

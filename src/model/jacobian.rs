@@ -114,13 +114,15 @@ impl PointSpec {
             self.euler_deg[1] * d,
             self.euler_deg[2] * d,
         );
-        NavPoint::new(
+        let mut np = NavPoint::new(
             self.lat_deg * d,
             self.h_m,
             Vector3::from(self.v_ned),
             &c,
             &Vector3::from(self.f_b),
-        )
+        );
+        np.set_rate(&Vector3::from(self.w_b));
+        np
     }
 }
 

@@ -385,6 +385,8 @@ impl Model {
         let mut missing = None;
         common::measurement_entries(idx, nav, &mut |row, state, v| match self.index_of(state) {
             Some(j) => h[row * n + j] = v,
+            // a GNSS term's entry applies only when the term is in the model
+            None if common::TERMS.iter().any(|t| t.name == state) => {}
             None => missing = Some(state),
         });
         match missing {

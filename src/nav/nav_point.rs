@@ -27,6 +27,9 @@ pub struct NavPoint {
     pub dg_dlat: f64,
     /// ∂γ/∂h [1/s²].
     pub dg_dh: f64,
+    /// Body angular rate w^b_ib, FRD [rad/s] (the step mean; zero until set with
+    /// [`NavPoint::set_rate`]).
+    pub w_b: [f64; 3],
 }
 
 impl NavPoint {
@@ -42,7 +45,9 @@ impl NavPoint {
         f_b: &Vector3<f64>,
     ) {
         if (lat - self.lat).abs() > 1e-9 || (h - self.h).abs() > 1e-3 {
+            let w_b = self.w_b;
             *self = NavPoint::new(lat, h, v_ned, c_bn, f_b);
+            self.w_b = w_b;
             return;
         }
         let f_n = c_bn * f_b;
@@ -82,6 +87,12 @@ impl NavPoint {
             c,
             dg_dlat: earth::gravity_dlat(lat, h),
             dg_dh: earth::gravity_dh(lat, h),
+            w_b: [0.0; 3],
         }
+    }
+
+    /// Sets the body angular rate w^b_ib [rad/s] (FRD) the point's H entries may use.
+    pub fn set_rate(&mut self, w_b: &Vector3<f64>) {
+        self.w_b = [w_b.x, w_b.y, w_b.z];
     }
 }

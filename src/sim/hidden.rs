@@ -8,6 +8,30 @@ use crate::sim::rng::Rng;
 /// Library groups a case can hide a term from.
 pub const GROUPS: [&str; 7] = ["d", "kaq", "kas", "kao", "kgf", "kgq", "size"];
 
+/// Groups of GNSS (measurement) terms a case can hide, on a drive with turns and speed
+/// changes: the IMU–GNSS time offset (20–300 ms times `effect`), the same with a gyro
+/// g-sensitivity kgf_yx beside it (3 deg/h/(m/s²) times `effect`, MEMS class), and the antenna
+/// lever arm (0.1–2 m times `effect`). No vibration: the time offset's velocity rows use the
+/// step's specific force, which vibration faster than the offset would not average.
+pub const GNSS_GROUPS: [&str; 3] = ["gnss_time", "gnss_time_kgf", "gnss_lever"];
+
+/// A drive for the GNSS cases: 60 s at rest, a start to 20 m/s, then minute-long cycles of a
+/// turn (±6 deg/s for 15 s), a speed change (±1 m/s² for 10 s) and straight driving.
+fn drive_segments(seconds: f64) -> String {
+    let n = ((seconds - 70.0) / 60.0).floor().max(1.0) as usize;
+    let mut s = String::from(
+        "[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = 2.0\n",
+    );
+    for i in 0..n {
+        let r = if i % 2 == 0 { 6.0 } else { -6.0 };
+        let a = if (i / 2) % 2 == 0 { 1.0 } else { -1.0 };
+        s.push_str(&format!(
+            "[[segment]]\nkind = \"turn\"\nduration_s = 15.0\nyaw_rate_deg_s = {r}\n[[segment]]\nkind = \"cruise\"\nduration_s = 20.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = {a}\n[[segment]]\nkind = \"cruise\"\nduration_s = 15.0\n"
+        ));
+    }
+    s
+}
+
 /// Standard gravity [m/s²].
 const G0: f64 = 9.806_65;
 
@@ -290,21 +314,38 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
                     let v = effect_si_acc / (om * om / 2.0);
                     hidden.push((name.into(), v));
                 }
+                "gnss_time" | "gnss_time_kgf" => {
+                    segments = drive_segments(seconds);
+                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                    // 20–300 ms
+                    let dt = sgn * effect * (0.02 + 0.28 * rng.uniform());
+                    hidden.push(("dt_gnss".into(), dt));
+                    if g == "gnss_time_kgf" {
+                        // and a sensor term beside it: a MEMS-class gyro g-sensitivity, excited
+                        // by the drive's speed changes (±1 m/s²) and turns
+                        hidden.push(("kgf_yx".into(), 3.0 * effect_si_gyro));
+                    }
+                }
+                "gnss_lever" => {
+                    segments = drive_segments(seconds);
+                    let name = *pick(&mut rng, &["lever_x", "lever_y"]);
+                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                    // 0.1–2 m
+                    hidden.push((name.into(), sgn * effect * (0.1 + 1.9 * rng.uniform())));
+                }
                 other => panic!("unknown group {other}"),
             }
-            description =
-                format!(
-                    "{} hidden ({} {}), baseline {baseline}",
-                    hidden[0].0,
-                    effect,
-                    if common::TERMS.iter().any(|t| t.name == hidden[0].0
-                        && t.sensor == crate::model::catalog::Sensor::Gyro)
-                    {
-                        "deg/h"
-                    } else {
-                        "mg"
-                    }
-                );
+            let info = common::TERMS.iter().find(|t| t.name == hidden[0].0);
+            let size = match info.map(|t| t.sensor) {
+                Some(crate::model::catalog::Sensor::Gyro) => format!("{effect} deg/h"),
+                // a GNSS term: its value
+                Some(crate::model::catalog::Sensor::Gnss) => {
+                    let t = info.expect("matched");
+                    format!("{:.3} {}", hidden[0].1 / t.display_to_si, t.display)
+                }
+                _ => format!("{effect} mg"),
+            };
+            description = format!("{} hidden ({size}), baseline {baseline}", hidden[0].0);
         }
     }
     let skip: Vec<String> = hidden.iter().map(|h| h.0.clone()).collect();
@@ -319,7 +360,7 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
     );
     // g-sensitivities of several deg/h/g belong to a MEMS-class gyro, not to the spec's laser
     // gyro (0.01 deg/h/g): the case declares that class, as a user would with --prior
-    let priors = if group == "kgf" {
+    let priors = if group == "kgf" || group == "gnss_time_kgf" {
         let sigma = 10.0 * std::f64::consts::PI / 180.0 / 3600.0 / G0; // 10 deg/h/g
         common::TERMS
             .iter()

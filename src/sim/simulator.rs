@@ -22,6 +22,10 @@ pub struct SimOutput {
     pub imu: ImuData,
     /// Truth at the truth rate, starting at t = 0.
     pub truth: Vec<TruthRow>,
+    /// The truth as the GNSS receiver reports it at each truth row: `truth` moved by the
+    /// scenario's GNSS terms (antenna lever arm, time offset; through their H entries), equal
+    /// to `truth` without them. Aiding formed from truth uses it.
+    pub gnss_truth: Vec<TruthRow>,
     /// GNSS fixes.
     pub gnss: Vec<PositionFix>,
     /// GNSS velocities, one per fix, when the scenario's `[gnss]` gives `sigma_v`.
@@ -51,6 +55,49 @@ fn body_signals(
     let ct = k.c.transpose();
     let rate = Vector3::new(v.x / e.rm, v.y / (e.rn * e.cos), -v.z);
     (ct * f_n, ct * (e.w_ie + w_en) + k.w_nb, rate)
+}
+
+/// How far before a fix the kinematics that move it through the GNSS terms' H are taken [s]:
+/// the acceleration of the IMU step that ends at the fix, as the filter sees it (a scenario's
+/// segment accelerations jump at segment boundaries, which fall on fix times; the left limit
+/// is also the physical one for a negative time offset).
+const KINEMATICS_BEFORE: f64 = 1e-6;
+
+/// The truth row `row` as a GNSS receiver with the GNSS terms `terms` ((term, value SI)) reports
+/// it: each measurement row's value moves by Σ H θ (the terms' H entries of the spec at the true
+/// point), z = computed − aided read back into the aided position and velocity. `row` itself
+/// without terms.
+fn gnss_shift(
+    row: &TruthRow,
+    e: &earth::LocalEarth,
+    k: &crate::sim::trajectory::Kinematics,
+    terms: &[(usize, f64)],
+) -> TruthRow {
+    if terms.is_empty() {
+        return *row;
+    }
+    let (f_b, w_b, _) = body_signals(e, k);
+    let mut np = crate::nav::nav_point::NavPoint::new(row.lat, row.h, row.v, &k.c, &f_b);
+    np.set_rate(&w_b);
+    let mut out = *row;
+    for (m, info) in common::MEASUREMENTS.iter().enumerate() {
+        common::measurement_entries(m, &np, &mut |comp, state, value| {
+            let Some(&(_, theta)) = terms.iter().find(|(t, _)| common::TERMS[*t].name == state)
+            else {
+                return;
+            };
+            let shift = value * theta;
+            match info.rows[comp].name {
+                "dp_n" => out.lat -= shift / np.rm,
+                "dp_e" => out.lon -= shift / (np.rn * row.lat.cos()),
+                "dp_u" => out.h -= shift,
+                "dv_n" => out.v.x -= shift,
+                "dv_e" => out.v.y -= shift,
+                other => panic!("the simulator does not know how measurement row `{other}` reads back into a fix"),
+            }
+        });
+    }
+    out
 }
 
 /// Runs a scenario. `progress` is called with the fraction done (for a progress bar).
@@ -95,6 +142,18 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         v: k0.v,
         euler: k0.euler,
     }];
+    let gnss_terms: Vec<(usize, f64)> = sc
+        .errors
+        .iter()
+        .copied()
+        .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Gnss)
+        .collect();
+    let mut gnss_truth = vec![gnss_shift(
+        &truth[0],
+        &earth::LocalEarth::new(lat, h),
+        &k0,
+        &gnss_terms,
+    )];
     let mut gnss = Vec::new();
     let mut gnss_velocity = Vec::new();
     let mut samples = Vec::with_capacity(n);
@@ -126,6 +185,8 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                     match inj.sensor {
                         Sensor::Gyro => om[inj.axis] += inj.value * r,
                         Sensor::Accel => fm[inj.axis] += inj.value * r,
+                        // in the aiding (`gnss_shift`), not in the IMU
+                        Sensor::Gnss => {}
                     }
                 }
                 let wt = 0.5 * hsub * w;
@@ -170,18 +231,39 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         h = h1;
         if (i + 1) % truth_every == 0 {
             let k1 = traj.at(t1);
-            truth.push(TruthRow {
+            let row = TruthRow {
                 t: t1,
                 lat,
                 lon,
                 h,
                 v: k1.v,
                 euler: k1.euler,
-            });
+            };
+            truth.push(row);
+            gnss_truth.push(gnss_shift(
+                &row,
+                &e,
+                &traj.at(t1 - KINEMATICS_BEFORE),
+                &gnss_terms,
+            ));
         }
         if let (Some(every), Some((_, sne, sd, noisy))) = (gnss_every, sc.gnss) {
             if (i + 1) % every == 0 {
-                let (mut glat, mut glon, mut gh) = (lat, lon, h);
+                let k1 = traj.at(t1);
+                let seen = gnss_shift(
+                    &TruthRow {
+                        t: t1,
+                        lat,
+                        lon,
+                        h,
+                        v: k1.v,
+                        euler: k1.euler,
+                    },
+                    &e,
+                    &traj.at(t1 - KINEMATICS_BEFORE),
+                    &gnss_terms,
+                );
+                let (mut glat, mut glon, mut gh) = (seen.lat, seen.lon, seen.h);
                 if noisy {
                     glat += sne * rng.normal() / (earth::radius_meridian(lat) + h);
                     glon += sne * rng.normal() / ((earth::radius_transverse(lat) + h) * lat.cos());
@@ -195,7 +277,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                     sigma: [sne, sne, sd],
                 });
                 if let Some(sv) = sc.gnss_sigma_v {
-                    let mut v = traj.at(t1).v;
+                    let mut v = seen.v;
                     if noisy {
                         for j in 0..3 {
                             v[j] += sv * rng_v.normal();
@@ -219,6 +301,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
     SimOutput {
         imu: ImuData { samples },
         truth,
+        gnss_truth,
         gnss,
         gnss_velocity: sc.gnss_sigma_v.map(|_| gnss_velocity),
         start,
