@@ -57,8 +57,19 @@ fn check_found(kind: CaseKind, seed: u64) {
             rel * 100.0
         );
     }
-    // nothing named that is neither hidden nor in a class with a hidden term
-    for f in &e.findings {
+    // nothing named that is neither hidden nor in a class with a hidden term; a noise finding
+    // may only be the true one that the simulated heights are noise-free (aiding_from_truth
+    // states σ for them but adds none)
+    for f in e.findings.iter().filter(|f| f.kind == "noise") {
+        assert!(
+            f.term == "sigma_pos_h" && f.scale.unwrap() < 1.0,
+            "{}: noise finding {}: {}",
+            case.description,
+            f.term,
+            f.words
+        );
+    }
+    for f in e.findings.iter().filter(|f| f.kind != "noise") {
         let related = case
             .hidden
             .iter()
@@ -277,4 +288,45 @@ fn known_gnss_values_are_applied_in_the_residuals() {
             "{group}: half of it {half}, all of it {right}"
         );
     }
+}
+
+/// Noise as a finding: the fixes state a position σ four times smaller than their real noise;
+/// explain names that scale (within 10 %) and no error term.
+#[test]
+fn finds_an_aiding_sigma_stated_too_small() {
+    use sinsmodel::experiment::hidden::{run_hidden_on, simulate_case};
+    let case = generate(11, CaseKind::Null, SECONDS, 1.0);
+    let (sim, mut aid) = simulate_case(&case).unwrap();
+    for ep in &mut aid {
+        if let Some(p) = &mut ep.pos {
+            for s in &mut p.3 {
+                *s /= 4.0;
+            }
+        }
+    }
+    let out = run_hidden_on(&case, &sim, &aid, &ExplainOptions::default()).unwrap();
+    let e = &out.explanation;
+    let kinds: Vec<(&str, &str)> = e
+        .findings
+        .iter()
+        .map(|f| (f.term.as_str(), f.kind))
+        .collect();
+    assert!(
+        e.findings.iter().all(|f| f.kind == "noise"),
+        "an error term named: {kinds:?}"
+    );
+    let f = e
+        .findings
+        .iter()
+        .find(|f| f.term == "sigma_pos_ne")
+        .unwrap_or_else(|| panic!("no position sigma finding: {kinds:?}; {:#?}", e.summary));
+    let scale = f.scale.unwrap();
+    assert!((scale / 4.0 - 1.0).abs() < 0.10, "scale {scale}");
+    let [lo, hi] = f.scale_interval.unwrap();
+    assert!(lo < scale && scale < hi);
+    assert!(
+        e.extended.nis_mean < 1.2,
+        "NIS after {}",
+        e.extended.nis_mean
+    );
 }

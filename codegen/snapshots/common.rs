@@ -2018,15 +2018,6 @@ pub fn measurement_entries(
 ) {
     match m {
         0 => {
-            let lat = nav.lat;
-            let vn = nav.v_ned[0];
-            let ve = nav.v_ned[1];
-            let vd = nav.v_ned[2];
-            let rm = nav.rm;
-            let rn = nav.rn;
-            let omega = nav.omega;
-            let f_n = nav.f_ned[0];
-            let f_e = nav.f_ned[1];
             let c11 = nav.c[0][0];
             let c12 = nav.c[0][1];
             let c13 = nav.c[0][2];
@@ -2036,23 +2027,15 @@ pub fn measurement_entries(
             let w_x = nav.w_b[0];
             let w_y = nav.w_b[1];
             let w_z = nav.w_b[2];
+            let a_n = nav.a_ned[0];
+            let a_e = nav.a_ned[1];
             emit(0, "dv_n", 1.0);
-            emit(
-                0,
-                "dt_gnss",
-                -(f_n - (2.0 * omega * lat.sin() + ve * lat.tan() / rn) * ve
-                    + vn * vd / rm),
-            );
+            emit(0, "dt_gnss", -a_n);
             emit(0, "lever_x", -(c12 * w_z - c13 * w_y));
             emit(0, "lever_y", -(c13 * w_x - c11 * w_z));
             emit(0, "lever_z", -(c11 * w_y - c12 * w_x));
             emit(1, "dv_e", 1.0);
-            emit(
-                1,
-                "dt_gnss",
-                -(f_e + (2.0 * omega * lat.sin() + ve * lat.tan() / rn) * vn
-                    + ve * vd / rn + 2.0 * omega * lat.cos() * vd),
-            );
+            emit(1, "dt_gnss", -a_e);
             emit(1, "lever_x", -(c22 * w_z - c23 * w_y));
             emit(1, "lever_y", -(c23 * w_x - c21 * w_z));
             emit(1, "lever_z", -(c21 * w_y - c22 * w_x));

@@ -30,6 +30,9 @@ fn nav_accessor(sym: &str) -> TokenStream {
         "w_x" => quote!(nav.w_b[0]),
         "w_y" => quote!(nav.w_b[1]),
         "w_z" => quote!(nav.w_b[2]),
+        "a_n" => quote!(nav.a_ned[0]),
+        "a_e" => quote!(nav.a_ned[1]),
+        "a_d" => quote!(nav.a_ned[2]),
         s if s.len() == 3
             && s.starts_with('c')
             && s[1..].chars().all(|c| ('1'..='3').contains(&c)) =>

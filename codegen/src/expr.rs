@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 /// Navigation quantities an A or H expression may use, with what they are (SI units).
 /// The generated code binds each one from `NavPoint` (see `nav_accessor`).
-pub const NAV_SYMBOLS: [(&str, &str); 25] = [
+pub const NAV_SYMBOLS: [(&str, &str); 28] = [
     ("lat", "geodetic latitude [rad]"),
     ("h", "height above the ellipsoid, up [m]"),
     ("vn", "north velocity [m/s]"),
@@ -44,6 +44,18 @@ pub const NAV_SYMBOLS: [(&str, &str); 25] = [
     ),
     ("w_y", "body angular rate about y [rad/s]"),
     ("w_z", "body angular rate about z [rad/s]"),
+    (
+        "a_n",
+        "north acceleration of the solution, dv/dt over the last second [m/s^2]",
+    ),
+    (
+        "a_e",
+        "east acceleration, dv/dt over the last second [m/s^2]",
+    ),
+    (
+        "a_d",
+        "down acceleration, dv/dt over the last second [m/s^2]",
+    ),
 ];
 
 /// Dimension of a navigation symbol (an H entry's unit is checked with it), doubled exponents
@@ -55,7 +67,7 @@ fn nav_symbol_dim(name: &str) -> Option<crate::units::Dim> {
         "h" | "rm" | "rn" => Dim([2, 0, 0]),
         "vn" | "ve" | "vd" => Dim([2, -2, 0]),
         "omega" | "w_x" | "w_y" | "w_z" => crate::units::DIM_RATE,
-        "f_n" | "f_e" | "f_d" => crate::units::DIM_ACCEL,
+        "f_n" | "f_e" | "f_d" | "a_n" | "a_e" | "a_d" => crate::units::DIM_ACCEL,
         "dg_dlat" => Dim([2, -4, -2]),
         "dg_dh" => Dim([0, -4, 0]),
         c if c.len() == 3 && c.starts_with('c') => crate::units::DIM_ONE,

@@ -452,7 +452,7 @@ fn gnss_terms_are_checked() {
     // but a velocity row is in m/s
     expect_error(
         "terms.toml",
-        "{ row = \"dv_n\", expr = \"-(f_n - (2.0 * omega * lat.sin() + ve * lat.tan() / rn) * ve + vn * vd / rm)\" }",
+        "{ row = \"dv_n\", expr = \"-a_n\" }",
         "{ row = \"dv_n\", expr = \"-vn\" }",
         "{ row = \"dv_n\", expr = \"-vn\" }",
         "term `dt_gnss`",

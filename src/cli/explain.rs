@@ -118,6 +118,9 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         args.data.config(&baseline, true)?;
         let mut opts = opts.clone();
         opts.candidate_sigma = args.data.term_priors()?;
+        // a static aid's or a ZUPT's σ is a tuning choice, not a receiver's: noise levels are
+        // tested with GNSS aiding only
+        opts.noise_levels = args.data.has_gnss();
         let inputs = args.data.input_paths();
         let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
         let out = OutputDir::create(&args.out, &refs)?;

@@ -68,6 +68,9 @@ pub struct FilterConfig {
     /// e.g. the antenna lever arm [m] and the IMU–GNSS time offset [s] given on the command line.
     /// A term that is also a state of the model then estimates what is left.
     pub known_gnss: Vec<(usize, f64)>,
+    /// Scales of the aiding's stated 1-σ per measurement (name, factor): the σ a fix states
+    /// times the factor enters R (1 when absent).
+    pub sigma_scale: Vec<(&'static str, f64)>,
 }
 
 impl FilterConfig {
@@ -99,7 +102,38 @@ impl FilterConfig {
             keep_covariance: false,
             dense_reference: false,
             known_gnss: Vec::new(),
+            sigma_scale: Vec::new(),
         }
+    }
+
+    /// Multiplies the white sensor noise in q by `arw_scale` (gyro) and `vrw_scale`
+    /// (accelerometer): the densities scale, q by their squares.
+    pub fn scale_sensor_noise(&mut self, model: &Model, arw_scale: f64, vrw_scale: f64) {
+        for (i, s) in model.states.iter().enumerate() {
+            if let StateRef::Nav(k) = *s {
+                match common::NAV_STATES[k].white_noise {
+                    WhiteNoise::GyroArw => self.q[i] *= arw_scale * arw_scale,
+                    WhiteNoise::AccelVrw => self.q[i] *= vrw_scale * vrw_scale,
+                    WhiteNoise::None => {}
+                }
+            }
+        }
+    }
+
+    /// White sensor noise densities in q: (ARW [rad/√s], VRW [m/s/√s]) of the first attitude and
+    /// velocity state (0 when the model has none).
+    pub fn sensor_noise(&self, model: &Model) -> (f64, f64) {
+        let (mut arw, mut vrw) = (0.0, 0.0);
+        for (i, s) in model.states.iter().enumerate() {
+            if let StateRef::Nav(k) = *s {
+                match common::NAV_STATES[k].white_noise {
+                    WhiteNoise::GyroArw if arw == 0.0 => arw = self.q[i].sqrt(),
+                    WhiteNoise::AccelVrw if vrw == 0.0 => vrw = self.q[i].sqrt(),
+                    _ => {}
+                }
+            }
+        }
+        (arw, vrw)
     }
 
     /// Sets the white sensor noise used in q: ARW [rad/√s] and VRW [m/s/√s].
@@ -334,6 +368,8 @@ struct Engine<'a> {
     f_sum: Vector3<f64>,
     /// Σ of the step's body rates [rad/s] (its mean is the point's w_b).
     w_sum: Vector3<f64>,
+    /// The solution's velocity over the last second, for the point's acceleration a_ned.
+    accel: crate::nav::nav_point::AccelWindow,
     in_step: usize,
     step_t0: f64,
     /// (model index, term index) of every instrument term.
@@ -405,6 +441,7 @@ impl<'a> Engine<'a> {
             r_mean: vec![0.0; model.regressor_ids.len()],
             f_sum: Vector3::zeros(),
             w_sum: Vector3::zeros(),
+            accel: crate::nav::nav_point::AccelWindow::default(),
             in_step: 0,
             step_t0: start.t,
             terms,
@@ -462,6 +499,7 @@ impl<'a> Engine<'a> {
         let f_mean = self.f_sum / self.in_step as f64;
         self.np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
         self.np.set_rate(&(self.w_sum / self.in_step as f64));
+        self.np.set_acceleration(&self.accel.push(t, s.v));
         for &(i, j) in self.model.a_pattern() {
             self.a[i * n + j] = 0.0;
         }
@@ -502,14 +540,17 @@ impl<'a> Engine<'a> {
         let f_ned = Vector3::from(self.np.f_ned);
         let c = s.dcm();
         let mut np = NavPoint::new(s.lat, s.h, s.v, &c, &(c.transpose() * f_ned));
-        np.w_b = self.np.w_b;
+        (np.w_b, np.a_ned) = (self.np.w_b, self.np.a_ned);
         // the epoch is applied at the first sample at or after its time: the navigation state
         // is taken back to the fix time (a GNSS fix between two IMU samples, a jittered clock)
         let s_fix = state_at(&s, ep.t, &f_ned);
         for &(name, rows) in &self.meas {
-            let Some((mut z, sigma)) = residual(name, &s_fix, ep) else {
+            let Some((mut z, mut sigma)) = residual(name, &s_fix, ep) else {
                 continue;
             };
+            if let Some(&(_, k)) = self.cfg.sigma_scale.iter().find(|x| x.0 == name) {
+                sigma.iter_mut().for_each(|v| *v *= k);
+            }
             // known GNSS terms (lever arm, time offset): z − H θ_known
             if !self.cfg.known_gnss.is_empty() {
                 let mi = common::MEASUREMENTS

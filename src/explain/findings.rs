@@ -89,6 +89,11 @@ pub struct Finding {
     /// Why it probably stands in for an effect the candidates do not describe (it needs
     /// ≫ its prior, or it explains little of the misfit); absent for a finding read as a cause.
     pub stand_in: Option<String>,
+    /// A noise finding's maximum-likelihood scale of the stated value (white noise density, or
+    /// the aiding's stated 1-σ).
+    pub scale: Option<f64>,
+    /// Its approximate 95 % interval.
+    pub scale_interval: Option<[f64; 2]>,
 }
 
 /// A term the data cannot tell from a finding, and the value it would need.

@@ -28,6 +28,7 @@
 
 mod diagnostics;
 mod findings;
+mod noise;
 mod selection;
 mod signatures;
 mod words;
@@ -81,6 +82,8 @@ pub struct ExplainOptions {
     /// A finding that removes less than this fraction of the baseline's excess mean NIS, while
     /// more than half of it is left, is reported as probably standing in (same reason).
     pub stand_in_share: f64,
+    /// Test the noise levels (white noise, aiding σ) when the extended model is inconsistent.
+    pub noise_levels: bool,
     /// Test only: when a candidate passes, name a pseudo-random one of the pool instead of the
     /// best, unconfirmed (a selector naming terms at random, which the evaluation must catch).
     pub broken_selector: bool,
@@ -97,6 +100,7 @@ impl Default for ExplainOptions {
             max_prior_sigmas: 100.0,
             stand_in_prior_sigmas: 30.0,
             stand_in_share: 0.2,
+            noise_levels: true,
             candidate_sigma: Vec::new(),
             broken_selector: false,
         }
@@ -274,11 +278,14 @@ pub fn explain(
         opts,
     };
     let r = select_and_retest(&ctx, cands, base, &eligible, progress)?;
-    let findings = complete_findings(&ctx, &r, &base_stats)?;
+    let (noise_findings, noise_pass) = noise_stage(&ctx, &r, &base_stats, progress)?;
+    // the extended pass is the last one run (the baseline itself when nothing was found)
+    let last_pass = noise_pass.as_ref().unwrap_or(&r.pass);
+    let mut findings = complete_findings(&ctx, &r, &base_stats, last_pass.stats.nis_mean)?;
+    findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
-    // the extended pass is the last one run (the baseline itself when nothing was found)
-    let extended_stats = r.pass.stats.clone();
+    let extended_stats = last_pass.stats.clone();
     let gain = Gain {
         loglik: extended_stats.loglik - base_stats.loglik,
         nis_mean_before: base_stats.nis_mean,
@@ -310,9 +317,9 @@ pub fn explain(
         summary: Vec::new(),
         misfit_unexplained: misfit_unexplained.map(|u| u.max(0.0)),
         innovations_before,
-        innovations_after: normalised(&r.pass.run),
+        innovations_after: normalised(&last_pass.run),
         model_error_before,
-        model_error_after: model_error_series(&r.pass.run),
+        model_error_after: model_error_series(&last_pass.run),
     };
     expl.summary = summary(&expl);
     Ok(expl)
@@ -544,9 +551,14 @@ fn select_and_retest(
 
 /// The findings of the rounds: each named term with the extended filter's estimate, its prior,
 /// its mean regressor and effect on these data, and the words.
-fn complete_findings(ctx: &Context, r: &Rounds, base: &PassStats) -> anyhow::Result<Vec<Finding>> {
+fn complete_findings(
+    ctx: &Context,
+    r: &Rounds,
+    base: &PassStats,
+    final_nis: f64,
+) -> anyhow::Result<Vec<Finding>> {
     let excess = baseline_excess(base);
-    let unexplained = excess.map(|e| (r.pass.stats.nis_mean - 1.0) / e);
+    let unexplained = excess.map(|e| (final_nis - 1.0) / e);
     let terms: Vec<usize> = r.named.iter().map(|n| n.term).collect();
     let means = if terms.is_empty() {
         Vec::new()
@@ -609,12 +621,159 @@ fn complete_findings(ctx: &Context, r: &Rounds, base: &PassStats) -> anyhow::Res
             misfit_share: excess.map(|e| n.nis_removed / e),
             prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
             stand_in: None,
+            scale: None,
+            scale_interval: None,
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
         f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         out.push(f);
     }
     Ok(out)
+}
+
+/// Noise levels as findings (after the terms): when the extended model's mean NIS lies outside
+/// its 95 % band, the ML scale of each noise level is tested against 1; the significant ones
+/// become findings of kind `noise` and a last pass with them is the extended one.
+fn noise_stage(
+    ctx: &Context,
+    r: &Rounds,
+    base: &PassStats,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<(Vec<Finding>, Option<Pass>)> {
+    let st = &r.pass.stats;
+    let n: usize = st.channels.iter().map(|c| c.count).sum();
+    let band = stats::mean_chi2_band(1.0, n.max(1), 1.959_964);
+    if !ctx.opts.noise_levels || (st.nis_mean >= band[0] && st.nis_mean <= band[1]) {
+        return Ok((Vec::new(), None));
+    }
+    let mut levels = vec![noise::Level::GyroArw, noise::Level::AccelVrw];
+    for i in &r.pass.run.innovations {
+        if !levels.contains(&noise::Level::Sigma(i.meas)) {
+            levels.push(noise::Level::Sigma(i.meas));
+        }
+    }
+    let cfg = ctx.extended_config(&r.model, &r.widened)?;
+    let round = r.rounds + 1;
+    let (fits, cfg_noise) = noise::fit(
+        &r.model,
+        &cfg,
+        &levels,
+        ctx.data,
+        (st.loglik, r.pass.run.innovations.len()),
+        ctx.opts,
+        &mut |f| progress(round, f),
+    )?;
+    if !fits.iter().any(|f| f.significant) {
+        return Ok((Vec::new(), None));
+    }
+    let pass = run_pass(&r.model, &[], ctx.data, &cfg_noise, &mut |f| {
+        progress(round + 1, f)
+    })?;
+    let excess = baseline_excess(base);
+    let removed = st.nis_mean - pass.stats.nis_mean;
+    let total: f64 = fits
+        .iter()
+        .filter(|f| f.significant)
+        .map(|f| f.two_delta_loglik)
+        .sum();
+    let (arw, vrw) = cfg.sensor_noise(&r.model);
+    let findings = fits
+        .iter()
+        .filter(|f| f.significant)
+        .map(|f| {
+            let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
+            noise_finding(
+                f,
+                arw,
+                vrw,
+                excess.map(|e| removed * w / e),
+                f.two_delta_loglik,
+            )
+        })
+        .collect();
+    Ok((findings, Some(pass)))
+}
+
+/// The finding of a significant noise level: the level the data show in the user's unit, its
+/// scale of the stated value and the interval.
+fn noise_finding(
+    f: &noise::LevelFit,
+    arw: f64,
+    vrw: f64,
+    misfit_share: Option<f64>,
+    two_delta_loglik: f64,
+) -> Finding {
+    let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0; // rad/√s → deg/√h
+    let ug_rt_hz = 1e6 / G0; // m/s/√s → µg/√Hz
+    let (stated, unit, what) = match f.level {
+        noise::Level::GyroArw => (
+            arw * deg_rt_h,
+            "deg/sqrt(h)",
+            "a gyro white noise (angle random walk)".to_string(),
+        ),
+        noise::Level::AccelVrw => (
+            vrw * ug_rt_hz,
+            "ug/sqrt(Hz)",
+            "an accelerometer white noise (velocity random walk)".to_string(),
+        ),
+        noise::Level::Sigma(m) => (1.0, "x stated", format!("a 1-σ of the {m} aiding")),
+    };
+    let estimate = stated * f.scale;
+    let [lo, hi] = f.interval;
+    let words = match f.level {
+        noise::Level::Sigma(_) => format!(
+            "the data show {what} {}× the σ the fixes state (95 % interval {}–{}×; 2Δℓ {})",
+            sig3(f.scale),
+            sig3(lo),
+            sig3(hi),
+            sig3(f.two_delta_loglik)
+        ),
+        _ => format!(
+            "the data show {what} of {} {unit}, {}× the stated {} (95 % interval {}–{}×; 2Δℓ {})",
+            sig3(estimate),
+            sig3(f.scale),
+            sig3(stated),
+            sig3(lo),
+            sig3(hi),
+            sig3(f.two_delta_loglik)
+        ),
+    };
+    let words = match misfit_share {
+        Some(s) => format!(
+            "{words}; it explains {} % of the baseline's excess misfit",
+            sig3(100.0 * s.max(0.0))
+        ),
+        None => words,
+    };
+    Finding {
+        term: f.level.name(),
+        kind: "noise",
+        estimate,
+        sigma: stated * f.scale * (hi / lo).ln() / (2.0 * 1.959_964),
+        unit: unit.into(),
+        llr: f.two_delta_loglik,
+        p_value: f.p_holm,
+        equivalent: Vec::new(),
+        equivalent_estimates: Vec::new(),
+        glr_estimate: estimate,
+        glr_sigma: f64::NAN,
+        round: 0,
+        confounded_with: None,
+        regressor_mean: 0.0,
+        regressor_unit: String::new(),
+        effect: estimate,
+        effect_unit: unit.into(),
+        separate_by: Vec::new(),
+        prior_sigma: stated,
+        prior_widened: false,
+        words,
+        two_delta_loglik,
+        misfit_share,
+        prior_sigmas: 0.0,
+        stand_in: None,
+        scale: Some(f.scale),
+        scale_interval: Some(f.interval),
+    }
 }
 
 /// The baseline's excess mean NIS (mean NIS − 1) when it lies above the 95 % band of its count
@@ -627,21 +786,24 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 
 /// Why finding `f` probably stands in for something the candidates do not describe, if it
 /// does: it needs more than `stand_in_prior_sigmas` of its prior, or, beyond 3 prior σ, its
-/// round removed less than `stand_in_share` of the baseline's excess misfit while more than
-/// half of it is left (`unexplained`).
+/// round removed less than `stand_in_share` of the baseline's excess misfit (`unexplained`, the
+/// share the extended model leaves, is said with it).
 fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
     let mut why = Vec::new();
     if f.prior_sigmas > opts.stand_in_prior_sigmas {
         why.push(format!("it needs {} prior σ", sig3(f.prior_sigmas)));
     }
-    if let (Some(share), Some(left)) = (f.misfit_share, unexplained) {
-        // a value within a few prior σ that explains little is a small effect beside a larger
-        // unexplained one, not a stand-in
-        if share < opts.stand_in_share && left > 0.5 && f.prior_sigmas > 3.0 {
+    if let Some(share) = f.misfit_share {
+        // a value within a few prior σ that explains little is a small effect beside larger
+        // ones, not a stand-in
+        if share < opts.stand_in_share && f.prior_sigmas > 3.0 {
             why.push(format!(
-                "it removes {} % of the baseline's excess misfit and {} % of it is left",
+                "it needs {} prior σ yet removes only {} % of the baseline's excess misfit{}",
+                sig3(f.prior_sigmas),
                 sig3(100.0 * share.max(0.0)),
-                sig3(100.0 * left)
+                unexplained
+                    .map(|l| format!(", {} % of which is left", sig3(100.0 * l.max(0.0))))
+                    .unwrap_or_default()
             ));
         }
     }
@@ -735,6 +897,8 @@ mod tests {
             misfit_share,
             prior_sigmas,
             stand_in: None,
+            scale: None,
+            scale_interval: None,
         }
     }
 
@@ -752,10 +916,11 @@ mod tests {
             little.contains("8.00 %") && little.contains("90.0 %"),
             "{little}"
         );
-        // explaining little is a stand-in only while most of the misfit is left …
-        assert!(stand_in_reason(&finding(5.0, Some(0.08)), Some(0.3), &o).is_none());
-        // … and beyond 3 prior σ (within them: a small effect beside a larger one)
+        // explaining little counts beyond 3 prior σ (within them: a small effect beside larger
+        // ones), whatever is left
+        assert!(stand_in_reason(&finding(5.0, Some(0.08)), Some(0.0), &o).is_some());
         assert!(stand_in_reason(&finding(0.6, Some(0.06)), Some(0.53), &o).is_none());
+        assert!(stand_in_reason(&finding(5.0, Some(0.5)), Some(0.0), &o).is_none());
     }
 
     #[test]

@@ -122,6 +122,13 @@ impl PointSpec {
             &Vector3::from(self.f_b),
         );
         np.set_rate(&Vector3::from(self.w_b));
+        // dv/dt of the navigation equations at the point: C f + g − (2 ω_ie + ω_en) × v
+        let (lat, h, v) = (self.lat_deg * d, self.h_m, Vector3::from(self.v_ned));
+        let w_ie = crate::nav::earth::OMEGA * Vector3::new(lat.cos(), 0.0, -lat.sin());
+        let w_en = Vector3::new(v.y / np.rn, -v.x / np.rm, -v.y * lat.tan() / np.rn);
+        let g = Vector3::new(0.0, 0.0, crate::nav::earth::gravity(lat, h));
+        let a = c * Vector3::from(self.f_b) + g - (2.0 * w_ie + w_en).cross(&v);
+        np.set_acceleration(&a);
         np
     }
 }

@@ -30,6 +30,10 @@ pub struct NavPoint {
     /// Body angular rate w^b_ib, FRD [rad/s] (the step mean; zero until set with
     /// [`NavPoint::set_rate`]).
     pub w_b: [f64; 3],
+    /// Acceleration of the navigation solution in NED, dv/dt over the last second [m/s²] (zero
+    /// until set with [`NavPoint::set_acceleration`]): smooth where the specific force
+    /// vibrates.
+    pub a_ned: [f64; 3],
 }
 
 impl NavPoint {
@@ -45,9 +49,9 @@ impl NavPoint {
         f_b: &Vector3<f64>,
     ) {
         if (lat - self.lat).abs() > 1e-9 || (h - self.h).abs() > 1e-3 {
-            let w_b = self.w_b;
+            let (w_b, a_ned) = (self.w_b, self.a_ned);
             *self = NavPoint::new(lat, h, v_ned, c_bn, f_b);
-            self.w_b = w_b;
+            (self.w_b, self.a_ned) = (w_b, a_ned);
             return;
         }
         let f_n = c_bn * f_b;
@@ -88,11 +92,45 @@ impl NavPoint {
             dg_dlat: earth::gravity_dlat(lat, h),
             dg_dh: earth::gravity_dh(lat, h),
             w_b: [0.0; 3],
+            a_ned: [0.0; 3],
         }
+    }
+
+    /// Sets the navigation-frame acceleration a [m/s²] (NED, dv/dt over the last second) the
+    /// point's H entries may use.
+    pub fn set_acceleration(&mut self, a: &Vector3<f64>) {
+        self.a_ned = [a.x, a.y, a.z];
     }
 
     /// Sets the body angular rate w^b_ib [rad/s] (FRD) the point's H entries may use.
     pub fn set_rate(&mut self, w_b: &Vector3<f64>) {
         self.w_b = [w_b.x, w_b.y, w_b.z];
+    }
+}
+
+/// Velocities of the last second, for the acceleration dv/dt over it.
+#[derive(Debug, Clone, Default)]
+pub struct AccelWindow {
+    /// (t [s], NED velocity [m/s]), oldest first.
+    past: std::collections::VecDeque<(f64, Vector3<f64>)>,
+}
+
+impl AccelWindow {
+    /// Width of the window [s].
+    pub const SECONDS: f64 = 1.0;
+
+    /// Adds the velocity `v` [m/s] at `t` [s]; returns dv/dt [m/s²] over the last
+    /// [`AccelWindow::SECONDS`] (over what there is at the start; zero for a single sample).
+    pub fn push(&mut self, t: f64, v: Vector3<f64>) -> Vector3<f64> {
+        self.past.push_back((t, v));
+        while self.past.len() > 2 && self.past[1].0 <= t - Self::SECONDS {
+            self.past.pop_front();
+        }
+        let (t0, v0) = self.past[0];
+        if t > t0 {
+            (v - v0) / (t - t0)
+        } else {
+            Vector3::zeros()
+        }
     }
 }

@@ -70,15 +70,22 @@ const KINEMATICS_BEFORE: f64 = 1e-6;
 fn gnss_shift(
     row: &TruthRow,
     e: &earth::LocalEarth,
-    k: &crate::sim::trajectory::Kinematics,
+    traj: &Trajectory,
     terms: &[(usize, f64)],
 ) -> TruthRow {
     if terms.is_empty() {
         return *row;
     }
-    let (f_b, w_b, _) = body_signals(e, k);
+    let t = row.t - KINEMATICS_BEFORE;
+    let k = traj.at(t);
+    let (f_b, w_b, _) = body_signals(e, &k);
     let mut np = crate::nav::nav_point::NavPoint::new(row.lat, row.h, row.v, &k.c, &f_b);
     np.set_rate(&w_b);
+    // dv/dt over the last second, as the filter forms it from its solution
+    let t0 = (t - crate::nav::nav_point::AccelWindow::SECONDS).max(0.0);
+    if t > t0 {
+        np.set_acceleration(&((k.v - traj.at(t0).v) / (t - t0)));
+    }
     let mut out = *row;
     for (m, info) in common::MEASUREMENTS.iter().enumerate() {
         common::measurement_entries(m, &np, &mut |comp, state, value| {
@@ -151,7 +158,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
     let mut gnss_truth = vec![gnss_shift(
         &truth[0],
         &earth::LocalEarth::new(lat, h),
-        &k0,
+        &traj,
         &gnss_terms,
     )];
     let mut gnss = Vec::new();
@@ -240,12 +247,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                 euler: k1.euler,
             };
             truth.push(row);
-            gnss_truth.push(gnss_shift(
-                &row,
-                &e,
-                &traj.at(t1 - KINEMATICS_BEFORE),
-                &gnss_terms,
-            ));
+            gnss_truth.push(gnss_shift(&row, &e, &traj, &gnss_terms));
         }
         if let (Some(every), Some((_, sne, sd, noisy))) = (gnss_every, sc.gnss) {
             if (i + 1) % every == 0 {
@@ -260,7 +262,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                         euler: k1.euler,
                     },
                     &e,
-                    &traj.at(t1 - KINEMATICS_BEFORE),
+                    &traj,
                     &gnss_terms,
                 );
                 let (mut glat, mut glon, mut gh) = (seen.lat, seen.lon, seen.h);

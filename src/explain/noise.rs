@@ -1,0 +1,226 @@
+//! Noise levels as findings: the gyro and accelerometer white noise and the aiding's stated
+//! 1-σ (one scale per measurement), each estimated by maximum likelihood of the innovations and
+//! tested against its stated value with a likelihood-ratio test (Holm over the levels, and the
+//! BIC).
+//!
+//! Each level is a scale s of what the filter was given (the `--noise`/`--grade` density, the σ a
+//! fix states). The log-likelihood is searched in log₂ s around the current value: passes at
+//! half and twice, a parabola through the three, a pass at its vertex (or further steps when
+//! the likelihood keeps rising), within 1/16 … 64. One sweep over the levels in turn (aiding
+//! σ first), each given the ones before. The 95 % interval is where the parabola falls by
+//! χ²₁(0.95)/2.
+
+use super::{run_pass, ExplainData, ExplainOptions};
+use crate::estimate::filter::FilterConfig;
+use crate::estimate::stats;
+use crate::model::Model;
+
+/// A noise level explain can scale.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Level {
+    /// Gyro white noise (angle random walk).
+    GyroArw,
+    /// Accelerometer white noise (velocity random walk).
+    AccelVrw,
+    /// The aiding's stated 1-σ of one measurement.
+    Sigma(&'static str),
+}
+
+impl Level {
+    /// The name in findings: `gyro_arw`, `accel_vrw`, `sigma_<measurement>`.
+    pub(super) fn name(&self) -> String {
+        match self {
+            Level::GyroArw => "gyro_arw".into(),
+            Level::AccelVrw => "accel_vrw".into(),
+            Level::Sigma(m) => format!("sigma_{m}"),
+        }
+    }
+
+    /// Applies scale `s` to `cfg` (on top of what it holds).
+    pub(super) fn apply(&self, model: &Model, cfg: &mut FilterConfig, s: f64) {
+        match self {
+            Level::GyroArw => cfg.scale_sensor_noise(model, s, 1.0),
+            Level::AccelVrw => cfg.scale_sensor_noise(model, 1.0, s),
+            Level::Sigma(m) => match cfg.sigma_scale.iter_mut().find(|x| x.0 == *m) {
+                Some(x) => x.1 *= s,
+                None => cfg.sigma_scale.push((m, s)),
+            },
+        }
+    }
+}
+
+/// One level's fit.
+#[derive(Debug, Clone)]
+pub(super) struct LevelFit {
+    /// The level.
+    pub(super) level: Level,
+    /// Maximum-likelihood scale of the stated value.
+    pub(super) scale: f64,
+    /// Approximate 95 % interval of the scale.
+    pub(super) interval: [f64; 2],
+    /// 2Δℓ the scale gained over its two sweeps (given the other levels).
+    pub(super) two_delta_loglik: f64,
+    /// Holm-adjusted p-value over the levels.
+    pub(super) p_holm: f64,
+    /// True when significant (Holm at α and 2Δℓ above the BIC penalty ln N).
+    pub(super) significant: bool,
+}
+
+/// ML scales of every level on `model` with configuration `cfg`, whose pass has log-likelihood
+/// and scalar innovation count `(loglik0, innovations)`; returns the fits and the configuration
+/// with the significant scales applied.
+pub(super) fn fit(
+    model: &Model,
+    cfg: &FilterConfig,
+    levels: &[Level],
+    data: &ExplainData,
+    (loglik0, innovations): (f64, usize),
+    opts: &ExplainOptions,
+    progress: &mut dyn FnMut(f64),
+) -> anyhow::Result<(Vec<LevelFit>, FilterConfig)> {
+    let mut cur = cfg.clone();
+    let mut l_cur = loglik0;
+    let mut fits = Vec::new();
+    let passes_per_level = MAX_EVALS as f64;
+    let total = 2.0 * passes_per_level * levels.len() as f64;
+    let mut done = 0.0;
+    // two sweeps: the second refits each level given all the others
+    let order: Vec<Level> = levels.iter().chain(levels.iter()).copied().collect();
+    let mut scales = vec![1.0; levels.len()];
+    let mut gains = vec![0.0; levels.len()];
+    let mut curvs = vec![0.0; levels.len()];
+    for (step, &level) in order.iter().enumerate() {
+        let li = step % levels.len();
+        let mut eval = |u: f64| -> anyhow::Result<f64> {
+            let mut c = cur.clone();
+            level.apply(model, &mut c, 2f64.powf(u));
+            let p = run_pass(model, &[], data, &c, &mut |f| progress((done + f) / total))?;
+            done += 1.0;
+            Ok(p.stats.loglik)
+        };
+        let (u, l, curv) = search(&mut eval, l_cur)?;
+        if l > l_cur {
+            level.apply(model, &mut cur, 2f64.powf(u));
+            scales[li] *= 2f64.powf(u);
+            gains[li] += 2.0 * (l - l_cur);
+            l_cur = l;
+        }
+        curvs[li] = curv;
+    }
+    for (li, &level) in levels.iter().enumerate() {
+        let curv = curvs[li];
+        let half = if curv < 0.0 {
+            (stats::chi2_isf(0.05, 1.0) / (-2.0 * curv)).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let u = scales[li].log2();
+        fits.push(LevelFit {
+            level,
+            scale: scales[li],
+            interval: [2f64.powf(u - half), 2f64.powf(u + half)],
+            two_delta_loglik: gains[li],
+            p_holm: stats::chi2_sf(gains[li], 1.0),
+            significant: false,
+        });
+    }
+    // Holm over the levels, and the BIC: a level is named only when the data need it
+    let p: Vec<f64> = fits.iter().map(|f| f.p_holm).collect();
+    let adj = stats::holm(&p);
+    let bic = (innovations.max(2) as f64).ln();
+    let mut out = cfg.clone();
+    for (f, a) in fits.iter_mut().zip(adj) {
+        f.p_holm = a;
+        f.significant = a <= opts.alpha && f.two_delta_loglik > bic;
+        if f.significant {
+            f.level.apply(model, &mut out, f.scale);
+        }
+    }
+    Ok((fits, out))
+}
+
+/// Maximises ℓ(u) over u = log₂ s from u = 0 (where ℓ = `l0`) in at most [`MAX_EVALS`]
+/// passes: ±1, then successive parabolic interpolation through the best point and its nearest
+/// neighbours on either side (a step of 2 beyond the best point while it lies at an end),
+/// within [−4, 6]. Returns (u, ℓ(u), the curvature a of the last parabola, ℓ ≈ a u² + …).
+fn search(
+    eval: &mut dyn FnMut(f64) -> anyhow::Result<f64>,
+    l0: f64,
+) -> anyhow::Result<(f64, f64, f64)> {
+    const LO: f64 = -4.0;
+    const HI: f64 = 6.0;
+    let mut pts: Vec<(f64, f64)> = vec![(0.0, l0), (-1.0, eval(-1.0)?), (1.0, eval(1.0)?)];
+    let mut curv = 0.5 * (pts[1].1 + pts[2].1 - 2.0 * l0);
+    for _ in 2..MAX_EVALS {
+        pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let k = (0..pts.len())
+            .max_by(|&i, &j| pts[i].1.total_cmp(&pts[j].1))
+            .expect("points");
+        let next = if k == 0 || k + 1 == pts.len() {
+            // the best point is at an end: step on
+            let dir: f64 = if k == 0 { -1.0 } else { 1.0 };
+            (pts[k].0 + 2.0 * dir).clamp(LO, HI)
+        } else {
+            let ((x0, y0), (x1, y1), (x2, y2)) = (pts[k - 1], pts[k], pts[k + 1]);
+            let a = ((y2 - y1) / (x2 - x1) - (y1 - y0) / (x1 - x0)) / (x2 - x0);
+            curv = a;
+            if a >= 0.0 {
+                break;
+            }
+            let b = (y1 - y0) / (x1 - x0) - a * (x0 + x1);
+            (-b / (2.0 * a)).clamp(x0, x2)
+        };
+        if pts.iter().any(|p| (p.0 - next).abs() < 0.02) {
+            break;
+        }
+        pts.push((next, eval(next)?));
+    }
+    pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let k = (0..pts.len())
+        .max_by(|&i, &j| pts[i].1.total_cmp(&pts[j].1))
+        .expect("points");
+    if k > 0 && k + 1 < pts.len() {
+        let ((x0, y0), (x1, y1), (x2, y2)) = (pts[k - 1], pts[k], pts[k + 1]);
+        curv = ((y2 - y1) / (x2 - x1) - (y1 - y0) / (x1 - x0)) / (x2 - x0);
+    }
+    Ok((pts[k].0, pts[k].1, curv))
+}
+
+/// Most filter passes per noise level (the start point's pass not counted).
+const MAX_EVALS: usize = 5;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_search_finds_the_maximum_of_a_parabola_in_log_scale() {
+        // ℓ(u) = −3 (u − 1.7)², maximum at s = 2^1.7 = 3.25
+        let f = |u: f64| -3.0 * (u - 1.7) * (u - 1.7);
+        let mut calls = 0;
+        let (u, l, a) = search(
+            &mut |u| {
+                calls += 1;
+                Ok(f(u))
+            },
+            f(0.0),
+        )
+        .unwrap();
+        assert!((u - 1.7).abs() < 1e-9, "{u}");
+        assert!(l.abs() < 1e-9);
+        assert!((a + 3.0).abs() < 1e-9, "{a}");
+        assert!(calls <= MAX_EVALS, "{calls}");
+    }
+
+    #[test]
+    fn the_search_steps_on_when_the_likelihood_keeps_rising() {
+        // rises up to u = 5 (s = 32): steps of 2 from 1
+        let f = |u: f64| -((u - 5.0) * (u - 5.0)).sqrt();
+        let (u, _, _) = search(&mut |u| Ok(f(u)), f(0.0)).unwrap();
+        assert!(u >= 3.0, "{u}");
+        // and stays at 1 when nothing is to gain
+        let g = |u: f64| -u * u;
+        let (u, _, a) = search(&mut |u| Ok(g(u)), g(0.0)).unwrap();
+        assert!(u.abs() < 1e-9 && (a + 1.0).abs() < 1e-9);
+    }
+}
