@@ -216,12 +216,13 @@ fn pct(v: Option<f64>) -> String {
 fn headline(s: &Summary) -> Vec<String> {
     vec![
         format!(
-            "detection {} (λ ≥ 50: {}), false alarms {} of {} null cases, wrong term {}",
+            "detection {} (λ ≥ 50: {}), false alarms {} of {} null cases, wrong term {}, a noise level named in {} of the cases",
             pct(s.detection_rate),
             pct(s.detection_rate_lambda_50),
             pct(s.false_alarm_rate),
             s.null_cases,
-            pct(s.wrong_term_rate)
+            pct(s.wrong_term_rate),
+            pct(s.noise_finding_rate)
         ),
         format!(
             "coefficient error median {} (90 %: {}), calibration (truth within ±2σ) {}, gain recovery median {}",

@@ -57,8 +57,11 @@ pub struct CaseResult {
     pub truth: Option<f64>,
     /// Noncentrality λ = θ² I of the hidden term's test through the baseline filter.
     pub lambda: Option<f64>,
-    /// Terms explain named.
+    /// Terms explain named (sensor and measurement findings).
     pub named: Vec<String>,
+    /// Noise levels explain named (noise findings: a claim about the data's noise, not a term).
+    #[serde(default)]
+    pub noise_named: Vec<String>,
     /// The hidden term was named or is in a named class.
     pub detected: bool,
     /// A named term is neither the hidden one nor in a class with it (or anything in a null case).
@@ -138,7 +141,18 @@ pub fn run_case(
     }
     let out = run_hidden_on(&case, &sim, &aid, &opts)?;
     let e = &out.explanation;
-    let named: Vec<String> = e.findings.iter().map(|f| f.term.clone()).collect();
+    let named: Vec<String> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind != "noise")
+        .map(|f| f.term.clone())
+        .collect();
+    let noise_named: Vec<String> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind == "noise")
+        .map(|f| f.term.clone())
+        .collect();
     let (mut detected, mut estimate, mut sigma) = (false, None, None);
     if let Some(t) = term {
         let name = common::TERMS[t].name;
@@ -154,10 +168,14 @@ pub fn run_case(
         }
     }
     let hidden_name = term.map(|t| common::TERMS[t].name);
-    let wrong_term = e.findings.iter().any(|f| match hidden_name {
-        Some(h) => f.term != h && !f.equivalent.iter().any(|q| q == h),
-        None => true,
-    });
+    let wrong_term = e
+        .findings
+        .iter()
+        .filter(|f| f.kind != "noise")
+        .any(|f| match hidden_name {
+            Some(h) => f.term != h && !f.equivalent.iter().any(|q| q == h),
+            None => true,
+        });
     Ok(CaseResult {
         index,
         group: drawn.group.clone(),
@@ -167,6 +185,7 @@ pub fn run_case(
             .map(|(t, v)| v / common::TERMS[t].display_to_si),
         lambda,
         named,
+        noise_named,
         detected,
         wrong_term,
         estimate,
@@ -226,6 +245,10 @@ pub struct Summary {
     pub false_alarm_rate: Option<f64>,
     /// Non-null cases in which a wrong term was named.
     pub wrong_term_rate: Option<f64>,
+    /// Cases in which a noise level was named (the simulations state their noise correctly,
+    /// except the heights of the truth-formed aiding, which carry none).
+    #[serde(default)]
+    pub noise_finding_rate: Option<f64>,
     /// Median of |θ̂ − θ|/|θ| over the detected cases (target ≤ 0.10).
     pub coef_error_median: Option<f64>,
     /// 90th percentile of the same.
@@ -340,6 +363,10 @@ pub fn summarize(spec: &EvalSpec, cases: &[CaseResult]) -> Summary {
         wrong_term_rate: rate(
             non_null.iter().filter(|c| c.wrong_term).count(),
             non_null.len(),
+        ),
+        noise_finding_rate: rate(
+            cases.iter().filter(|c| !c.noise_named.is_empty()).count(),
+            cases.len(),
         ),
         coef_error_median: quantile(&mut errs, 0.5),
         coef_error_p90: quantile(&mut errs, 0.9),

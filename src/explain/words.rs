@@ -204,6 +204,17 @@ pub(super) fn finding_words(
             "; on these data its regressor is proportional to that of the baseline term {b}, so part of it may be taken up there"
         ));
     }
+    s.push_str(&share_and_stand_in(
+        f,
+        ": noise stated too small, an aiding error or a sensor effect outside the library fit sensor terms this way; do not read it as a property of the sensor",
+    ));
+    s
+}
+
+/// The tail every term finding's words end with: the share of the misfit it explains and, for a
+/// stand-in, why (then `what_else`).
+fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
+    let mut s = String::new();
     if let Some(share) = f.misfit_share {
         s.push_str(&format!(
             "; it explains {} % of the baseline's excess misfit (2Δℓ {})",
@@ -213,7 +224,7 @@ pub(super) fn finding_words(
     }
     if let Some(why) = &f.stand_in {
         s.push_str(&format!(
-            ". It probably stands in for an effect the candidates do not describe ({why}): noise stated too small, an aiding error or a sensor effect outside the library fit sensor terms this way; do not read it as a property of the sensor"
+            ". It probably stands in for an effect the candidates do not describe ({why}){what_else}"
         ));
     }
     s
@@ -251,18 +262,7 @@ fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> St
             f.separate_by.join("; ")
         ));
     }
-    if let Some(share) = f.misfit_share {
-        s.push_str(&format!(
-            "; it explains {} % of the baseline's excess misfit (2Δℓ {})",
-            sig3(100.0 * share),
-            sig3(f.two_delta_loglik)
-        ));
-    }
-    if let Some(why) = &f.stand_in {
-        s.push_str(&format!(
-            ". It probably stands in for an effect the candidates do not describe ({why})"
-        ));
-    }
+    s.push_str(&share_and_stand_in(f, ""));
     s
 }
 
