@@ -414,6 +414,15 @@ fn measured_data() {
     assert!(dt["stand_in"].is_null(), "{dt}");
     let ms = dt["estimate"].as_f64().unwrap();
     assert!((30.0..300.0).contains(&ms), "dt_gnss {ms} ms");
+    // the preset explain recommends holds error terms only: no noise level, no stand-in
+    let preset = std::fs::read_to_string(out.join("extended.toml")).unwrap();
+    let terms_line = preset.lines().find(|l| l.starts_with("terms = ")).unwrap();
+    for f in findings {
+        if f["kind"] == "noise" || !f["stand_in"].is_null() {
+            let quoted = format!("\"{}\"", f["term"].as_str().unwrap());
+            assert!(!terms_line.contains(&quoted), "{terms_line}");
+        }
+    }
     // no size effect read as a cause: one that is named is labelled a stand-in, or is a few
     // centimetres at most
     for f in findings {
@@ -450,7 +459,7 @@ fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
     let (ok, _, stderr) = sinsmodel(&args);
     assert!(!ok);
     assert!(
-        stderr.contains("dt_gnss are GNSS terms") && stderr.contains("without --aid"),
+        stderr.contains("dt_gnss is a GNSS term") && stderr.contains("without --aid"),
         "{stderr}"
     );
     let mut args = base.to_vec();
@@ -487,6 +496,9 @@ fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
         (&["--gnss-delay", "92 s"][..], "ms read as s?"),
         (&["--lever-arm", "0.1,0.2"][..], "got 2 values"),
         (&["--lever-arm", "600,0,0"][..], "mm read as m?"),
+        (&["--gnss-delay", "0.179 ms"][..], "below 1 ms"),
+        (&["--lever-arm", "NaN,0,0"][..], "is not a number"),
+        (&["--lever-arm", "0.3 furlongs,0,0"][..], "expected metres"),
     ] {
         let (ok, _, stderr) = drive(extra);
         assert!(!ok, "{extra:?} accepted");

@@ -146,7 +146,7 @@ pub struct DataArgs {
     /// Known GNSS antenna lever arm, IMU to antenna in the body frame (FRD): X,Y,Z [m] (the spec
     /// terms lever_x lever_y lever_z), applied in the residuals; needs --aid.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    lever_arm: Option<Vec<f64>>,
+    lever_arm: Option<Vec<String>>,
 }
 
 /// A GNSS outage window on the data's clock [s].
@@ -378,6 +378,12 @@ impl DataArgs {
                     "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second difference belongs in --clock-offset)"
                 );
             }
+            if dt != 0.0 && dt.abs() < 1e-3 {
+                bail!(
+                    "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
+                    dt * 1e3
+                );
+            }
             out.push((term("dt_gnss", "--gnss-delay")?, dt));
         }
         if let Some(l) = &self.lever_arm {
@@ -387,8 +393,19 @@ impl DataArgs {
                     l.len()
                 );
             }
-            for (k, (&v, axis)) in l.iter().zip(["x", "y", "z"]).enumerate() {
-                if !v.is_finite() || v.abs() > 10.0 {
+            for (k, (item, axis)) in l.iter().zip(["x", "y", "z"]).enumerate() {
+                // bare numbers are metres; a unit may be given (`34 cm`)
+                let item = item.trim();
+                let v = match item.parse::<f64>() {
+                    Ok(v) => v,
+                    Err(_) => sinsmodel::io::units::parse_quantity_as(item, "m").with_context(|| {
+                        format!("--lever-arm: {axis} = `{item}`: expected metres (`0.3`) or a length with its unit (`30 cm`)")
+                    })?,
+                };
+                if !v.is_finite() {
+                    bail!("--lever-arm: {axis} = `{item}` is not a number");
+                }
+                if v.abs() > 10.0 {
                     bail!(
                         "--lever-arm: {axis} = {v} m is beyond ±10 m; a vehicle's IMU-to-antenna arm is metres at most (mm read as m?)"
                     );
@@ -430,12 +447,23 @@ impl DataArgs {
                 if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
             ),
             Some(g) => eprintln!(
-                "priors and noise: --grade {} (ARW {}, VRW {}; the priors of the README's --grade table){}",
+                "priors and noise: --grade {} (ARW {}, VRW {}; the priors of model-spec/grades.toml){}",
                 g.name,
                 g.gyro_arw_text,
                 g.accel_vrw_text,
                 if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
             ),
+        }
+        for (t, v) in self.known_gnss()? {
+            let info = &common::TERMS[t];
+            eprintln!(
+                "known GNSS value applied in the residuals: {} = {} {} ({}); a {} state in the model estimates what is left on top of it",
+                info.name,
+                v / info.display_to_si,
+                info.display,
+                info.doc,
+                info.name
+            );
         }
         if let Some(path) = &self.noise {
             let (arw, vrw) = noise_from_allan(path)?;
@@ -467,6 +495,12 @@ impl DataArgs {
         }
         if let Some(p) = &self.truth {
             s.push_str(&format!(", truth {}", p.display()));
+        }
+        if let Some(d) = &self.gnss_delay {
+            s.push_str(&format!(", known GNSS delay {d}"));
+        }
+        if let Some(l) = &self.lever_arm {
+            s.push_str(&format!(", known lever arm {} (m, FRD)", l.join(",")));
         }
         s
     }

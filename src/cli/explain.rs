@@ -106,8 +106,10 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
                 .collect();
             if args.candidates.is_some() && !gnss.is_empty() {
                 bail!(
-                    "--candidates: {} are GNSS terms (they enter the fixes of a GNSS receiver); without --aid there is none",
-                    gnss.join(", ")
+                    "--candidates: {} {} GNSS term{} (entering the fixes of a GNSS receiver); without --aid there is none",
+                    gnss.join(", "),
+                    if gnss.len() == 1 { "is a" } else { "are" },
+                    if gnss.len() == 1 { "" } else { "s" }
                 );
             }
             cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
@@ -142,7 +144,30 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
             super::data::apply_opened(&mut c, m, inputs.init_sigma, inputs.step_s);
             Ok(c)
         };
-        let e = run_explain(&baseline, &cands, &data, &config_for, &opts)?;
+        let mut e = run_explain(&baseline, &cands, &data, &config_for, &opts)?;
+        let known: Vec<String> = args
+            .data
+            .known_gnss()?
+            .iter()
+            .map(|&(t, v)| {
+                let info = &common::TERMS[t];
+                format!(
+                    "{} = {} {}",
+                    info.name,
+                    explain::sig3(v / info.display_to_si),
+                    info.display
+                )
+            })
+            .collect();
+        if !known.is_empty() {
+            e.summary.insert(
+                0,
+                format!(
+                    "Known GNSS values applied in every pass (--gnss-delay, --lever-arm): {}; a GNSS finding is what the data show on top of them.",
+                    known.join(", ")
+                ),
+            );
+        }
         finish(args, out, &e, &args.data.describe(), &skipped)
     } else {
         demo(args, &opts)

@@ -802,7 +802,8 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
                 sig3(f.prior_sigmas),
                 sig3(100.0 * share.max(0.0)),
                 unexplained
-                    .map(|l| format!(", {} % of which is left", sig3(100.0 * l.max(0.0))))
+                    .filter(|l| *l >= 0.01)
+                    .map(|l| format!(" (the extended model leaves {} % of it)", sig3(100.0 * l)))
                     .unwrap_or_default()
             ));
         }
@@ -913,7 +914,7 @@ mod tests {
         assert!(far.contains("91.0 prior σ"), "{far}");
         let little = stand_in_reason(&finding(5.0, Some(0.08)), Some(0.9), &o).unwrap();
         assert!(
-            little.contains("8.00 %") && little.contains("90.0 %"),
+            little.contains("8.00 %") && little.contains("leaves 90.0 %"),
             "{little}"
         );
         // explaining little counts beyond 3 prior σ (within them: a small effect beside larger

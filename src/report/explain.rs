@@ -62,8 +62,12 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
 /// nothing was found).
 pub fn extended_preset(e: &Explanation) -> Option<String> {
     // a finding that probably stands in for something else is no term to compile in
-    let causes: Vec<&crate::explain::Finding> =
-        e.findings.iter().filter(|f| f.stand_in.is_none()).collect();
+    // nor is a noise level (it is a --noise value or an aiding σ, not a state)
+    let causes: Vec<&crate::explain::Finding> = e
+        .findings
+        .iter()
+        .filter(|f| f.stand_in.is_none() && f.kind != "noise")
+        .collect();
     if causes.is_empty() {
         return None;
     }
@@ -89,6 +93,24 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
         s.push_str(&format!(
             "# {} is left out: it probably stands in for an effect the candidates do not describe.\n",
             f.term
+        ));
+    }
+    for f in e.findings.iter().filter(|f| f.kind == "noise") {
+        s.push_str(&format!(
+            "# noise, not a term: {} = {} {} ({}× the stated; give it with --noise or the aiding's σ).\n",
+            f.term,
+            sig3(f.estimate),
+            f.unit,
+            f.scale.map(sig3).unwrap_or_default()
+        ));
+    }
+    if e.findings
+        .iter()
+        .any(|f| f.stand_in.is_some() || f.kind == "noise")
+    {
+        s.push_str(&format!(
+            "# the extended pass explain reports ({}) also held the lines above.\n",
+            e.extended_model
         ));
     }
     for f in causes.iter().filter(|f| f.prior_widened) {
