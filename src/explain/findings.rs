@@ -94,6 +94,13 @@ pub struct Finding {
     pub scale: Option<f64>,
     /// Its approximate 95 % interval.
     pub scale_interval: Option<[f64; 2]>,
+    /// A term finding's GLR estimate and σ (display unit) from the first and from the second
+    /// half of the aiding epochs alone: `[[estimate, σ], [estimate, σ]]` (null without
+    /// information in a half). A constant of the sensor or the aiding holds across both.
+    pub halves: Option<[[f64; 2]; 2]>,
+    /// The same from the updates below and at or above the median aided speed (a constant
+    /// holds at any speed; a term standing in for an effect that grows with speed does not).
+    pub speed_halves: Option<[[f64; 2]; 2]>,
 }
 
 /// A term the data cannot tell from a finding, and the value it would need.

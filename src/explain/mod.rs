@@ -211,7 +211,23 @@ fn run_pass(
     cfg: &FilterConfig,
     progress: &mut dyn FnMut(f64),
 ) -> anyhow::Result<Pass> {
-    let mut sig = Signatures::new(model, cands);
+    // the median aiding time splits the updates into halves
+    let t_half = data
+        .aid
+        .get(data.aid.len() / 2)
+        .map_or(f64::INFINITY, |a| a.t);
+    // … and the median aided speed by speed (none without velocity aiding)
+    let mut speeds: Vec<f64> = data
+        .aid
+        .iter()
+        .filter_map(|a| a.vel.map(|v| v.0.norm()))
+        .collect();
+    speeds.sort_by(f64::total_cmp);
+    let speed_half = speeds
+        .get(speeds.len() / 2)
+        .copied()
+        .unwrap_or(f64::INFINITY);
+    let mut sig = Signatures::new(model, cands, t_half, speed_half);
     let mut samples = data.imu.samples()?;
     let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
     let mut io = filter::StreamIo {
@@ -373,6 +389,9 @@ struct Named {
     confounded_with: Option<String>,
     /// Which excitation separates it from each equivalent term.
     separate_by: Vec<String>,
+    /// Its GLR estimate and σ from each half of the data alone (display unit): [by time, by
+    /// speed][first/slower, second/faster].
+    halves: [[(f64, f64); 2]; 2],
     /// Its share of its round's gain: 2Δℓ, and the mean NIS removed.
     two_delta_loglik: f64,
     nis_removed: f64,
@@ -416,6 +435,7 @@ impl Named {
                 .iter()
                 .map(|c| separation_hint(t, sig.cands[c.0]))
                 .collect(),
+            halves: s.halves,
             two_delta_loglik: 0.0,
             nis_removed: 0.0,
         }
@@ -623,6 +643,8 @@ fn complete_findings(
             stand_in: None,
             scale: None,
             scale_interval: None,
+            halves: Some(n.halves[0].map(|(e, s)| [e, s])),
+            speed_halves: Some(n.halves[1].map(|(e, s)| [e, s])),
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
         f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
@@ -773,7 +795,30 @@ fn noise_finding(
         stand_in: None,
         scale: Some(f.scale),
         scale_interval: Some(f.interval),
+        halves: None,
+        speed_halves: None,
     }
+}
+
+/// Why a term's estimates from two halves of the data, `which` (`[estimate, σ]` each, in `unit`),
+/// do not describe one constant, if they do not: they differ by more than 3 σ of the difference
+/// and by more than a quarter of the larger. A sensor or aiding constant holds across the data;
+/// a term fitting some other effect follows what that effect does in each half.
+fn differs_between_halves(h: [[f64; 2]; 2], unit: &str, which: &str) -> Option<String> {
+    let ([a, sa], [b, sb]) = (h[0], h[1]);
+    if !(a.is_finite() && b.is_finite() && sa.is_finite() && sb.is_finite()) {
+        return None;
+    }
+    let d = (a - b).abs();
+    (d > 3.0 * sa.hypot(sb) && d > 0.25 * a.abs().max(b.abs())).then(|| {
+        format!(
+            "{which} give {} ± {} and {} ± {} {unit}: it does not hold across the data",
+            sig3(a),
+            sig3(sa),
+            sig3(b),
+            sig3(sb)
+        )
+    })
 }
 
 /// The baseline's excess mean NIS (mean NIS − 1) when it lies above the 95 % band of its count
@@ -790,6 +835,17 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 /// share the extended model leaves, is said with it).
 fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
     let mut why = Vec::new();
+    for (h, which) in [
+        (f.halves, "the first and the second half of the data"),
+        (
+            f.speed_halves,
+            "the slower and the faster half of the updates",
+        ),
+    ] {
+        if let Some(w) = h.and_then(|h| differs_between_halves(h, &f.unit, which)) {
+            why.push(w);
+        }
+    }
     if f.prior_sigmas > opts.stand_in_prior_sigmas {
         why.push(format!("it needs {} prior σ", sig3(f.prior_sigmas)));
     }
@@ -864,7 +920,7 @@ pub fn signature_information(
     cfg: &FilterConfig,
 ) -> anyhow::Result<f64> {
     let pass = run_pass(model, &[term], data, cfg, &mut |_| {})?;
-    Ok(pass.sig.info[0])
+    Ok(pass.sig.info()[0])
 }
 
 #[cfg(test)]
@@ -900,6 +956,8 @@ mod tests {
             stand_in: None,
             scale: None,
             scale_interval: None,
+            halves: None,
+            speed_halves: None,
         }
     }
 
@@ -922,6 +980,27 @@ mod tests {
         assert!(stand_in_reason(&finding(5.0, Some(0.08)), Some(0.0), &o).is_some());
         assert!(stand_in_reason(&finding(0.6, Some(0.06)), Some(0.53), &o).is_none());
         assert!(stand_in_reason(&finding(5.0, Some(0.5)), Some(0.0), &o).is_none());
+    }
+
+    #[test]
+    fn a_term_whose_halves_disagree_does_not_hold_across_the_data() {
+        // one constant: the halves agree within their σ
+        assert!(
+            differs_between_halves([[-0.34, 0.02], [-0.36, 0.02]], "m", "the halves").is_none()
+        );
+        // many σ apart but within a quarter: a constant the model describes a little unevenly
+        assert!(differs_between_halves([[179.0, 1.0], [190.0, 1.0]], "ms", "the halves").is_none());
+        // far apart on both counts
+        let w = differs_between_halves([[-1.6, 0.02], [-0.4, 0.02]], "m", "the halves").unwrap();
+        assert!(w.contains("-1.60 ± 0.020 and -0.400 ± 0.020 m"), "{w}");
+        // a half without information says nothing
+        assert!(
+            differs_between_halves([[1.0, f64::INFINITY], [5.0, 0.1]], "m", "the halves").is_none()
+        );
+        let mut f = finding(0.9, Some(0.3));
+        f.speed_halves = Some([[-1.6, 0.02], [-0.4, 0.02]]);
+        let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default()).unwrap();
+        assert!(why.contains("slower and the faster"), "{why}");
     }
 
     #[test]

@@ -7,11 +7,21 @@ use crate::estimate::stats;
 use crate::model::generated::common;
 use nalgebra::DMatrix;
 
-/// Prior-scaled quantities of a pass: J' = D J D, b' = D b with D = diag(σ_prior).
-pub(super) fn scaled(
-    sig: &Signatures,
-    opts: &ExplainOptions,
-) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
+/// A pass's information and score, prior-scaled: J' = D J D, b' = D b with D = diag(σ_prior),
+/// over the whole pass and per half of its updates.
+pub(super) struct Scaled {
+    /// J' over the whole pass.
+    pub(super) j: DMatrix<f64>,
+    /// b' over the whole pass.
+    pub(super) b: Vec<f64>,
+    /// Prior σ of each candidate (SI).
+    pub(super) sd: Vec<f64>,
+    /// (J', b') of the halves of the updates: [by time, by speed][first/slower, second/faster].
+    pub(super) halves: [[(DMatrix<f64>, Vec<f64>); 2]; 2],
+}
+
+/// The prior-scaled quantities of a pass.
+pub(super) fn scaled(sig: &Signatures, opts: &ExplainOptions) -> Scaled {
     let m = sig.cands.len();
     let sd: Vec<f64> = sig
         .cands
@@ -21,9 +31,24 @@ pub(super) fn scaled(
     // quasi-likelihood: innovations φ times larger than S predicts scale the information and
     // score by 1/φ, so an inconsistent baseline does not make every candidate significant
     let phi = sig.dispersion.max(1.0);
-    let j = DMatrix::from_fn(m, m, |a, b| sig.info[a * m + b] * sd[a] * sd[b] / phi);
-    let b = (0..m).map(|a| sig.score[a] * sd[a] / phi).collect();
-    (j, b, sd)
+    let scale = |info: &[f64], score: &[f64]| {
+        (
+            DMatrix::from_fn(m, m, |a, b| info[a * m + b] * sd[a] * sd[b] / phi),
+            (0..m).map(|a| score[a] * sd[a] / phi).collect::<Vec<f64>>(),
+        )
+    };
+    let (j, b) = scale(&sig.info(), &sig.score());
+    let halves = [
+        [
+            scale(&sig.info_half[0], &sig.score_half[0]),
+            scale(&sig.info_half[1], &sig.score_half[1]),
+        ],
+        [
+            scale(&sig.info_speed[0], &sig.score_speed[0]),
+            scale(&sig.info_speed[1], &sig.score_speed[1]),
+        ],
+    ];
+    Scaled { j, b, sd, halves }
 }
 
 /// Prior σ of term `t` (SI): the override in `opts`, else the spec's.
@@ -76,6 +101,10 @@ pub(super) fn conditional_rho(j: &DMatrix<f64>, s: &[usize], a: usize, c: usize)
 /// A candidate the selection names, with its equivalence class.
 pub(super) struct Selected {
     pub(super) idx: usize,
+    /// Its GLR estimate and σ (display unit) from each half of the updates alone, given the
+    /// terms chosen before it: [by time, by speed][first/slower, second/faster] (NaN, ∞ without
+    /// information there).
+    pub(super) halves: [[(f64, f64); 2]; 2],
     pub(super) llr: f64,
     pub(super) p: f64,
     pub(super) glr: f64,
@@ -100,21 +129,19 @@ pub(super) fn forward_select(
     innovations: usize,
     opts: &ExplainOptions,
 ) -> (Vec<Selected>, Vec<Implausible>) {
-    let (j, b, sd) = scaled(sig, opts);
-    select(&j, &b, &sd, &sig.cands, eligible, innovations, opts)
+    select(&scaled(sig, opts), &sig.cands, eligible, innovations, opts)
 }
 
-/// [`forward_select`] on prior-scaled information `j`, score `b` and prior σ `sd` of the
-/// candidate terms `cands` (term indices).
+/// [`forward_select`] on the prior-scaled quantities `sc` of the candidate terms `cands` (term
+/// indices).
 fn select(
-    j: &DMatrix<f64>,
-    b: &[f64],
-    sd: &[f64],
+    sc: &Scaled,
     cands: &[usize],
     eligible: &[bool],
     innovations: usize,
     opts: &ExplainOptions,
 ) -> (Vec<Selected>, Vec<Implausible>) {
+    let (j, b, sd) = (&sc.j, &sc.b[..], &sc.sd[..]);
     let m = cands.len();
     let margin = stats::chi2_isf(opts.alpha, 1.0);
     let bic = (innovations.max(2) as f64).ln();
@@ -185,8 +212,20 @@ fn select(
             pool.retain(|a| !members.iter().any(|m| m.0 == *a));
             continue;
         }
+        // the named member's estimate from each half of the data alone (given the chosen set)
+        let halves = sc.halves.each_ref().map(|split| {
+            split.each_ref().map(|(jh, bh)| {
+                let (ih, bch) = conditional(jh, bh, &chosen, named);
+                if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
+                    display(named, bch / ih, ih)
+                } else {
+                    (f64::NAN, f64::INFINITY)
+                }
+            })
+        });
         out.push(Selected {
             idx: named,
+            halves,
             llr: named_llr,
             p: (stats::chi2_sf(named_llr, 1.0) * pool.len() as f64).min(1.0),
             glr,
@@ -212,7 +251,7 @@ pub(super) fn candidate_tests(
     sig: &Signatures,
     opts: &ExplainOptions,
 ) -> (Vec<CandidateTest>, Vec<bool>) {
-    let (j, b, sd) = scaled(sig, opts);
+    let Scaled { j, b, sd, .. } = scaled(sig, opts);
     let m = sig.cands.len();
     let nb = sig.base_terms.len();
     // testability is a property of the data's excitation, not of the dispersion
@@ -340,12 +379,23 @@ mod tests {
         ExplainOptions::default()
     }
 
+    /// The run's totals, each half holding half of them.
+    fn sc(j: DMatrix<f64>, b: &[f64]) -> Scaled {
+        let half = (&j * 0.5, b.iter().map(|x| 0.5 * x).collect::<Vec<f64>>());
+        Scaled {
+            sd: vec![1.0; b.len()],
+            b: b.to_vec(),
+            j,
+            halves: [[half.clone(), half.clone()], [half.clone(), half]],
+        }
+    }
+
     #[test]
     fn a_strong_candidate_is_named_and_weak_independent_ones_are_not() {
         let j = DMatrix::identity(3, 3) * 100.0;
         // θ' = b/J: 0.5 prior σ (llr 25), 0.01 (llr 0.01), 0.02 (llr 0.04)
         let b = [50.0, 1.0, 2.0];
-        let (sel, imp) = select(&j, &b, &[1.0; 3], &[0, 1, 2], &[true; 3], 1000, &opts());
+        let (sel, imp) = select(&sc(j.clone(), &b), &[0, 1, 2], &[true; 3], 1000, &opts());
         assert!(imp.is_empty());
         assert_eq!(sel.len(), 1);
         assert_eq!(sel[0].idx, 0);
@@ -360,12 +410,10 @@ mod tests {
         let j = DMatrix::identity(4, 4);
         // llr 9: p = 0.0027 < α = 0.01 alone, but × 4 candidates = 0.0108 > α
         let b = [3.0, 0.0, 0.0, 0.0];
-        let (sel, _) = select(&j, &b, &[1.0; 4], &[0, 1, 2, 3], &[true; 4], 10, &opts());
+        let (sel, _) = select(&sc(j.clone(), &b), &[0, 1, 2, 3], &[true; 4], 10, &opts());
         assert!(sel.is_empty());
         let (sel, _) = select(
-            &j,
-            &b,
-            &[1.0; 4],
+            &sc(j.clone(), &b),
             &[0, 1, 2, 3],
             &[true, false, false, false],
             10,
@@ -374,9 +422,7 @@ mod tests {
         assert_eq!(sel.len(), 1, "alone it passes α");
         // with 10⁵ innovations the BIC asks llr > ln N = 11.5
         let (sel, _) = select(
-            &j,
-            &b,
-            &[1.0; 4],
+            &sc(j.clone(), &b),
             &[0, 1, 2, 3],
             &[true, false, false, false],
             100_000,
@@ -397,7 +443,7 @@ mod tests {
         );
         let theta0 = 0.5;
         let b = [i0 * theta0, rho * (i0 * i1).sqrt() * theta0];
-        let (sel, _) = select(&j, &b, &[1.0; 2], &[0, 1], &[true; 2], 1000, &opts());
+        let (sel, _) = select(&sc(j.clone(), &b), &[0, 1], &[true; 2], 1000, &opts());
         assert_eq!(sel.len(), 1);
         assert_eq!(sel[0].idx, 0);
         assert_eq!(sel[0].class.len(), 1);
@@ -409,7 +455,7 @@ mod tests {
     fn a_value_beyond_the_plausible_prior_sigmas_is_not_named() {
         let j = DMatrix::identity(1, 1) * 1e-2;
         let b = [10.0]; // θ' = 1000 prior σ, llr 10⁴
-        let (sel, imp) = select(&j, &b, &[1.0], &[0], &[true], 1000, &opts());
+        let (sel, imp) = select(&sc(j.clone(), &b), &[0], &[true], 1000, &opts());
         assert!(sel.is_empty());
         assert_eq!(imp.len(), 1);
         assert!((imp[0].prior_sigmas - 1000.0).abs() < 1e-9);

@@ -32,9 +32,21 @@ pub(super) struct Signatures {
     pub(super) cand_rows: Vec<Vec<(usize, usize)>>,
     /// Mean NIS of the pass (the dispersion φ of the quasi-likelihood; 1 when consistent).
     pub(super) dispersion: f64,
-    /// Information J (m × m) and score b (m).
-    pub(super) info: Vec<f64>,
-    pub(super) score: Vec<f64>,
+    /// Information J (m × m) and score b (m) of the updates before and after `t_half` (each
+    /// half's, so that a finding can be checked to hold across the data; J = J₀ + J₁).
+    pub(super) info_half: [Vec<f64>; 2],
+    pub(super) score_half: [Vec<f64>; 2],
+    /// Time that splits the aiding epochs into halves [s].
+    pub(super) t_half: f64,
+    /// The same information and score split by speed instead: updates below and at or above
+    /// `speed_half` [m/s] (a constant holds at any speed; a term standing in for an effect
+    /// that grows with speed does not).
+    pub(super) info_speed: [Vec<f64>; 2],
+    pub(super) score_speed: [Vec<f64>; 2],
+    /// Speed that splits the updates [m/s] (∞: no split).
+    pub(super) speed_half: f64,
+    /// Speed of the last step [m/s].
+    pub(super) speed: f64,
     /// Σ over steps of each candidate's regressor mean, and steps counted.
     pub(super) reg_sum: Vec<f64>,
     pub(super) steps: usize,
@@ -58,7 +70,9 @@ pub(super) fn reg_id(t: usize) -> usize {
 }
 
 impl Signatures {
-    pub(super) fn new(model: &Model, cands: &[usize]) -> Signatures {
+    /// Signatures of the candidates `cands` through `model`'s filter; `t_half` [s] and
+    /// `speed_half` [m/s] split the updates into the halves whose information is kept apart.
+    pub(super) fn new(model: &Model, cands: &[usize], t_half: f64, speed_half: f64) -> Signatures {
         let n = model.n();
         let base_terms: Vec<(usize, usize)> = model
             .states
@@ -110,8 +124,13 @@ impl Signatures {
             base_r: vec![0.0; nb],
             cand_rows,
             dispersion: 1.0,
-            info: vec![0.0; m * m],
-            score: vec![0.0; m],
+            info_half: [vec![0.0; m * m], vec![0.0; m * m]],
+            score_half: [vec![0.0; m], vec![0.0; m]],
+            t_half,
+            info_speed: [vec![0.0; m * m], vec![0.0; m * m]],
+            score_speed: [vec![0.0; m], vec![0.0; m]],
+            speed_half,
+            speed: 0.0,
             reg_sum: vec![0.0; m],
             steps: 0,
             cross: vec![0.0; m * nb],
@@ -164,6 +183,7 @@ impl Observer for Signatures {
         if !self.gnss.is_empty() {
             self.np = Some(*np);
         }
+        self.speed = Vector3::from(np.v_ned).norm();
         self.acc.mean_into(&mut self.r_mean);
         self.acc.reset();
         if self.count > 0 {
@@ -214,7 +234,7 @@ impl Observer for Signatures {
 
     fn scalar_update(
         &mut self,
-        _t: f64,
+        t: f64,
         meas: &'static str,
         component: usize,
         h: &[f64],
@@ -255,15 +275,42 @@ impl Observer for Signatures {
             }
         }
         let inv_s = 1.0 / s;
+        let half = usize::from(t >= self.t_half);
+        let fast = usize::from(self.speed >= self.speed_half);
+        let (info, score) = (&mut self.info_half[half], &mut self.score_half[half]);
+        let (info_v, score_v) = (&mut self.info_speed[fast], &mut self.score_speed[fast]);
         for a in 0..m {
             let ga = self.g[a] * inv_s;
             if ga == 0.0 {
                 continue;
             }
-            self.score[a] += ga * nu;
+            score[a] += ga * nu;
+            score_v[a] += ga * nu;
             for b in 0..m {
-                self.info[a * m + b] += ga * self.g[b];
+                let v = ga * self.g[b];
+                info[a * m + b] += v;
+                info_v[a * m + b] += v;
             }
         }
+    }
+}
+
+impl Signatures {
+    /// Information J (m × m, row-major) over the whole pass.
+    pub(super) fn info(&self) -> Vec<f64> {
+        self.info_half[0]
+            .iter()
+            .zip(&self.info_half[1])
+            .map(|(a, b)| a + b)
+            .collect()
+    }
+
+    /// Score b (m) over the whole pass.
+    pub(super) fn score(&self) -> Vec<f64> {
+        self.score_half[0]
+            .iter()
+            .zip(&self.score_half[1])
+            .map(|(a, b)| a + b)
+            .collect()
     }
 }
