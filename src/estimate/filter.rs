@@ -109,44 +109,33 @@ impl FilterConfig {
     /// Multiplies the white sensor noise in q by `arw_scale` (gyro) and `vrw_scale`
     /// (accelerometer): the densities scale, q by their squares.
     pub fn scale_sensor_noise(&mut self, model: &Model, arw_scale: f64, vrw_scale: f64) {
-        for (i, s) in model.states.iter().enumerate() {
-            if let StateRef::Nav(k) = *s {
-                match common::NAV_STATES[k].white_noise {
-                    WhiteNoise::GyroArw => self.q[i] *= arw_scale * arw_scale,
-                    WhiteNoise::AccelVrw => self.q[i] *= vrw_scale * vrw_scale,
-                    WhiteNoise::None => {}
-                }
-            }
+        for (i, w) in white_noise_states(model) {
+            self.q[i] *= match w {
+                WhiteNoise::GyroArw => arw_scale * arw_scale,
+                _ => vrw_scale * vrw_scale,
+            };
         }
     }
 
     /// White sensor noise densities in q: (ARW [rad/√s], VRW [m/s/√s]) of the first attitude and
     /// velocity state (0 when the model has none).
     pub fn sensor_noise(&self, model: &Model) -> (f64, f64) {
-        let (mut arw, mut vrw) = (0.0, 0.0);
-        for (i, s) in model.states.iter().enumerate() {
-            if let StateRef::Nav(k) = *s {
-                match common::NAV_STATES[k].white_noise {
-                    WhiteNoise::GyroArw if arw == 0.0 => arw = self.q[i].sqrt(),
-                    WhiteNoise::AccelVrw if vrw == 0.0 => vrw = self.q[i].sqrt(),
-                    _ => {}
-                }
-            }
-        }
-        (arw, vrw)
+        let first = |kind: WhiteNoise| {
+            white_noise_states(model)
+                .find(|&(_, w)| w == kind)
+                .map_or(0.0, |(i, _)| self.q[i].sqrt())
+        };
+        (first(WhiteNoise::GyroArw), first(WhiteNoise::AccelVrw))
     }
 
     /// Sets the white sensor noise used in q: ARW [rad/√s] and VRW [m/s/√s].
     /// (which states each drives is the spec's `white_noise`).
     pub fn with_sensor_noise(mut self, model: &Model, arw: f64, vrw: f64) -> FilterConfig {
-        for (i, s) in model.states.iter().enumerate() {
-            if let StateRef::Nav(k) = *s {
-                match common::NAV_STATES[k].white_noise {
-                    WhiteNoise::GyroArw => self.q[i] = arw * arw,
-                    WhiteNoise::AccelVrw => self.q[i] = vrw * vrw,
-                    WhiteNoise::None => {}
-                }
-            }
+        for (i, w) in white_noise_states(model) {
+            self.q[i] = match w {
+                WhiteNoise::GyroArw => arw * arw,
+                _ => vrw * vrw,
+            };
         }
         self
     }
@@ -161,6 +150,20 @@ impl FilterConfig {
             None => false,
         }
     }
+}
+
+/// The model's states driven by white sensor noise (spec `white_noise`): (model index, kind),
+/// `WhiteNoise::None` left out.
+fn white_noise_states(model: &Model) -> impl Iterator<Item = (usize, WhiteNoise)> + '_ {
+    model
+        .states
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| match *s {
+            StateRef::Nav(k) => Some((i, common::NAV_STATES[k].white_noise)),
+            StateRef::Term(_) => None,
+        })
+        .filter(|&(_, w)| w != WhiteNoise::None)
 }
 
 /// One aiding epoch: velocity and/or position with their 1-σ.

@@ -294,10 +294,13 @@ pub fn explain(
         opts,
     };
     let r = select_and_retest(&ctx, cands, base, &eligible, progress)?;
-    let (noise_findings, noise_pass) = noise_stage(&ctx, &r, &base_stats, progress)?;
+    let (noise_findings, noise_pass) = noise::stage(&ctx, &r, &base_stats, progress)?;
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let last_pass = noise_pass.as_ref().unwrap_or(&r.pass);
-    let mut findings = complete_findings(&ctx, &r, &base_stats, last_pass.stats.nis_mean)?;
+    let excess = baseline_excess(&base_stats);
+    // the share of the baseline's excess the extended model leaves
+    let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
+    let mut findings = complete_findings(&ctx, &r, excess, misfit_unexplained)?;
     findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
@@ -311,8 +314,6 @@ pub fn explain(
             .model_error_rms_arcsec
             .map(|e| e[0].hypot(e[1])),
     };
-    let misfit_unexplained =
-        baseline_excess(&base_stats).map(|e| (extended_stats.nis_mean - 1.0) / e);
     let mut ranked = tests;
     ranked.sort_by(|a, b| b.llr.total_cmp(&a.llr));
     let mut expl = Explanation {
@@ -570,15 +571,14 @@ fn select_and_retest(
 }
 
 /// The findings of the rounds: each named term with the extended filter's estimate, its prior,
-/// its mean regressor and effect on these data, and the words.
+/// its mean regressor and effect on these data, and the words; `excess` is the baseline's
+/// excess mean NIS and `unexplained` the share of it the extended model leaves.
 fn complete_findings(
     ctx: &Context,
     r: &Rounds,
-    base: &PassStats,
-    final_nis: f64,
+    excess: Option<f64>,
+    unexplained: Option<f64>,
 ) -> anyhow::Result<Vec<Finding>> {
-    let excess = baseline_excess(base);
-    let unexplained = excess.map(|e| (final_nis - 1.0) / e);
     let terms: Vec<usize> = r.named.iter().map(|n| n.term).collect();
     let means = if terms.is_empty() {
         Vec::new()
@@ -651,153 +651,6 @@ fn complete_findings(
         out.push(f);
     }
     Ok(out)
-}
-
-/// Noise levels as findings (after the terms): when the extended model's mean NIS lies outside
-/// its 95 % band, the ML scale of each noise level is tested against 1; the significant ones
-/// become findings of kind `noise` and a last pass with them is the extended one.
-fn noise_stage(
-    ctx: &Context,
-    r: &Rounds,
-    base: &PassStats,
-    progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<(Vec<Finding>, Option<Pass>)> {
-    let st = &r.pass.stats;
-    let n: usize = st.channels.iter().map(|c| c.count).sum();
-    let band = stats::mean_chi2_band(1.0, n.max(1), 1.959_964);
-    if !ctx.opts.noise_levels || (st.nis_mean >= band[0] && st.nis_mean <= band[1]) {
-        return Ok((Vec::new(), None));
-    }
-    let mut levels = vec![noise::Level::GyroArw, noise::Level::AccelVrw];
-    for i in &r.pass.run.innovations {
-        if !levels.contains(&noise::Level::Sigma(i.meas)) {
-            levels.push(noise::Level::Sigma(i.meas));
-        }
-    }
-    let cfg = ctx.extended_config(&r.model, &r.widened)?;
-    let round = r.rounds + 1;
-    let (fits, cfg_noise) = noise::fit(
-        &r.model,
-        &cfg,
-        &levels,
-        ctx.data,
-        (st.loglik, r.pass.run.innovations.len()),
-        ctx.opts,
-        &mut |f| progress(round, f),
-    )?;
-    if !fits.iter().any(|f| f.significant) {
-        return Ok((Vec::new(), None));
-    }
-    let pass = run_pass(&r.model, &[], ctx.data, &cfg_noise, &mut |f| {
-        progress(round + 1, f)
-    })?;
-    let excess = baseline_excess(base);
-    let removed = st.nis_mean - pass.stats.nis_mean;
-    let total: f64 = fits
-        .iter()
-        .filter(|f| f.significant)
-        .map(|f| f.two_delta_loglik)
-        .sum();
-    let (arw, vrw) = cfg.sensor_noise(&r.model);
-    let findings = fits
-        .iter()
-        .filter(|f| f.significant)
-        .map(|f| {
-            let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
-            noise_finding(
-                f,
-                arw,
-                vrw,
-                excess.map(|e| removed * w / e),
-                f.two_delta_loglik,
-            )
-        })
-        .collect();
-    Ok((findings, Some(pass)))
-}
-
-/// The finding of a significant noise level: the level the data show in the user's unit, its
-/// scale of the stated value and the interval.
-fn noise_finding(
-    f: &noise::LevelFit,
-    arw: f64,
-    vrw: f64,
-    misfit_share: Option<f64>,
-    two_delta_loglik: f64,
-) -> Finding {
-    let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0; // rad/√s → deg/√h
-    let ug_rt_hz = 1e6 / G0; // m/s/√s → µg/√Hz
-    let (stated, unit, what) = match f.level {
-        noise::Level::GyroArw => (
-            arw * deg_rt_h,
-            "deg/sqrt(h)",
-            "a gyro white noise (angle random walk)".to_string(),
-        ),
-        noise::Level::AccelVrw => (
-            vrw * ug_rt_hz,
-            "ug/sqrt(Hz)",
-            "an accelerometer white noise (velocity random walk)".to_string(),
-        ),
-        noise::Level::Sigma(m) => (1.0, "x stated", format!("a 1-σ of the {m} aiding")),
-    };
-    let estimate = stated * f.scale;
-    let [lo, hi] = f.interval;
-    let words = match f.level {
-        noise::Level::Sigma(_) => format!(
-            "the data show {what} {}× the σ the fixes state (95 % interval {}–{}×; 2Δℓ {})",
-            sig3(f.scale),
-            sig3(lo),
-            sig3(hi),
-            sig3(f.two_delta_loglik)
-        ),
-        _ => format!(
-            "the data show {what} of {} {unit}, {}× the stated {} (95 % interval {}–{}×; 2Δℓ {})",
-            sig3(estimate),
-            sig3(f.scale),
-            sig3(stated),
-            sig3(lo),
-            sig3(hi),
-            sig3(f.two_delta_loglik)
-        ),
-    };
-    let words = match misfit_share {
-        Some(s) => format!(
-            "{words}; it explains {} % of the baseline's excess misfit",
-            sig3(100.0 * s.max(0.0))
-        ),
-        None => words,
-    };
-    Finding {
-        term: f.level.name(),
-        kind: "noise",
-        estimate,
-        sigma: stated * f.scale * (hi / lo).ln() / (2.0 * 1.959_964),
-        unit: unit.into(),
-        llr: f.two_delta_loglik,
-        p_value: f.p_holm,
-        equivalent: Vec::new(),
-        equivalent_estimates: Vec::new(),
-        glr_estimate: estimate,
-        glr_sigma: f64::NAN,
-        round: 0,
-        confounded_with: None,
-        regressor_mean: 0.0,
-        regressor_unit: String::new(),
-        effect: estimate,
-        effect_unit: unit.into(),
-        separate_by: Vec::new(),
-        prior_sigma: stated,
-        prior_widened: false,
-        words,
-        two_delta_loglik,
-        misfit_share,
-        prior_sigmas: 0.0,
-        stand_in: None,
-        scale: Some(f.scale),
-        scale_interval: Some(f.interval),
-        halves: None,
-        speed_halves: None,
-    }
 }
 
 /// Why a term's estimates from two halves of the data, `which` (`[estimate, σ]` each, in `unit`),

@@ -5,12 +5,16 @@
 //!
 //! Each level is a scale s of what the filter was given (the `--noise`/`--grade` density, the σ a
 //! fix states). The log-likelihood is searched in log₂ s around the current value: passes at
-//! half and twice, a parabola through the three, a pass at its vertex (or further steps when
-//! the likelihood keeps rising), within 1/16 … 64. One sweep over the levels in turn (aiding
-//! σ first), each given the ones before. The 95 % interval is where the parabola falls by
-//! χ²₁(0.95)/2.
+//! half and twice, then successive parabolic interpolation (or steps of 4× while it keeps
+//! rising), within 1/16 … 64 of the start. Two sweeps over the levels in turn (white noise
+//! first, then the aiding σ), each given all the others. The 95 % interval is where the last
+//! parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns the significant
+//! levels into findings.
 
-use super::{run_pass, ExplainData, ExplainOptions};
+use super::{
+    baseline_excess, run_pass, sig3, Context, ExplainData, ExplainOptions, Finding, Pass,
+    PassStats, Rounds, G0,
+};
 use crate::estimate::filter::FilterConfig;
 use crate::estimate::stats;
 use crate::model::Model;
@@ -188,6 +192,153 @@ fn search(
 
 /// Most filter passes per noise level (the start point's pass not counted).
 const MAX_EVALS: usize = 5;
+
+/// Noise levels as findings (after the terms): when the extended model's mean NIS lies outside
+/// its 95 % band, the ML scale of each noise level is tested against 1; the significant ones
+/// become findings of kind `noise` and a last pass with them is the extended one.
+pub(super) fn stage(
+    ctx: &Context,
+    r: &Rounds,
+    base: &PassStats,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<(Vec<Finding>, Option<Pass>)> {
+    let st = &r.pass.stats;
+    let n: usize = st.channels.iter().map(|c| c.count).sum();
+    let band = stats::mean_chi2_band(1.0, n.max(1), 1.959_964);
+    if !ctx.opts.noise_levels || (st.nis_mean >= band[0] && st.nis_mean <= band[1]) {
+        return Ok((Vec::new(), None));
+    }
+    let mut levels = vec![Level::GyroArw, Level::AccelVrw];
+    for i in &r.pass.run.innovations {
+        if !levels.contains(&Level::Sigma(i.meas)) {
+            levels.push(Level::Sigma(i.meas));
+        }
+    }
+    let cfg = ctx.extended_config(&r.model, &r.widened)?;
+    let round = r.rounds + 1;
+    let (fits, cfg_noise) = fit(
+        &r.model,
+        &cfg,
+        &levels,
+        ctx.data,
+        (st.loglik, r.pass.run.innovations.len()),
+        ctx.opts,
+        &mut |f| progress(round, f),
+    )?;
+    if !fits.iter().any(|f| f.significant) {
+        return Ok((Vec::new(), None));
+    }
+    let pass = run_pass(&r.model, &[], ctx.data, &cfg_noise, &mut |f| {
+        progress(round + 1, f)
+    })?;
+    let excess = baseline_excess(base);
+    let removed = st.nis_mean - pass.stats.nis_mean;
+    let total: f64 = fits
+        .iter()
+        .filter(|f| f.significant)
+        .map(|f| f.two_delta_loglik)
+        .sum();
+    let (arw, vrw) = cfg.sensor_noise(&r.model);
+    let findings = fits
+        .iter()
+        .filter(|f| f.significant)
+        .map(|f| {
+            let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
+            noise_finding(
+                f,
+                arw,
+                vrw,
+                excess.map(|e| removed * w / e),
+                f.two_delta_loglik,
+            )
+        })
+        .collect();
+    Ok((findings, Some(pass)))
+}
+
+/// The finding of a significant noise level: the level the data show in the user's unit, its
+/// scale of the stated value and the interval.
+fn noise_finding(
+    f: &LevelFit,
+    arw: f64,
+    vrw: f64,
+    misfit_share: Option<f64>,
+    two_delta_loglik: f64,
+) -> Finding {
+    let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0; // rad/√s → deg/√h
+    let ug_rt_hz = 1e6 / G0; // m/s/√s → µg/√Hz
+    let (stated, unit, what) = match f.level {
+        Level::GyroArw => (
+            arw * deg_rt_h,
+            "deg/sqrt(h)",
+            "a gyro white noise (angle random walk)".to_string(),
+        ),
+        Level::AccelVrw => (
+            vrw * ug_rt_hz,
+            "ug/sqrt(Hz)",
+            "an accelerometer white noise (velocity random walk)".to_string(),
+        ),
+        Level::Sigma(m) => (1.0, "x stated", format!("a 1-σ of the {m} aiding")),
+    };
+    let estimate = stated * f.scale;
+    let [lo, hi] = f.interval;
+    let words = match f.level {
+        Level::Sigma(_) => format!(
+            "the data show {what} {}× the σ the fixes state (95 % interval {}–{}×; 2Δℓ {})",
+            sig3(f.scale),
+            sig3(lo),
+            sig3(hi),
+            sig3(f.two_delta_loglik)
+        ),
+        _ => format!(
+            "the data show {what} of {} {unit}, {}× the stated {} (95 % interval {}–{}×; 2Δℓ {})",
+            sig3(estimate),
+            sig3(f.scale),
+            sig3(stated),
+            sig3(lo),
+            sig3(hi),
+            sig3(f.two_delta_loglik)
+        ),
+    };
+    let words = match misfit_share {
+        Some(s) => format!(
+            "{words}; it explains {} % of the baseline's excess misfit",
+            sig3(100.0 * s.max(0.0))
+        ),
+        None => words,
+    };
+    Finding {
+        term: f.level.name(),
+        kind: "noise",
+        estimate,
+        sigma: stated * f.scale * (hi / lo).ln() / (2.0 * 1.959_964),
+        unit: unit.into(),
+        llr: f.two_delta_loglik,
+        p_value: f.p_holm,
+        equivalent: Vec::new(),
+        equivalent_estimates: Vec::new(),
+        glr_estimate: estimate,
+        glr_sigma: f64::NAN,
+        round: 0,
+        confounded_with: None,
+        regressor_mean: 0.0,
+        regressor_unit: String::new(),
+        effect: estimate,
+        effect_unit: unit.into(),
+        separate_by: Vec::new(),
+        prior_sigma: stated,
+        prior_widened: false,
+        words,
+        two_delta_loglik,
+        misfit_share,
+        prior_sigmas: 0.0,
+        stand_in: None,
+        scale: Some(f.scale),
+        scale_interval: Some(f.interval),
+        halves: None,
+        speed_halves: None,
+    }
+}
 
 #[cfg(test)]
 mod tests {

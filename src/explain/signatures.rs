@@ -63,6 +63,10 @@ pub(super) struct Signatures {
     pub(super) gnss: Vec<(usize, &'static str)>,
     /// The navigation point of the last step (a GNSS candidate's H entry is evaluated there).
     pub(super) np: Option<NavPoint>,
+    /// The current measurement's GNSS candidate entries: (component, candidate, H value).
+    pub(super) gnss_h: Vec<(usize, usize, f64)>,
+    /// The (measurement, time) `gnss_h` holds.
+    pub(super) gnss_h_key: (&'static str, f64),
 }
 
 pub(super) fn reg_id(t: usize) -> usize {
@@ -147,6 +151,8 @@ impl Signatures {
                 .map(|(c, &t)| (c, common::TERMS[t].name))
                 .collect(),
             np: None,
+            gnss_h: Vec::new(),
+            gnss_h_key: ("", f64::NAN),
         }
     }
 }
@@ -249,15 +255,23 @@ impl Observer for Signatures {
         // G = H D (per candidate), plus a GNSS candidate's own H entry, then D ← D − K G
         self.g.iter_mut().for_each(|x| *x = 0.0);
         if let (false, Some(np)) = (self.gnss.is_empty(), &self.np) {
-            if let Some(mi) = common::MEASUREMENTS.iter().position(|x| x.name == meas) {
-                let (g, gnss) = (&mut self.g, &self.gnss);
-                common::measurement_entries(mi, np, &mut |row, state, v| {
-                    if row == component {
+            // the measurement's GNSS entries, evaluated once per epoch for all its components
+            if self.gnss_h_key != (meas, t) {
+                self.gnss_h_key = (meas, t);
+                self.gnss_h.clear();
+                if let Some(mi) = common::MEASUREMENTS.iter().position(|x| x.name == meas) {
+                    let (out, gnss) = (&mut self.gnss_h, &self.gnss);
+                    common::measurement_entries(mi, np, &mut |row, state, v| {
                         if let Some(&(c, _)) = gnss.iter().find(|x| x.1 == state) {
-                            g[c] += v;
+                            out.push((row, c, v));
                         }
-                    }
-                });
+                    });
+                }
+            }
+            for &(row, c, v) in &self.gnss_h {
+                if row == component {
+                    self.g[c] += v;
+                }
             }
         }
         for (j, &hj) in h.iter().enumerate().take(n) {
