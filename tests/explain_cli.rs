@@ -334,27 +334,40 @@ fn candidates_in_the_baseline_are_skipped_and_untestable_ones_listed() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
-/// Both measured sets (docs/explain.md): only what is stable is asserted.
-#[test]
-fn measured_data() {
-    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
-    let rlg = format!("{shared}/psins-lasergyro/lasergyro.imu");
-    let out = tmp("rlg");
-    let (ok, _, stderr) = sinsmodel(&[
+/// `explain` on the parked laser-gyro log with its static aid (docs/explain.md §1), P28.
+fn rlg_static_explain(out: &std::path::Path) -> Vec<String> {
+    let rlg = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/data/psins-lasergyro/lasergyro.imu"
+    );
+    [
         "explain",
         "--model",
         "P28",
         "--imu",
-        &rlg,
+        rlg,
         "--static-aid",
         "34.246048,108.909664,380",
         "--init",
         "34.246048,108.909664,380,0.3878,1.0026,90.603",
-        "--noise",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/docs/real-data/rlg_allan.json"),
         "--out",
         out.to_str().unwrap(),
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// Both measured sets (docs/explain.md): only what is stable is asserted.
+#[test]
+fn measured_data() {
+    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
+    let out = tmp("rlg");
+    let mut args = rlg_static_explain(&out);
+    args.extend([
+        "--noise".to_string(),
+        concat!(env!("CARGO_MANIFEST_DIR"), "/docs/real-data/rlg_allan.json").to_string(),
     ]);
+    let (ok, _, stderr) = sinsmodel(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(ok, "{stderr}");
     let v = json(&out.join("explain.json"));
     // the parked car's motion is no error term: nothing is named
@@ -439,32 +452,20 @@ fn measured_data() {
 #[test]
 fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
     let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
-    let rlg = format!("{shared}/psins-lasergyro/lasergyro.imu");
     let out = tmp("gnss-static");
-    let base = [
-        "explain",
-        "--model",
-        "P28",
-        "--imu",
-        &rlg,
-        "--static-aid",
-        "34.246048,108.909664,380",
-        "--init",
-        "34.246048,108.909664,380,0.3878,1.0026,90.603",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    let mut args = base.to_vec();
-    args.extend(["--candidates", "dt_gnss,d_x"]);
-    let (ok, _, stderr) = sinsmodel(&args);
+    let base = rlg_static_explain(&out);
+    let run = |extra: [&str; 2]| {
+        let mut a: Vec<&str> = base.iter().map(String::as_str).collect();
+        a.extend(extra);
+        sinsmodel(&a)
+    };
+    let (ok, _, stderr) = run(["--candidates", "dt_gnss,d_x"]);
     assert!(!ok);
     assert!(
         stderr.contains("dt_gnss is a GNSS term") && stderr.contains("without --aid"),
         "{stderr}"
     );
-    let mut args = base.to_vec();
-    args.extend(["--lever-arm", "0.1,0,-1"]);
-    let (ok, _, stderr) = sinsmodel(&args);
+    let (ok, _, stderr) = run(["--lever-arm", "0.1,0,-1"]);
     assert!(!ok);
     assert!(stderr.contains("need --aid"), "{stderr}");
     let d = format!("{shared}/gnss-imu-drive");
