@@ -161,6 +161,52 @@ fn finds_a_hidden_antenna_lever_arm() {
 }
 
 #[test]
+fn finds_an_off_axis_inner_lever_arm_on_a_turntable() {
+    check_found(CaseKind::One("inner_lever"), 1);
+}
+
+/// The same turntable with the off-axis lever arm withheld from the candidates (the hidden
+/// effect is outside what explain may name): whatever explain fits must be labelled as standing
+/// in for something else, never presented as a cause. (Measured over seeds 1–10: 8 of 10
+/// give no confident finding; docs/explain.md §5.)
+#[test]
+fn a_withheld_inner_lever_arm_gives_no_confident_finding() {
+    let case = generate(1, CaseKind::One("inner_lever"), SECONDS, 1.0).withholding(&["size_"]);
+    let out = run_hidden_case(&case, &ExplainOptions::default()).expect("explain runs");
+    let e = &out.explanation;
+    assert!(
+        !e.findings.is_empty(),
+        "{}: nothing fitted",
+        case.description
+    );
+    for f in &e.findings {
+        assert!(
+            f.stand_in.is_some(),
+            "{}: {} = {} {} presented as a cause: {}",
+            case.description,
+            f.term,
+            f.estimate,
+            f.unit,
+            f.words
+        );
+    }
+}
+
+/// The turntable with nothing hidden (the lever arm scaled to zero) names nothing.
+#[test]
+fn names_nothing_on_a_clean_turntable() {
+    let case = generate(1, CaseKind::One("inner_lever"), SECONDS, 1.0).scaled(0.0);
+    let out = run_hidden_case(&case, &ExplainOptions::default()).expect("explain runs");
+    let named: Vec<&str> = out
+        .explanation
+        .findings
+        .iter()
+        .map(|f| f.term.as_str())
+        .collect();
+    assert!(named.is_empty(), "{}: named {named:?}", case.description);
+}
+
+#[test]
 fn finds_two_hidden_terms_by_forward_selection() {
     check_found(CaseKind::Two, 1);
 }
@@ -208,6 +254,7 @@ fn probe() {
             sinsmodel::sim::hidden::GROUPS
                 .iter()
                 .chain(sinsmodel::sim::hidden::GNSS_GROUPS.iter())
+                .chain(sinsmodel::sim::hidden::TURNTABLE_GROUPS.iter())
                 .find(|x| **x == g)
                 .expect("a group, null or two"),
         ),
@@ -216,7 +263,11 @@ fn probe() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
-    let (case, out) = run(kind, seed);
+    let mut case = generate(seed, kind, SECONDS, clear_effect(kind));
+    if let Ok(w) = std::env::var("WITHHOLD") {
+        case = case.withholding(&w.split(',').collect::<Vec<_>>());
+    }
+    let out = run_hidden_case(&case, &ExplainOptions::default()).expect("explain runs");
     eprintln!("{}", case.description);
     if std::env::var("SCEN").is_ok() {
         eprintln!("{}", case.scenario);
@@ -229,6 +280,23 @@ fn probe() {
         eprintln!(
             "  cand {} llr {:.1} p_holm {:.2e} glr {:.3e}±{:.1e} {} conf {:?}",
             c.term, c.llr, c.p_holm, c.glr_estimate, c.glr_sigma, c.unit, c.confounded_with
+        );
+    }
+    for f in &e.findings {
+        eprintln!(
+            "  finding {} {:.4} ± {:.2} {} prior σ {:.1} share {:?} stand-in {} splits failing {:?}",
+            f.term,
+            f.estimate,
+            f.sigma,
+            f.unit,
+            f.prior_sigmas,
+            f.misfit_share,
+            f.stand_in.is_some(),
+            f.consistency
+                .iter()
+                .filter(|c| !c.holds)
+                .map(|c| format!("{} χ² {:.1}/{}", c.split, c.chi2, c.dof))
+                .collect::<Vec<_>>()
         );
     }
     for (h, (x, s)) in case.hidden.iter().zip(&out.oracle_estimates) {

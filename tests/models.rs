@@ -127,8 +127,9 @@ fn preset_path_equals_runtime_path() {
         for _ in 0..50 {
             let (nav, f, w) = random_point(&mut rng);
             let mut acc = m.accumulator();
-            acc.add(&f, &w);
-            acc.add(&(f * 0.5), &(w * -0.3));
+            let dw = w.cross(&f) * 0.7;
+            acc.add(&f, &w, &dw);
+            acc.add(&(f * 0.5), &(w * -0.3), &(dw * 1.9));
             let r = acc.mean();
             let mut a1 = vec![0.0; n * n];
             let mut a2 = vec![0.0; n * n];
@@ -177,7 +178,7 @@ fn covariance_kernels_match_dense_reference() {
         let n = m.n();
         let (nav, f, w) = random_point(&mut rng);
         let mut acc = m.accumulator();
-        acc.add(&f, &w);
+        acc.add(&f, &w, &Vector3::zeros());
         let mut a = vec![0.0; n * n];
         m.fill_a(&nav, &acc.mean(), &mut a);
         // a random symmetric positive definite P
@@ -223,7 +224,11 @@ fn accumulator_uses_mean_of_squares() {
     let samples = 2000;
     for i in 0..samples {
         let fx = amp * (2.0 * std::f64::consts::PI * i as f64 / 20.0).cos();
-        acc.add(&Vector3::new(fx, 0.0, -9.8), &Vector3::zeros());
+        acc.add(
+            &Vector3::new(fx, 0.0, -9.8),
+            &Vector3::zeros(),
+            &Vector3::zeros(),
+        );
     }
     let r = acc.mean();
     assert!(

@@ -71,6 +71,11 @@ class MisprintsAreCaught(unittest.TestCase):
     def test_reversed_lever_arm_velocity_is_named_in_h(self):
         self.check_fails(9, "P31+lever_y", "H[vel_ne][0][lever_y]")
 
+    def test_reversed_tangential_inner_lever_arm_is_named(self):
+        code, out = run("--corrupt", "10", "--models", "P31+size_x_y")
+        self.assertEqual(code, 1, f"reversed tangential part not caught:\n{out}")
+        self.assertIn("][size_x_y]:", out, f"wrong entry named:\n{out}")
+
     def test_every_spec_term_is_checked_by_default(self):
         models = vj.default_models()
         named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}
@@ -80,15 +85,15 @@ class MisprintsAreCaught(unittest.TestCase):
 class RegressorTranslation(unittest.TestCase):
     def test_translates_the_spec_grammar(self):
         import casadi as ca
-        f, w = ca.DM([1.5, -2.0, 3.0]), ca.DM([0.1, 0.2, -0.3])
+        f, w, dw = ca.DM([1.5, -2.0, 3.0]), ca.DM([0.1, 0.2, -0.3]), ca.DM([4.0, 5.0, 6.0])
         for text, want in [("1", 1.0), ("f.x * f.y", -3.0), ("f.z.powi(2)", 9.0), ("f.y.abs()", 2.0),
                            ("f.y * f.y.abs()", -4.0), ("-(w.y.powi(2) + w.z.powi(2))", -0.13),
-                           ("f.x / 2.0 - w.x", 0.65)]:
-            got = float(vj.translate_regressor(text, "t")(f, w))
+                           ("f.x / 2.0 - w.x", 0.65), ("w.x * w.y - dw.z", -5.98)]:
+            got = float(vj.translate_regressor(text, "t")(f, w, dw))
             self.assertAlmostEqual(got, want, places=12, msg=text)
 
     def test_rejects_what_it_cannot_translate(self):
-        for text in ["f.x.exp()", "g.y", "f.x ** 2", "f.x.powi(h)", "import os", "f[0]", "lat"]:
+        for text in ["f.x.exp()", "g.y", "f.x ** 2", "f.x.powi(h)", "import os", "f[0]", "lat", "dw.q"]:
             with self.assertRaises(vj.SpecTranslationError, msg=text):
                 vj.translate_regressor(text, "t")
 

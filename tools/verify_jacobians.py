@@ -97,9 +97,10 @@ _METHODS = {
 
 
 def translate_regressor(text, term):
-    """Turns a spec regressor (Rust syntax: `f.x * f.y`, `f.z.powi(2)`, `-(w.y.powi(2) + w.z.powi(2))`)
-    into a function (f, w) -> CasADi expression. Only literals, f.x..w.z, + - * /, unary minus and
-    the methods abs sqrt sin cos tan powi(integer) are accepted; anything else raises."""
+    """Turns a spec regressor (Rust syntax: `f.x * f.y`, `f.z.powi(2)`, `-(w.y.powi(2) + w.z.powi(2))`,
+    `w.x * w.y - dw.z`) into a function (f, w, dw) -> CasADi expression. Only literals, f.x..dw.z,
+    + - * /, unary minus and the methods abs sqrt sin cos tan powi(integer) are accepted; anything
+    else raises."""
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as e:
@@ -108,18 +109,20 @@ def translate_regressor(text, term):
     def fail(node, why):
         raise SpecTranslationError(f"term `{term}`: regressor `{text}`: cannot translate `{ast.unparse(node)}` ({why})")
 
+    signals = ("f", "w", "dw")
+
     def tr(node):
         if isinstance(node, ast.Constant) and type(node.value) in (int, float):
             v = float(node.value)
-            return lambda f, w: v
+            return lambda s: v
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
-            if node.value.id in ("f", "w") and node.attr in ("x", "y", "z"):
-                sig, k = node.value.id, "xyz".index(node.attr)
-                return (lambda f, w: f[k]) if sig == "f" else (lambda f, w: w[k])
-            fail(node, "signals are f.x f.y f.z and w.x w.y w.z")
+            if node.value.id in signals and node.attr in ("x", "y", "z"):
+                i, k = signals.index(node.value.id), "xyz".index(node.attr)
+                return lambda s: s[i][k]
+            fail(node, "signals are f.x f.y f.z, w.x w.y w.z and dw.x dw.y dw.z")
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
             inner = tr(node.operand)
-            return (lambda f, w: -inner(f, w)) if isinstance(node.op, ast.USub) else inner
+            return (lambda s: -inner(s)) if isinstance(node.op, ast.USub) else inner
         if isinstance(node, ast.BinOp):
             a, b = tr(node.left), tr(node.right)
             ops = {ast.Add: lambda x, y: x + y, ast.Sub: lambda x, y: x - y,
@@ -127,21 +130,30 @@ def translate_regressor(text, term):
             op = ops.get(type(node.op))
             if op is None:
                 fail(node, "operators are + - * /")
-            return lambda f, w: op(a(f, w), b(f, w))
+            return lambda s: op(a(s), b(s))
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and not node.keywords:
             recv, name = tr(node.func.value), node.func.attr
             if name == "powi":
                 if len(node.args) != 1 or not (isinstance(node.args[0], ast.Constant) and type(node.args[0].value) is int):
                     fail(node, "powi takes one integer literal")
                 k = node.args[0].value
-                return lambda f, w: recv(f, w) ** k
+                return lambda s: recv(s) ** k
             if name in _METHODS and not node.args:
                 m = _METHODS[name]
-                return lambda f, w: m(recv(f, w))
+                return lambda s: m(recv(s))
             fail(node, f"methods are {' '.join(sorted(_METHODS))} powi")
-        fail(node, "not arithmetic over f and w")
+        fail(node, "not arithmetic over f, w and dw")
 
-    return tr(tree.body)
+    body = tr(tree.body)
+    return lambda f, w, dw=(0, 0, 0): body((f, w, dw))
+
+
+# Accelerometer inner lever arms, written independently of the spec: accelerometer i sits at
+# r = theta along body axis j, so it reads the specific force of that point,
+# f + w x (w x r) + dw x r, along its axis i (w the inertial body rate, dw its derivative).
+# name -> (accelerometer axis i, coordinate j)
+INNER_LEVER = {f"size_{i}" + ("" if i == j else f"_{j}"): ("xyz".index(i), "xyz".index(j))
+               for i in "xyz" for j in "xyz"}
 
 
 # GNSS measurement terms, written independently of the spec: what each one does to the fix.
@@ -176,7 +188,15 @@ def load_spec_terms(spec_dir=SPEC_DIR):
             continue
         if t["sensor"] not in ("gyro", "accel") or t["axis"] not in ("x", "y", "z"):
             raise SpecTranslationError(f"term `{name}`: sensor `{t['sensor']}` / axis `{t['axis']}` unknown to the checker")
-        terms[name] = (t["sensor"], "xyz".index(t["axis"]), translate_regressor(t["regressor"], name))
+        if name in INNER_LEVER:
+            # its physics is this file's own (INNER_LEVER); the spec's regressor is not read
+            i, j = INNER_LEVER[name]
+            if t["sensor"] != "accel" or "xyz".index(t["axis"]) != i:
+                raise SpecTranslationError(f"term `{name}`: an inner lever arm of the {'xyz'[i]} accelerometer, "
+                                           f"but the spec says {t['sensor']} {t['axis']}")
+            terms[name] = ("accel", i, ("inner_lever", j))
+        else:
+            terms[name] = (t["sensor"], "xyz".index(t["axis"]), translate_regressor(t["regressor"], name))
         if t.get("library", False):
             library.append(name)
     with open(os.path.join(spec_dir, "presets.toml"), "rb") as fh:
@@ -203,11 +223,11 @@ MEAS_STATES = {"vel_ne": ["dv_n", "dv_e"], "pos_ne": ["dlat", "dlon"], "pos_h": 
 # ---------------------------------------------------------------- the nonlinear error dynamics
 def build_jacobian_function():
     """CasADi function: point parameters -> (J_A [9 x (9+T)] at zero error, J_H, sparsity)."""
-    p = ca.SX.sym("p", 14)  # lat, h, vn ve vd, roll pitch yaw, f_b(3), w_b(3)
+    p = ca.SX.sym("p", 17)  # lat, h, vn ve vd, roll pitch yaw, f_b(3), w_b(3), dw_b(3)
     lat, h = p[0], p[1]
     v = p[2:5]
     c = dcm_from_euler(p[5], p[6], p[7])
-    f_b, w_b = p[8:11], p[11:14]
+    f_b, w_b, dw_b = p[8:11], p[11:14], p[14:17]
     rm0, rn0 = radii(lat)  # frozen at the true latitude
 
     x = ca.SX.sym("x", len(ALL_STATES))
@@ -238,7 +258,13 @@ def build_jacobian_function():
         sensor, axis, reg = TERMS[name]
         if sensor == "gnss":
             continue
-        contrib = theta[k] * reg(f_b, w_b)
+        if isinstance(reg, tuple):
+            # an inner lever arm: the accelerometer at r = theta e_j
+            r = ca.SX.zeros(3)
+            r[reg[1]] = theta[k]
+            contrib = (ca.cross(w_b, ca.cross(w_b, r)) + ca.cross(dw_b, r))[axis]
+        else:
+            contrib = theta[k] * reg(f_b, w_b, dw_b)
         if sensor == "gyro":
             dw[axis] = dw[axis] + contrib
         else:
@@ -323,6 +349,13 @@ def corrupt(kind, out, pt):
         # a lever arm's velocity rows with the cross product reversed (l x w for w x l)
         col = idx["lever_y"]
         out["h"]["vel_ne"][0][col] = -out["h"]["vel_ne"][0][col]
+    elif kind == 10 and "size_x_y" in idx:
+        # an off-axis inner lever arm with its tangential part reversed (r x dw for dw x r)
+        dwz = pt["dw_b"][2]
+        reg_wrong = w[0] * w[1] + dwz
+        for k, row in enumerate(["dv_n", "dv_e", "dv_d"]):
+            if row in idx:
+                a[idx[row]][idx["size_x_y"]] = cm[k, 0] * reg_wrong
 
 
 def random_points(n, rng):
@@ -339,13 +372,14 @@ def random_points(n, rng):
             "euler_deg": [float(rng.uniform(-180, 180)), float(rng.uniform(-89, 89)), float(rng.uniform(-180, 180))],
             "f_b": [float(x) for x in rand_vec(20 * 9.80665)],
             "w_b": [float(x) for x in rand_vec(3.0)],
+            "dw_b": [float(x) for x in rand_vec(30.0)],
         })
     return pts
 
 
 def point_vector(pt):
     return [math.radians(pt["lat_deg"]), pt["h_m"], *pt["v_ned"],
-            *[math.radians(v) for v in pt["euler_deg"]], *pt["f_b"], *pt["w_b"]]
+            *[math.radians(v) for v in pt["euler_deg"]], *pt["f_b"], *pt["w_b"], *pt.get("dw_b", [0, 0, 0])]
 
 
 def run_sinsmodel(binary, model, points, runtime):
@@ -476,7 +510,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed; the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed; the check must fail")
     args = ap.parse_args()
 
     models = args.models or default_models()

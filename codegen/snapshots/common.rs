@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 55;
+pub const TERM_COUNT: usize = 61;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -854,6 +854,90 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         library: true,
     },
     TermInfo {
+        name: "size_x_y",
+        sensor: Sensor::Accel,
+        axis: 0,
+        regressor: 22,
+        unit: "m",
+        display: "mm",
+        display_to_si: 0.001,
+        sigma: 0.01,
+        noise: 0.0,
+        group: "size effect",
+        doc: "x accelerometer offset along y (centripetal w_x w_y, tangential -dw_z)",
+        library: true,
+    },
+    TermInfo {
+        name: "size_x_z",
+        sensor: Sensor::Accel,
+        axis: 0,
+        regressor: 23,
+        unit: "m",
+        display: "mm",
+        display_to_si: 0.001,
+        sigma: 0.01,
+        noise: 0.0,
+        group: "size effect",
+        doc: "x accelerometer offset along z (centripetal w_x w_z, tangential dw_y)",
+        library: true,
+    },
+    TermInfo {
+        name: "size_y_x",
+        sensor: Sensor::Accel,
+        axis: 1,
+        regressor: 24,
+        unit: "m",
+        display: "mm",
+        display_to_si: 0.001,
+        sigma: 0.01,
+        noise: 0.0,
+        group: "size effect",
+        doc: "y accelerometer offset along x (centripetal w_x w_y, tangential dw_z)",
+        library: true,
+    },
+    TermInfo {
+        name: "size_y_z",
+        sensor: Sensor::Accel,
+        axis: 1,
+        regressor: 25,
+        unit: "m",
+        display: "mm",
+        display_to_si: 0.001,
+        sigma: 0.01,
+        noise: 0.0,
+        group: "size effect",
+        doc: "y accelerometer offset along z (centripetal w_y w_z, tangential -dw_x)",
+        library: true,
+    },
+    TermInfo {
+        name: "size_z_x",
+        sensor: Sensor::Accel,
+        axis: 2,
+        regressor: 26,
+        unit: "m",
+        display: "mm",
+        display_to_si: 0.001,
+        sigma: 0.01,
+        noise: 0.0,
+        group: "size effect",
+        doc: "z accelerometer offset along x (centripetal w_x w_z, tangential -dw_y)",
+        library: true,
+    },
+    TermInfo {
+        name: "size_z_y",
+        sensor: Sensor::Accel,
+        axis: 2,
+        regressor: 27,
+        unit: "m",
+        display: "mm",
+        display_to_si: 0.001,
+        sigma: 0.01,
+        noise: 0.0,
+        group: "size effect",
+        doc: "z accelerometer offset along y (centripetal w_y w_z, tangential dw_x)",
+        library: true,
+    },
+    TermInfo {
         name: "dt_gnss",
         sensor: Sensor::Gnss,
         axis: 0,
@@ -1008,6 +1092,12 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
     &[],
     &[],
     &[],
@@ -1015,7 +1105,7 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
 ];
 
 /// Number of distinct regressors.
-pub const REGRESSOR_COUNT: usize = 22;
+pub const REGRESSOR_COUNT: usize = 28;
 
 /// Regressor expressions over the body-frame signals f [m/s²] and w [rad/s].
 pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [
@@ -1041,12 +1131,19 @@ pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [
     "-(w.y.powi(2) + w.z.powi(2))",
     "-(w.x.powi(2) + w.z.powi(2))",
     "-(w.x.powi(2) + w.y.powi(2))",
+    "w.x * w.y - dw.z",
+    "w.x * w.z + dw.y",
+    "w.x * w.y + dw.z",
+    "w.y * w.z - dw.x",
+    "w.x * w.z - dw.y",
+    "w.y * w.z + dw.x",
 ];
 
 /// True for regressors that use no IMU signal (no accumulation needed).
 pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [
     true, false, false, false, false, false, false, false, false, false, false, false,
-    false, false, false, false, false, false, false, false, false, false,
+    false, false, false, false, false, false, false, false, false, false, false, false,
+    false, false, false, false,
 ];
 
 /// Gyro angle random walk [rad/√s] (spec default).
@@ -1130,6 +1227,12 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.01,
             0.01,
             0.01,
+            0.01,
+            0.01,
+            0.01,
+            0.01,
+            0.01,
+            0.01,
             0.1,
             1.0,
             1.0,
@@ -1206,6 +1309,12 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.01,
             0.01,
             0.01,
+            0.01,
+            0.01,
+            0.01,
+            0.01,
+            0.01,
+            0.01,
             0.1,
             1.0,
             1.0,
@@ -1268,8 +1377,13 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
     },
 ];
 
-/// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], FRD body frame).
-pub fn regressor_value(id: usize, f: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
+/// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], dw [rad/s²], FRD body frame).
+pub fn regressor_value(
+    id: usize,
+    f: &Vector3<f64>,
+    w: &Vector3<f64>,
+    dw: &Vector3<f64>,
+) -> f64 {
     match id {
         0 => 1.0,
         1 => w.x,
@@ -1293,6 +1407,12 @@ pub fn regressor_value(id: usize, f: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
         19 => -(w.y.powi(2) + w.z.powi(2)),
         20 => -(w.x.powi(2) + w.z.powi(2)),
         21 => -(w.x.powi(2) + w.y.powi(2)),
+        22 => w.x * w.y - dw.z,
+        23 => w.x * w.z + dw.y,
+        24 => w.x * w.y + dw.z,
+        25 => w.y * w.z - dw.x,
+        26 => w.x * w.z - dw.y,
+        27 => w.y * w.z + dw.x,
         _ => panic!("regressor index {id} out of range"),
     }
 }
@@ -1952,15 +2072,87 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             col[DV_D] = c33 * r;
         }
         51 => {
-            // dt_gnss: Gnss x axis, regressor 1
+            // size_x_y: Accel x axis, regressor w.x * w.y - dw.z
+            let c11 = nav.c[0][0];
+            let c21 = nav.c[1][0];
+            let c31 = nav.c[2][0];
+            // A[dv_n][size_x_y] = C11 * <w.x * w.y - dw.z>
+            col[DV_N] = c11 * r;
+            // A[dv_e][size_x_y] = C21 * <w.x * w.y - dw.z>
+            col[DV_E] = c21 * r;
+            // A[dv_d][size_x_y] = C31 * <w.x * w.y - dw.z>
+            col[DV_D] = c31 * r;
         }
         52 => {
-            // lever_x: Gnss x axis, regressor 1
+            // size_x_z: Accel x axis, regressor w.x * w.z + dw.y
+            let c11 = nav.c[0][0];
+            let c21 = nav.c[1][0];
+            let c31 = nav.c[2][0];
+            // A[dv_n][size_x_z] = C11 * <w.x * w.z + dw.y>
+            col[DV_N] = c11 * r;
+            // A[dv_e][size_x_z] = C21 * <w.x * w.z + dw.y>
+            col[DV_E] = c21 * r;
+            // A[dv_d][size_x_z] = C31 * <w.x * w.z + dw.y>
+            col[DV_D] = c31 * r;
         }
         53 => {
-            // lever_y: Gnss x axis, regressor 1
+            // size_y_x: Accel y axis, regressor w.x * w.y + dw.z
+            let c12 = nav.c[0][1];
+            let c22 = nav.c[1][1];
+            let c32 = nav.c[2][1];
+            // A[dv_n][size_y_x] = C12 * <w.x * w.y + dw.z>
+            col[DV_N] = c12 * r;
+            // A[dv_e][size_y_x] = C22 * <w.x * w.y + dw.z>
+            col[DV_E] = c22 * r;
+            // A[dv_d][size_y_x] = C32 * <w.x * w.y + dw.z>
+            col[DV_D] = c32 * r;
         }
         54 => {
+            // size_y_z: Accel y axis, regressor w.y * w.z - dw.x
+            let c12 = nav.c[0][1];
+            let c22 = nav.c[1][1];
+            let c32 = nav.c[2][1];
+            // A[dv_n][size_y_z] = C12 * <w.y * w.z - dw.x>
+            col[DV_N] = c12 * r;
+            // A[dv_e][size_y_z] = C22 * <w.y * w.z - dw.x>
+            col[DV_E] = c22 * r;
+            // A[dv_d][size_y_z] = C32 * <w.y * w.z - dw.x>
+            col[DV_D] = c32 * r;
+        }
+        55 => {
+            // size_z_x: Accel z axis, regressor w.x * w.z - dw.y
+            let c13 = nav.c[0][2];
+            let c23 = nav.c[1][2];
+            let c33 = nav.c[2][2];
+            // A[dv_n][size_z_x] = C13 * <w.x * w.z - dw.y>
+            col[DV_N] = c13 * r;
+            // A[dv_e][size_z_x] = C23 * <w.x * w.z - dw.y>
+            col[DV_E] = c23 * r;
+            // A[dv_d][size_z_x] = C33 * <w.x * w.z - dw.y>
+            col[DV_D] = c33 * r;
+        }
+        56 => {
+            // size_z_y: Accel z axis, regressor w.y * w.z + dw.x
+            let c13 = nav.c[0][2];
+            let c23 = nav.c[1][2];
+            let c33 = nav.c[2][2];
+            // A[dv_n][size_z_y] = C13 * <w.y * w.z + dw.x>
+            col[DV_N] = c13 * r;
+            // A[dv_e][size_z_y] = C23 * <w.y * w.z + dw.x>
+            col[DV_E] = c23 * r;
+            // A[dv_d][size_z_y] = C33 * <w.y * w.z + dw.x>
+            col[DV_D] = c33 * r;
+        }
+        57 => {
+            // dt_gnss: Gnss x axis, regressor 1
+        }
+        58 => {
+            // lever_x: Gnss x axis, regressor 1
+        }
+        59 => {
+            // lever_y: Gnss x axis, regressor 1
+        }
+        60 => {
             // lever_z: Gnss x axis, regressor 1
         }
         _ => panic!("term index {term} out of range"),

@@ -327,9 +327,10 @@ pub struct Regressors {
 }
 
 impl Regressors {
-    /// Adds one IMU sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
+    /// Adds one IMU sample: specific force f [m/s²], rate w [rad/s] and angular
+    /// acceleration dw [rad/s²], FRD body frame.
     #[inline]
-    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
+    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, _dw: &Vector3<f64>) {
         self.sum[0] += w.x;
         self.sum[1] += w.y;
         self.sum[2] += w.z;
@@ -362,8 +363,14 @@ impl Regressors {
     }
 }
 
-/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
-pub fn accumulate_dyn(sum: &mut [f64], f: &Vector3<f64>, w: &Vector3<f64>) {
+/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s],
+/// dw [rad/s²]).
+pub fn accumulate_dyn(
+    sum: &mut [f64],
+    f: &Vector3<f64>,
+    w: &Vector3<f64>,
+    _dw: &Vector3<f64>,
+) {
     let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");
     sum[0] += w.x;
     sum[1] += w.y;

@@ -203,8 +203,9 @@ pub fn common_module(spec: &Spec) -> String {
         quote!(#i => #ast,)
     });
     let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
-    let (uses_f, uses_w) = signals_used(spec, &all_regs);
-    let (f_param, w_param) = (param("f", uses_f), param("w", uses_w));
+    let (uses_f, uses_w, uses_dw) = signals_used(spec, &all_regs);
+    let (f_param, w_param, dw_param) =
+        (param("f", uses_f), param("w", uses_w), param("dw", uses_dw));
     let r_param = param(
         "r",
         spec.terms
@@ -410,8 +411,8 @@ pub fn common_module(spec: &Spec) -> String {
         /// Measurement types.
         pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
 
-        /// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], FRD body frame).
-        pub fn regressor_value(id: usize, #f_param: &Vector3<f64>, #w_param: &Vector3<f64>) -> f64 {
+        /// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], dw [rad/s²], FRD body frame).
+        pub fn regressor_value(id: usize, #f_param: &Vector3<f64>, #w_param: &Vector3<f64>, #dw_param: &Vector3<f64>) -> f64 {
             match id {
                 #(#reg_arms)*
                 _ => panic!("regressor index {id} out of range"),
@@ -501,13 +502,14 @@ fn param(name: &str, used: bool) -> syn::Ident {
     }
 }
 
-/// Which IMU signals (`f`, `w`) the given regressors read.
-fn signals_used(spec: &Spec, regs: &[usize]) -> (bool, bool) {
-    let mut used = (false, false);
+/// Which IMU signals (`f`, `w`, `dw`) the given regressors read.
+fn signals_used(spec: &Spec, regs: &[usize]) -> (bool, bool, bool) {
+    let mut used = (false, false, false);
     for &r in regs {
         for s in spec.regressors[r].expr.symbols() {
             used.0 |= s.starts_with("f.");
             used.1 |= s.starts_with("w.");
+            used.2 |= s.starts_with("dw.");
         }
     }
     used
@@ -599,8 +601,8 @@ fn preset_constants(
 /// The step-mean accumulator of the model's regressors (struct and slice form).
 fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
     let regs = layout.regressors(spec);
-    let (uses_f, uses_w) = signals_used(spec, &regs);
-    let (f, w) = (param("f", uses_f), param("w", uses_w));
+    let (uses_f, uses_w, uses_dw) = signals_used(spec, &regs);
+    let (f, w, dw) = (param("f", uses_f), param("w", uses_w), param("dw", uses_dw));
     let sum = param("sum", !regs.is_empty());
     let reg_add = regs.iter().enumerate().map(|(k, &r)| {
         let ast = &spec.regressors[r].expr.ast;
@@ -624,9 +626,10 @@ fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
         }
 
         impl Regressors {
-            /// Adds one IMU sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
+            /// Adds one IMU sample: specific force f [m/s²], rate w [rad/s] and angular
+            /// acceleration dw [rad/s²], FRD body frame.
             #[inline]
-            pub fn add(&mut self, #f: &Vector3<f64>, #w: &Vector3<f64>) {
+            pub fn add(&mut self, #f: &Vector3<f64>, #w: &Vector3<f64>, #dw: &Vector3<f64>) {
                 #(#reg_add)*
                 self.count += 1;
             }
@@ -651,8 +654,9 @@ fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
             }
         }
 
-        /// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s]).
-        pub fn accumulate_dyn(#sum: &mut [f64], #f: &Vector3<f64>, #w: &Vector3<f64>) {
+        /// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s],
+        /// dw [rad/s²]).
+        pub fn accumulate_dyn(#sum: &mut [f64], #f: &Vector3<f64>, #w: &Vector3<f64>, #dw: &Vector3<f64>) {
             #sum_array
             #(#reg_add_dyn)*
         }

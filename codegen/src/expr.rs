@@ -94,8 +94,9 @@ pub const AID_POSITION_FIELDS: [&str; 6] = ["lat", "lon", "h", "sigma_n", "sigma
 /// Fields of a velocity fix (`aid.vn`, …; one 1-σ for every component).
 pub const AID_VELOCITY_FIELDS: [&str; 4] = ["vn", "ve", "vd", "sigma_v"];
 
-/// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s].
-pub const IMU_SIGNALS: [&str; 2] = ["f", "w"];
+/// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s],
+/// `dw.x dw.y dw.z` [rad/s²] (angular acceleration, the rate's change from the previous sample).
+pub const IMU_SIGNALS: [&str; 3] = ["f", "w", "dw"];
 
 /// Float methods an expression may call.
 pub const METHODS: [&str; 6] = ["sin", "cos", "tan", "abs", "sqrt", "powi"];
@@ -204,12 +205,13 @@ fn literals(e: &syn::Expr, out: &mut Vec<f64>) {
 }
 
 fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
-    use crate::units::{DIM_ACCEL, DIM_ONE, DIM_RATE};
+    use crate::units::{DIM_ACCEL, DIM_ANG_ACCEL, DIM_ONE, DIM_RATE};
     match e {
         syn::Expr::Lit(_) => Ok(DIM_ONE),
         syn::Expr::Field(f) => match &*f.base {
             syn::Expr::Path(p) if p.path.is_ident("f") => Ok(DIM_ACCEL),
             syn::Expr::Path(p) if p.path.is_ident("w") => Ok(DIM_RATE),
+            syn::Expr::Path(p) if p.path.is_ident("dw") => Ok(DIM_ANG_ACCEL),
             _ => Err(format!("no dimension for `{}`", f.to_token_stream())),
         },
         syn::Expr::Path(p) => p
@@ -356,7 +358,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                     nav_symbol_list()
                 )),
                 ExprKind::Regressor => Err(format!(
-                    "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2] and w.x w.y w.z [rad/s])"
+                    "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2], w.x w.y w.z [rad/s] and dw.x dw.y dw.z [rad/s^2])"
                 )),
             }
         }
@@ -382,7 +384,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 )),
                 (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
                 (ExprKind::Regressor, _) => Err(format!(
-                    "unknown signal `{}` (use f.x f.y f.z or w.x w.y w.z)",
+                    "unknown signal `{}` (use f.x f.y f.z, w.x w.y w.z or dw.x dw.y dw.z)",
                     f.to_token_stream().to_string().replace(' ', "")
                 )),
                 (ExprKind::Navigation, _) => Err(format!(

@@ -108,7 +108,7 @@ fn syntax_error_in_an_expression() {
         "terms.toml",
         "regressor = \"w.x\"",
         "regressor = \"w.x *\"",
-        "w.x *",
+        "regressor = \"w.x *\"",
         "term `kg_11`",
         "syntax error",
     );

@@ -270,7 +270,8 @@ impl FilterRun {
 /// update with its gain. `explain` propagates candidate-term signatures through it.
 pub trait Observer {
     /// One IMU sample as the filter uses it: specific force f [m/s²] and rate w [rad/s], FRD.
-    fn sample(&mut self, _f: &Vector3<f64>, _w: &Vector3<f64>) {}
+    /// `dw` is the angular acceleration [rad/s²] ([`crate::model::AngularAccel`]).
+    fn sample(&mut self, _f: &Vector3<f64>, _w: &Vector3<f64>, _dw: &Vector3<f64>) {}
     /// After the propagation over a step of `dt` [s] ending at `t`: the navigation point and the
     /// model's A (n×n row-major; non-zeros at `pattern`) used for it.
     fn step(&mut self, _t: f64, _dt: f64, _np: &NavPoint, _a: &[f64], _pattern: &[(usize, usize)]) {
@@ -367,6 +368,8 @@ struct Engine<'a> {
     kernel: Kernel,
     a: Vec<f64>,
     acc: crate::model::RegressorAccumulator,
+    /// Angular acceleration from the measured rates (regressors with `dw`).
+    dw: crate::model::AngularAccel,
     r_mean: Vec<f64>,
     f_sum: Vector3<f64>,
     /// Σ of the step's body rates [rad/s] (its mean is the point's w_b).
@@ -441,6 +444,7 @@ impl<'a> Engine<'a> {
             kernel,
             a: vec![0.0; n * n],
             acc: model.accumulator(),
+            dw: crate::model::AngularAccel::default(),
             r_mean: vec![0.0; model.regressor_ids.len()],
             f_sum: Vector3::zeros(),
             w_sum: Vector3::zeros(),
@@ -467,13 +471,14 @@ impl<'a> Engine<'a> {
     /// One IMU sample: closed-loop sensor corrections, strapdown step, regressor sums.
     fn navigate(&mut self, smp: &crate::io::imu::ImuSample, dt: f64, obs: &mut dyn Observer) {
         let (mut dth, mut dvel) = (smp.dtheta, smp.dv);
+        let dw = self.dw.next(&(dth / dt), dt);
         if self.cfg.mode == Mode::ClosedLoop {
             let f_meas = dvel / dt;
             let w_meas = dth / dt;
             for &(i, t) in &self.terms {
                 if self.correction[i] != 0.0 {
                     let info = &common::TERMS[t];
-                    let r = common::regressor_value(info.regressor, &f_meas, &w_meas);
+                    let r = common::regressor_value(info.regressor, &f_meas, &w_meas, &dw);
                     match info.sensor {
                         Sensor::Gyro => dth[info.axis] -= self.correction[i] * r * dt,
                         Sensor::Accel => dvel[info.axis] -= self.correction[i] * r * dt,
@@ -487,8 +492,8 @@ impl<'a> Engine<'a> {
         self.nav.state.t = smp.t;
         let inv_dt = 1.0 / dt;
         let (f_c, w_c) = (dvel * inv_dt, dth * inv_dt);
-        self.acc.add(&f_c, &w_c);
-        obs.sample(&f_c, &w_c);
+        self.acc.add(&f_c, &w_c, &dw);
+        obs.sample(&f_c, &w_c, &dw);
         self.f_sum += f_c;
         self.w_sum += w_c;
         self.in_step += 1;

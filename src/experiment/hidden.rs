@@ -51,7 +51,11 @@ pub fn run_hidden_on(
 ) -> anyhow::Result<HiddenOutcome> {
     let aid = aid.to_vec();
     let baseline = Model::parse(&case.baseline)?;
-    let cands = parse_candidates(None, &baseline).map_err(anyhow::Error::msg)?;
+    let mut cands = parse_candidates(None, &baseline).map_err(anyhow::Error::msg)?;
+    cands.retain(|&t| !case.withheld.iter().any(|w| w == common::TERMS[t].name));
+    if case.static_aid {
+        cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
+    }
     let data = ExplainData {
         imu: ImuInput::Memory(&sim.imu),
         aid: &aid,
@@ -60,6 +64,7 @@ pub fn run_hidden_on(
     };
     let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(FilterConfig::new(m)) };
     let mut opts = opts.clone();
+    opts.noise_levels &= !case.static_aid;
     for (name, sigma) in &case.priors {
         if let Some(t) = common::TERMS.iter().position(|x| x.name == name) {
             opts.candidate_sigma.retain(|x| x.0 != t);
@@ -108,18 +113,22 @@ pub fn run_hidden_on(
 }
 
 /// Adds term `term` with value `theta` (SI) to IMU increments: the sensor's output along its
-/// axis gains θ · regressor(f, ω) · Δt, the regressor formed from each increment's mean rates.
+/// axis gains θ · regressor(f, ω, ω̇) · Δt, the regressor formed from each increment's mean
+/// rates (ω̇ from consecutive increments).
 /// A GNSS term changes nothing here (the simulator puts it into the aiding).
 pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
     let info = &common::TERMS[term];
     let mut prev = start_t;
+    let mut dw_of = crate::model::AngularAccel::default();
     for smp in &mut imu.samples {
         let dt = smp.t - prev;
         prev = smp.t;
         if dt <= 0.0 {
             continue;
         }
-        let r = common::regressor_value(info.regressor, &(smp.dv / dt), &(smp.dtheta / dt));
+        let w = smp.dtheta / dt;
+        let dw = dw_of.next(&w, dt);
+        let r = common::regressor_value(info.regressor, &(smp.dv / dt), &w, &dw);
         match info.sensor {
             Sensor::Accel => smp.dv[info.axis] += theta * r * dt,
             Sensor::Gyro => smp.dtheta[info.axis] += theta * r * dt,

@@ -99,8 +99,43 @@ pub struct Finding {
     /// information in a half). A constant of the sensor or the aiding holds across both.
     pub halves: Option<[[f64; 2]; 2]>,
     /// The same from the updates below and at or above the median aided speed (a constant
-    /// holds at any speed; a term standing in for an effect that grows with speed does not).
+    /// holds at any speed; a term standing in for an effect that grows with speed does not);
+    /// null when the run is not split by speed (a median aided speed below 0.5 m/s).
     pub speed_halves: Option<[[f64; 2]; 2]>,
+    /// A term finding's tests that it holds across the data: per split of the updates (time,
+    /// speed, motion), its estimate from each group alone and whether they agree.
+    pub consistency: Vec<Consistency>,
+}
+
+/// A finding's test that it holds across the data: its estimate from each group of one split
+/// of the updates alone, and whether they describe one constant.
+#[derive(Debug, Clone, Serialize)]
+pub struct Consistency {
+    /// The split: `time` (halves of the aiding epochs), `speed` (below and from the median
+    /// aided speed), `motion` (by the body axis of the most recent rotation).
+    pub split: String,
+    /// The groups with information, each with its estimate and σ (display unit).
+    pub groups: Vec<GroupEstimate>,
+    /// χ² of the group estimates about their information-weighted mean.
+    pub chi2: f64,
+    /// Its degrees of freedom (groups with information − 1).
+    pub dof: usize,
+    /// Its p-value.
+    pub p_value: f64,
+    /// False when the groups disagree: χ² p < 0.0027 (3σ) and two groups more than 3σ and
+    /// more than a quarter of the larger apart.
+    pub holds: bool,
+}
+
+/// A finding's estimate from one group of the updates alone.
+#[derive(Debug, Clone, Serialize)]
+pub struct GroupEstimate {
+    /// The group, in words (e.g. `after rotating about z`).
+    pub group: String,
+    /// Estimate (display unit).
+    pub estimate: f64,
+    /// Its σ (display unit).
+    pub sigma: f64,
 }
 
 /// A term the data cannot tell from a finding, and the value it would need.
@@ -202,4 +237,92 @@ pub struct Implausible {
     pub prior_sigmas: f64,
     /// Conditional log-likelihood ratio.
     pub llr: f64,
+}
+
+/// χ² p-value below which a split's groups disagree (the two-sided 3σ level).
+const SPLIT_P: f64 = 0.0027;
+
+impl Consistency {
+    /// The test over `split`'s groups (`labels`), given each group's estimate and σ in the
+    /// finding's display unit (groups without information, σ = ∞ or NaN, are left out).
+    pub(super) fn test(split: &str, labels: &[&str], est: &[(f64, f64)]) -> Consistency {
+        let groups: Vec<GroupEstimate> = labels
+            .iter()
+            .zip(est)
+            .filter(|(_, (e, s))| e.is_finite() && s.is_finite() && *s > 0.0)
+            .map(|(l, &(estimate, sigma))| GroupEstimate {
+                group: l.to_string(),
+                estimate,
+                sigma,
+            })
+            .collect();
+        let w: f64 = groups.iter().map(|g| g.sigma.powi(-2)).sum();
+        let mean = groups
+            .iter()
+            .map(|g| g.estimate * g.sigma.powi(-2))
+            .sum::<f64>()
+            / w;
+        let chi2: f64 = groups
+            .iter()
+            .map(|g| ((g.estimate - mean) / g.sigma).powi(2))
+            .sum();
+        let dof = groups.len().saturating_sub(1);
+        let p_value = if dof > 0 {
+            crate::estimate::stats::chi2_sf(chi2, dof as f64)
+        } else {
+            1.0
+        };
+        // two groups far apart on both counts: beyond their noise, and by more than a quarter
+        let apart = groups.iter().enumerate().any(|(i, a)| {
+            groups[i + 1..].iter().any(|b| {
+                let d = (a.estimate - b.estimate).abs();
+                d > 3.0 * a.sigma.hypot(b.sigma)
+                    && d > 0.25 * a.estimate.abs().max(b.estimate.abs())
+            })
+        });
+        Consistency {
+            split: split.to_string(),
+            groups,
+            chi2: if dof > 0 { chi2 } else { 0.0 },
+            dof,
+            p_value,
+            holds: !(p_value < SPLIT_P && apart),
+        }
+    }
+
+    /// Why the groups show the term is not one constant, in words, when they do (`unit`: the
+    /// finding's display unit).
+    pub(super) fn disagreement(&self, unit: &str) -> Option<String> {
+        use super::words::sig3;
+        if self.holds {
+            return None;
+        }
+        let g = &self.groups;
+        let pair = |which: &str| {
+            format!(
+                "{which} give {} ± {} and {} ± {} {unit}: it does not hold across the data",
+                sig3(g[0].estimate),
+                sig3(g[0].sigma),
+                sig3(g[1].estimate),
+                sig3(g[1].sigma)
+            )
+        };
+        Some(match self.split.as_str() {
+            "time" if g.len() == 2 => pair("the first and the second half of the data"),
+            "speed" if g.len() == 2 => pair("the slower and the faster half of the updates"),
+            _ => format!(
+                "grouped by {}, the updates give {} {unit} (χ² {} on {} degrees of freedom): it does not hold across the data",
+                match self.split.as_str() {
+                    "motion" => "the last rotation's axis",
+                    other => other,
+                },
+                g.iter()
+                    .map(|x| format!("{} ± {} {}", sig3(x.estimate), sig3(x.sigma), x.group))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                sig3(self.chi2),
+                self.dof
+            ),
+        })
+    }
 }

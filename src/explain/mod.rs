@@ -34,7 +34,10 @@ mod signatures;
 mod words;
 
 pub use diagnostics::{innovation_loglik, ChannelStats, PassStats, SegmentStats, TruthCheck};
-pub use findings::{CandidateTest, EquivalentTerm, Explanation, Finding, Gain, Implausible};
+pub use findings::{
+    CandidateTest, Consistency, EquivalentTerm, Explanation, Finding, Gain, GroupEstimate,
+    Implausible,
+};
 pub use selection::prior_sigma;
 pub use words::{separation_hint, sig3};
 
@@ -48,7 +51,11 @@ use crate::model::{did_you_mean, Model};
 use crate::nav::strapdown::NavState;
 use diagnostics::pass_stats;
 use selection::{candidate_tests, forward_select, Selected};
-use signatures::Signatures;
+use signatures::{Signatures, Split};
+
+/// Median aided speed [m/s] below which the updates are not split by speed (a static or
+/// walking run's speeds are the fixes' noise).
+const MIN_SPLIT_SPEED: f64 = 0.5;
 use words::{finding_words, regressor_in_natural_units, summary};
 
 /// Standard gravity [m/s²] for expressing regressors in g.
@@ -227,7 +234,14 @@ fn run_pass(
         .get(speeds.len() / 2)
         .copied()
         .unwrap_or(f64::INFINITY);
-    let mut sig = Signatures::new(model, cands, t_half, speed_half);
+    let mut splits = vec![Split::Time(t_half)];
+    // below a walking pace the aided speed is the fixes' noise: no split by it
+    if speed_half.is_finite() && speed_half >= MIN_SPLIT_SPEED {
+        splits.push(Split::Speed(speed_half));
+    }
+    splits.push(Split::Motion);
+    splits.push(Split::Manoeuvre);
+    let mut sig = Signatures::new(model, cands, &splits);
     let mut samples = data.imu.samples()?;
     let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
     let mut io = filter::StreamIo {
@@ -390,9 +404,8 @@ struct Named {
     confounded_with: Option<String>,
     /// Which excitation separates it from each equivalent term.
     separate_by: Vec<String>,
-    /// Its GLR estimate and σ from each half of the data alone (display unit): [by time, by
-    /// speed][first/slower, second/faster].
-    halves: [[(f64, f64); 2]; 2],
+    /// Its GLR estimate and σ from each group of each split of the updates alone (display unit).
+    splits: Vec<(Split, Vec<(f64, f64)>)>,
     /// Its share of its round's gain: 2Δℓ, and the mean NIS removed.
     two_delta_loglik: f64,
     nis_removed: f64,
@@ -436,7 +449,7 @@ impl Named {
                 .iter()
                 .map(|c| separation_hint(t, sig.cands[c.0]))
                 .collect(),
-            halves: s.halves,
+            splits: s.splits.clone(),
             two_delta_loglik: 0.0,
             nis_removed: 0.0,
         }
@@ -643,8 +656,13 @@ fn complete_findings(
             stand_in: None,
             scale: None,
             scale_interval: None,
-            halves: Some(n.halves[0].map(|(e, s)| [e, s])),
-            speed_halves: Some(n.halves[1].map(|(e, s)| [e, s])),
+            halves: split_halves(&n.splits, "time"),
+            speed_halves: split_halves(&n.splits, "speed"),
+            consistency: n
+                .splits
+                .iter()
+                .map(|(split, est)| Consistency::test(split.name(), split.groups(), est))
+                .collect(),
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
         f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
@@ -653,25 +671,13 @@ fn complete_findings(
     Ok(out)
 }
 
-/// Why a term's estimates from two halves of the data, `which` (`[estimate, σ]` each, in `unit`),
-/// do not describe one constant, if they do not: they differ by more than 3 σ of the difference
-/// and by more than a quarter of the larger. A sensor or aiding constant holds across the data;
-/// a term fitting some other effect follows what that effect does in each half.
-fn differs_between_halves(h: [[f64; 2]; 2], unit: &str, which: &str) -> Option<String> {
-    let ([a, sa], [b, sb]) = (h[0], h[1]);
-    if !(a.is_finite() && b.is_finite() && sa.is_finite() && sb.is_finite()) {
-        return None;
-    }
-    let d = (a - b).abs();
-    (d > 3.0 * sa.hypot(sb) && d > 0.25 * a.abs().max(b.abs())).then(|| {
-        format!(
-            "{which} give {} ± {} and {} ± {} {unit}: it does not hold across the data",
-            sig3(a),
-            sig3(sa),
-            sig3(b),
-            sig3(sb)
-        )
-    })
+/// A two-group split's estimates as `[[estimate, σ], [estimate, σ]]` (the JSON's `halves` and
+/// `speed_halves`), when the run has that split.
+fn split_halves(splits: &[(Split, Vec<(f64, f64)>)], name: &str) -> Option<[[f64; 2]; 2]> {
+    splits
+        .iter()
+        .find(|(s, g)| s.name() == name && g.len() == 2)
+        .map(|(_, g)| [[g[0].0, g[0].1], [g[1].0, g[1].1]])
 }
 
 /// The baseline's excess mean NIS (mean NIS − 1) when it lies above the 95 % band of its count
@@ -687,18 +693,11 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 /// round removed less than `stand_in_share` of the baseline's excess misfit (`unexplained`, the
 /// share the extended model leaves, is said with it).
 fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
-    let mut why = Vec::new();
-    for (h, which) in [
-        (f.halves, "the first and the second half of the data"),
-        (
-            f.speed_halves,
-            "the slower and the faster half of the updates",
-        ),
-    ] {
-        if let Some(w) = h.and_then(|h| differs_between_halves(h, &f.unit, which)) {
-            why.push(w);
-        }
-    }
+    let mut why: Vec<String> = f
+        .consistency
+        .iter()
+        .filter_map(|c| c.disagreement(&f.unit))
+        .collect();
     if f.prior_sigmas > opts.stand_in_prior_sigmas {
         why.push(format!("it needs {} prior σ", sig3(f.prior_sigmas)));
     }
@@ -727,13 +726,15 @@ fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f6
     let mut sums = vec![0.0; terms.len()];
     let mut c = 0usize;
     let mut samples = data.imu.samples()?;
+    let mut dw_of = crate::model::AngularAccel::default();
     while let Some(smp) = samples.next_sample()? {
         let dt = smp.t - prev;
         prev = smp.t;
         if dt > 0.0 {
             let (f, w) = (smp.dv / dt, smp.dtheta / dt);
+            let dw = dw_of.next(&w, dt);
             for (sum, &t) in sums.iter_mut().zip(terms) {
-                *sum += common::regressor_value(common::TERMS[t].regressor, &f, &w);
+                *sum += common::regressor_value(common::TERMS[t].regressor, &f, &w, &dw);
             }
             c += 1;
         }
@@ -811,6 +812,7 @@ mod tests {
             scale_interval: None,
             halves: None,
             speed_halves: None,
+            consistency: vec![],
         }
     }
 
@@ -836,22 +838,44 @@ mod tests {
     }
 
     #[test]
-    fn a_term_whose_halves_disagree_does_not_hold_across_the_data() {
+    fn a_term_whose_groups_disagree_does_not_hold_across_the_data() {
+        let halves = ["first half", "second half"];
+        let test = |e: &[(f64, f64)]| Consistency::test("time", &halves, e);
         // one constant: the halves agree within their σ
-        assert!(
-            differs_between_halves([[-0.34, 0.02], [-0.36, 0.02]], "m", "the halves").is_none()
-        );
+        assert!(test(&[(-0.34, 0.02), (-0.36, 0.02)]).holds);
         // many σ apart but within a quarter: a constant the model describes a little unevenly
-        assert!(differs_between_halves([[179.0, 1.0], [190.0, 1.0]], "ms", "the halves").is_none());
+        assert!(test(&[(179.0, 1.0), (190.0, 1.0)]).holds);
         // far apart on both counts
-        let w = differs_between_halves([[-1.6, 0.02], [-0.4, 0.02]], "m", "the halves").unwrap();
+        let c = test(&[(-1.6, 0.02), (-0.4, 0.02)]);
+        assert!(!c.holds && c.dof == 1 && c.p_value < 1e-6);
+        let w = c.disagreement("m").unwrap();
         assert!(w.contains("-1.60 ± 0.020 and -0.400 ± 0.020 m"), "{w}");
         // a half without information says nothing
-        assert!(
-            differs_between_halves([[1.0, f64::INFINITY], [5.0, 0.1]], "m", "the halves").is_none()
+        let c = test(&[(1.0, f64::INFINITY), (5.0, 0.1)]);
+        assert!(c.holds && c.dof == 0 && c.groups.len() == 1);
+        // four groups: three agree, one is far off; the words name every group
+        let motion = Split::Motion.groups();
+        let c = Consistency::test(
+            "motion",
+            motion,
+            &[(10.0, 1.0), (11.0, 1.0), (9.5, 1.0), (40.0, 2.0)],
         );
+        assert!(!c.holds && c.dof == 3, "{c:?}");
+        let w = c.disagreement("mm").unwrap();
+        assert!(w.contains("40.0 ± 2.00 after rotating about z"), "{w}");
+        // four groups within noise
+        let c = Consistency::test(
+            "motion",
+            motion,
+            &[(10.0, 1.0), (11.0, 1.0), (9.5, 1.0), (12.0, 2.0)],
+        );
+        assert!(c.holds, "{c:?}");
         let mut f = finding(0.9, Some(0.3));
-        f.speed_halves = Some([[-1.6, 0.02], [-0.4, 0.02]]);
+        f.consistency = vec![Consistency::test(
+            "speed",
+            Split::Speed(1.0).groups(),
+            &[(-1.6, 0.02), (-0.4, 0.02)],
+        )];
         let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default()).unwrap();
         assert!(why.contains("slower and the faster"), "{why}");
     }

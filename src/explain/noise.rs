@@ -337,6 +337,7 @@ fn noise_finding(
         scale_interval: Some(f.interval),
         halves: None,
         speed_halves: None,
+        consistency: vec![],
     }
 }
 

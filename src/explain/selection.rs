@@ -1,14 +1,14 @@
 //! Selection on a pass's joint information: conditional llr (Schur complements), Holm, equivalence classes.
 
 use super::findings::{CandidateTest, Implausible};
-use super::signatures::Signatures;
+use super::signatures::{Signatures, Split};
 use super::ExplainOptions;
 use crate::estimate::stats;
 use crate::model::generated::common;
 use nalgebra::DMatrix;
 
 /// A pass's information and score, prior-scaled: J' = D J D, b' = D b with D = diag(σ_prior),
-/// over the whole pass and per half of its updates.
+/// over the whole pass and per group of each split of its updates.
 pub(super) struct Scaled {
     /// J' over the whole pass.
     pub(super) j: DMatrix<f64>,
@@ -16,9 +16,12 @@ pub(super) struct Scaled {
     pub(super) b: Vec<f64>,
     /// Prior σ of each candidate (SI).
     pub(super) sd: Vec<f64>,
-    /// (J', b') of the halves of the updates: [by time, by speed][first/slower, second/faster].
-    pub(super) halves: [[(DMatrix<f64>, Vec<f64>); 2]; 2],
+    /// (J', b') of each group of each split of the updates.
+    pub(super) splits: Vec<(Split, Vec<InfoScore>)>,
 }
+
+/// A prior-scaled information matrix J' and score b'.
+pub(super) type InfoScore = (DMatrix<f64>, Vec<f64>);
 
 /// The prior-scaled quantities of a pass.
 pub(super) fn scaled(sig: &Signatures, opts: &ExplainOptions) -> Scaled {
@@ -38,17 +41,20 @@ pub(super) fn scaled(sig: &Signatures, opts: &ExplainOptions) -> Scaled {
         )
     };
     let (j, b) = scale(&sig.info(), &sig.score());
-    let halves = [
-        [
-            scale(&sig.info_half[0], &sig.score_half[0]),
-            scale(&sig.info_half[1], &sig.score_half[1]),
-        ],
-        [
-            scale(&sig.info_speed[0], &sig.score_speed[0]),
-            scale(&sig.info_speed[1], &sig.score_speed[1]),
-        ],
-    ];
-    Scaled { j, b, sd, halves }
+    let splits = sig
+        .splits
+        .iter()
+        .map(|acc| {
+            let groups = acc
+                .info
+                .iter()
+                .zip(&acc.score)
+                .map(|(i, b)| scale(i, b))
+                .collect();
+            (acc.split, groups)
+        })
+        .collect();
+    Scaled { j, b, sd, splits }
 }
 
 /// Prior σ of term `t` (SI): the override in `opts`, else the spec's.
@@ -101,10 +107,9 @@ pub(super) fn conditional_rho(j: &DMatrix<f64>, s: &[usize], a: usize, c: usize)
 /// A candidate the selection names, with its equivalence class.
 pub(super) struct Selected {
     pub(super) idx: usize,
-    /// Its GLR estimate and σ (display unit) from each half of the updates alone, given the
-    /// terms chosen before it: [by time, by speed][first/slower, second/faster] (NaN, ∞ without
-    /// information there).
-    pub(super) halves: [[(f64, f64); 2]; 2],
+    /// Its GLR estimate and σ (display unit) from each group of each split of the updates
+    /// alone, given the terms chosen before it (NaN, ∞ without information there).
+    pub(super) splits: Vec<(Split, Vec<(f64, f64)>)>,
     pub(super) llr: f64,
     pub(super) p: f64,
     pub(super) glr: f64,
@@ -212,20 +217,28 @@ fn select(
             pool.retain(|a| !members.iter().any(|m| m.0 == *a));
             continue;
         }
-        // the named member's estimate from each half of the data alone (given the chosen set)
-        let halves = sc.halves.each_ref().map(|split| {
-            split.each_ref().map(|(jh, bh)| {
-                let (ih, bch) = conditional(jh, bh, &chosen, named);
-                if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
-                    display(named, bch / ih, ih)
-                } else {
-                    (f64::NAN, f64::INFINITY)
-                }
+        // the named member's estimate from each group of the data alone (given the chosen set)
+        let splits = sc
+            .splits
+            .iter()
+            .map(|(split, groups)| {
+                let est = groups
+                    .iter()
+                    .map(|(jh, bh)| {
+                        let (ih, bch) = conditional(jh, bh, &chosen, named);
+                        if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
+                            display(named, bch / ih, ih)
+                        } else {
+                            (f64::NAN, f64::INFINITY)
+                        }
+                    })
+                    .collect();
+                (*split, est)
             })
-        });
+            .collect();
         out.push(Selected {
             idx: named,
-            halves,
+            splits,
             llr: named_llr,
             p: (stats::chi2_sf(named_llr, 1.0) * pool.len() as f64).min(1.0),
             glr,
@@ -254,10 +267,17 @@ pub(super) fn candidate_tests(
     let Scaled { j, b, sd, .. } = scaled(sig, opts);
     let m = sig.cands.len();
     let nb = sig.base_terms.len();
-    // testability is a property of the data's excitation, not of the dispersion
+    // testability is a property of the data's excitation, not of the dispersion; a regressor
+    // of the body rate needs a rotation (without one its step means are the gyros' noise,
+    // which the signatures would take for excitation)
     let phi = sig.dispersion.max(1.0);
+    let rotated = sig.last_axis > 0;
     let testable: Vec<bool> = (0..m)
-        .map(|c| j[(c, c)] * phi > opts.min_information)
+        .map(|c| {
+            let reads_rate =
+                common::REGRESSORS[super::signatures::reg_id(sig.cands[c])].contains("w.");
+            j[(c, c)] * phi > opts.min_information && (rotated || !reads_rate)
+        })
         .collect();
     let p: Vec<f64> = (0..m)
         .map(|c| {
@@ -386,7 +406,7 @@ mod tests {
             sd: vec![1.0; b.len()],
             b: b.to_vec(),
             j,
-            halves: [[half.clone(), half.clone()], [half.clone(), half]],
+            splits: vec![(Split::Time(0.0), vec![half.clone(), half])],
         }
     }
 

@@ -32,21 +32,18 @@ pub(super) struct Signatures {
     pub(super) cand_rows: Vec<Vec<(usize, usize)>>,
     /// Mean NIS of the pass (the dispersion φ of the quasi-likelihood; 1 when consistent).
     pub(super) dispersion: f64,
-    /// Information J (m × m) and score b (m) of the updates before and after `t_half` (each
-    /// half's, so that a finding can be checked to hold across the data; J = J₀ + J₁).
-    pub(super) info_half: [Vec<f64>; 2],
-    pub(super) score_half: [Vec<f64>; 2],
-    /// Time that splits the aiding epochs into halves [s].
-    pub(super) t_half: f64,
-    /// The same information and score split by speed instead: updates below and at or above
-    /// `speed_half` [m/s] (a constant holds at any speed; a term standing in for an effect
-    /// that grows with speed does not).
-    pub(super) info_speed: [Vec<f64>; 2],
-    pub(super) score_speed: [Vec<f64>; 2],
-    /// Speed that splits the updates [m/s] (∞: no split).
-    pub(super) speed_half: f64,
+    /// Information J (m × m) and score b (m) per group of each split of the updates (the first
+    /// split is by time and covers every update: J is the sum of its groups').
+    pub(super) splits: Vec<SplitAcc>,
     /// Speed of the last step [m/s].
     pub(super) speed: f64,
+    /// Group of [`Split::Motion`] for the next update: 0 before any rotation, else 1 + the body
+    /// axis of the most recent step that rotated faster than [`ROTATING`].
+    pub(super) last_axis: usize,
+    /// Group of [`Split::Manoeuvre`]: rotations begun so far (capped), and whether the last
+    /// step rotated.
+    pub(super) manoeuvre: usize,
+    pub(super) rotating: bool,
     /// Σ over steps of each candidate's regressor mean, and steps counted.
     pub(super) reg_sum: Vec<f64>,
     pub(super) steps: usize,
@@ -69,14 +66,87 @@ pub(super) struct Signatures {
     pub(super) gnss_h_key: (&'static str, f64),
 }
 
+/// A body rate above which a step counts as rotating [rad/s] (0.5 deg/s; Earth's rate is
+/// 0.004 deg/s).
+pub(super) const ROTATING: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
+/// A partition of the updates into groups whose information and score are kept apart, so that
+/// a finding can be checked to hold across the data (a constant of the sensor or the aiding
+/// gives one value in every group; a term fitting some other effect follows that effect).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Split {
+    /// Before and from the median aiding time [s].
+    Time(f64),
+    /// Below and from the median aided speed [m/s].
+    Speed(f64),
+    /// By the body axis of the most recent rotation: none yet, x, y, z (a turntable's
+    /// positions, a vehicle's turns).
+    Motion,
+    /// By manoeuvre: the updates since each rotation began (before the first, then one group
+    /// per rotation, the last of [`MAX_MANOEUVRES`] holding the rest).
+    Manoeuvre,
+}
+
+/// Most groups of [`Split::Manoeuvre`].
+pub(super) const MAX_MANOEUVRES: usize = 64;
+
+/// Group labels of [`Split::Manoeuvre`].
+static MANOEUVRE_LABELS: std::sync::LazyLock<Vec<&'static str>> = std::sync::LazyLock::new(|| {
+    (0..MAX_MANOEUVRES)
+        .map(|k| -> &'static str {
+            match k {
+                0 => "before any rotation",
+                k if k + 1 == MAX_MANOEUVRES => "from rotation 63 on",
+                k => Box::leak(format!("rotation {k}").into_boxed_str()),
+            }
+        })
+        .collect()
+});
+
+impl Split {
+    /// The split's name in the report and the JSON.
+    pub(super) fn name(&self) -> &'static str {
+        match self {
+            Split::Time(_) => "time",
+            Split::Speed(_) => "speed",
+            Split::Motion => "motion",
+            Split::Manoeuvre => "manoeuvre",
+        }
+    }
+
+    /// Its groups, in words.
+    pub(super) fn groups(&self) -> &'static [&'static str] {
+        match self {
+            Split::Time(_) => &["first half", "second half"],
+            Split::Speed(_) => &["slower half", "faster half"],
+            Split::Motion => &[
+                "before any rotation",
+                "after rotating about x",
+                "after rotating about y",
+                "after rotating about z",
+            ],
+            Split::Manoeuvre => &MANOEUVRE_LABELS,
+        }
+    }
+}
+
+/// One split's information and score per group.
+pub(super) struct SplitAcc {
+    pub(super) split: Split,
+    /// J per group (m × m, row-major).
+    pub(super) info: Vec<Vec<f64>>,
+    /// b per group (m).
+    pub(super) score: Vec<Vec<f64>>,
+}
+
 pub(super) fn reg_id(t: usize) -> usize {
     common::TERMS[t].regressor
 }
 
 impl Signatures {
-    /// Signatures of the candidates `cands` through `model`'s filter; `t_half` [s] and
-    /// `speed_half` [m/s] split the updates into the halves whose information is kept apart.
-    pub(super) fn new(model: &Model, cands: &[usize], t_half: f64, speed_half: f64) -> Signatures {
+    /// Signatures of the candidates `cands` through `model`'s filter, the updates' information
+    /// kept apart per group of each of `splits` (the first must be [`Split::Time`]).
+    pub(super) fn new(model: &Model, cands: &[usize], splits: &[Split]) -> Signatures {
         let n = model.n();
         let base_terms: Vec<(usize, usize)> = model
             .states
@@ -128,13 +198,21 @@ impl Signatures {
             base_r: vec![0.0; nb],
             cand_rows,
             dispersion: 1.0,
-            info_half: [vec![0.0; m * m], vec![0.0; m * m]],
-            score_half: [vec![0.0; m], vec![0.0; m]],
-            t_half,
-            info_speed: [vec![0.0; m * m], vec![0.0; m * m]],
-            score_speed: [vec![0.0; m], vec![0.0; m]],
-            speed_half,
+            splits: splits
+                .iter()
+                .map(|&split| {
+                    let k = split.groups().len();
+                    SplitAcc {
+                        split,
+                        info: vec![vec![0.0; m * m]; k],
+                        score: vec![vec![0.0; m]; k],
+                    }
+                })
+                .collect(),
             speed: 0.0,
+            last_axis: 0,
+            manoeuvre: 0,
+            rotating: false,
             reg_sum: vec![0.0; m],
             steps: 0,
             cross: vec![0.0; m * nb],
@@ -177,8 +255,8 @@ pub(super) fn sparse_mul_block(
 }
 
 impl Observer for Signatures {
-    fn sample(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
-        self.acc.add(f, w);
+    fn sample(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, dw: &Vector3<f64>) {
+        self.acc.add(f, w, dw);
         self.f_sum += f;
         self.f2_sum += f.norm_squared();
         self.count += 1;
@@ -190,6 +268,16 @@ impl Observer for Signatures {
             self.np = Some(*np);
         }
         self.speed = Vector3::from(np.v_ned).norm();
+        let w = Vector3::from(np.w_b);
+        if w.norm() > ROTATING {
+            self.last_axis = 1 + w.iamax();
+            if !self.rotating {
+                self.manoeuvre = (self.manoeuvre + 1).min(MAX_MANOEUVRES - 1);
+            }
+            self.rotating = true;
+        } else if w.norm() < 0.5 * ROTATING {
+            self.rotating = false;
+        }
         self.acc.mean_into(&mut self.r_mean);
         self.acc.reset();
         if self.count > 0 {
@@ -289,21 +377,24 @@ impl Observer for Signatures {
             }
         }
         let inv_s = 1.0 / s;
-        let half = usize::from(t >= self.t_half);
-        let fast = usize::from(self.speed >= self.speed_half);
-        let (info, score) = (&mut self.info_half[half], &mut self.score_half[half]);
-        let (info_v, score_v) = (&mut self.info_speed[fast], &mut self.score_speed[fast]);
-        for a in 0..m {
-            let ga = self.g[a] * inv_s;
-            if ga == 0.0 {
-                continue;
-            }
-            score[a] += ga * nu;
-            score_v[a] += ga * nu;
-            for b in 0..m {
-                let v = ga * self.g[b];
-                info[a * m + b] += v;
-                info_v[a * m + b] += v;
+        let (speed, axis, manoeuvre) = (self.speed, self.last_axis, self.manoeuvre);
+        for acc in &mut self.splits {
+            let k = match acc.split {
+                Split::Time(t_half) => usize::from(t >= t_half),
+                Split::Speed(v_half) => usize::from(speed >= v_half),
+                Split::Motion => axis,
+                Split::Manoeuvre => manoeuvre,
+            };
+            let (info, score) = (&mut acc.info[k], &mut acc.score[k]);
+            for a in 0..m {
+                let ga = self.g[a] * inv_s;
+                if ga == 0.0 {
+                    continue;
+                }
+                score[a] += ga * nu;
+                for b in 0..m {
+                    info[a * m + b] += ga * self.g[b];
+                }
             }
         }
     }
@@ -312,19 +403,22 @@ impl Observer for Signatures {
 impl Signatures {
     /// Information J (m × m, row-major) over the whole pass.
     pub(super) fn info(&self) -> Vec<f64> {
-        self.info_half[0]
-            .iter()
-            .zip(&self.info_half[1])
-            .map(|(a, b)| a + b)
-            .collect()
+        sum_groups(&self.splits[0].info)
     }
 
     /// Score b (m) over the whole pass.
     pub(super) fn score(&self) -> Vec<f64> {
-        self.score_half[0]
-            .iter()
-            .zip(&self.score_half[1])
-            .map(|(a, b)| a + b)
-            .collect()
+        sum_groups(&self.splits[0].score)
     }
+}
+
+/// Element-wise sum of a split's groups.
+fn sum_groups(groups: &[Vec<f64>]) -> Vec<f64> {
+    let mut out = vec![0.0; groups.first().map_or(0, Vec::len)];
+    for g in groups {
+        for (o, x) in out.iter_mut().zip(g) {
+            *o += x;
+        }
+    }
+    out
 }

@@ -7,33 +7,42 @@ use crate::model::generated::common;
 use nalgebra::Vector3;
 
 /// Homogeneous degree of a regressor in the IMU signals (1 for f_x, |f_x|; 2 for f_x², f_x f_y,
-/// ω²; 0 for a constant), found numerically.
+/// ω², ω̇; 0 for a constant), found numerically (ω̇ scales as ω² does: a faster motion).
 pub(super) fn regressor_degree(id: usize) -> i32 {
-    let f = Vector3::new(3.1, -2.3, 1.7);
-    let w = Vector3::new(0.7, -0.4, 0.9);
-    let r1 = common::regressor_value(id, &f, &w);
-    let r2 = common::regressor_value(id, &(f * 2.0), &(w * 2.0));
+    let (f, w, dw) = base_signals();
+    let r1 = common::regressor_value(id, &f, &w, &dw);
+    let r2 = common::regressor_value(id, &(f * 2.0), &(w * 2.0), &(dw * 4.0));
     if r1 == 0.0 || r2 == 0.0 {
         return 0;
     }
     (r2 / r1).abs().log2().round() as i32
 }
 
-/// Which body signals a regressor depends on (`f.x` … `w.z`).
+/// A generic point of the IMU signals (f [m/s²], w [rad/s], dw [rad/s²]) for probing regressors.
+fn base_signals() -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    (
+        Vector3::new(3.1, -2.3, 1.7),
+        Vector3::new(0.7, -0.4, 0.9),
+        Vector3::new(0.3, 0.8, -0.6),
+    )
+}
+
+/// Which body signals a regressor depends on (`f.x` … `w.z`, `dw.x` … `dw.z`).
 pub(super) fn regressor_signals(id: usize) -> Vec<&'static str> {
-    let names = ["f.x", "f.y", "f.z", "w.x", "w.y", "w.z"];
-    let base_f = Vector3::new(3.1, -2.3, 1.7);
-    let base_w = Vector3::new(0.7, -0.4, 0.9);
-    let r0 = common::regressor_value(id, &base_f, &base_w);
-    (0..6)
+    let names = [
+        "f.x", "f.y", "f.z", "w.x", "w.y", "w.z", "dw.x", "dw.y", "dw.z",
+    ];
+    let (base_f, base_w, base_dw) = base_signals();
+    let r0 = common::regressor_value(id, &base_f, &base_w, &base_dw);
+    (0..9)
         .filter(|&k| {
-            let (mut f, mut w) = (base_f, base_w);
-            if k < 3 {
-                f[k] *= 1.37;
-            } else {
-                w[k - 3] *= 1.37;
+            let (mut f, mut w, mut dw) = (base_f, base_w, base_dw);
+            match k {
+                0..=2 => f[k] *= 1.37,
+                3..=5 => w[k - 3] *= 1.37,
+                _ => dw[k - 6] *= 1.37,
             }
-            (common::regressor_value(id, &f, &w) - r0).abs() > 1e-12 * r0.abs().max(1.0)
+            (common::regressor_value(id, &f, &w, &dw) - r0).abs() > 1e-12 * r0.abs().max(1.0)
         })
         .map(|k| names[k])
         .collect()

@@ -39,6 +39,12 @@ pub fn angular_rate_rps(w: [f64; 3]) -> Option<String> {
     (!w.iter().all(|x| x.abs() <= 1e3)).then(|| format!("angular rate {w:?} beyond ±1e3 rad/s"))
 }
 
+/// `None` when every angular acceleration component is within ±1e5 rad/s² (else why not).
+pub fn angular_accel_rps2(dw: [f64; 3]) -> Option<String> {
+    (!dw.iter().all(|x| x.abs() <= 1e5))
+        .then(|| format!("angular acceleration {dw:?} beyond ±1e5 rad/s²"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,6 +25,9 @@ pub struct PointSpec {
     pub f_b: [f64; 3],
     /// Angular rate, FRD body [rad/s].
     pub w_b: [f64; 3],
+    /// Angular acceleration, FRD body [rad/s²] (regressors with `dw`; zero when absent).
+    #[serde(default)]
+    pub dw_b: [f64; 3],
 }
 
 /// The JSON printed by `sinsmodel jacobian`.
@@ -85,7 +88,8 @@ impl PointSpec {
             .chain(self.v_ned)
             .chain(self.euler_deg)
             .chain(self.f_b)
-            .chain(self.w_b);
+            .chain(self.w_b)
+            .chain(self.dw_b);
         if all.into_iter().any(|v| !v.is_finite()) {
             bail!("point has a non-finite number");
         }
@@ -99,6 +103,7 @@ impl PointSpec {
             bounds::velocity_mps(self.v_ned).map(|p| format!("v_ned: {p}")),
             bounds::specific_force_mps2(self.f_b).map(|p| format!("f_b: {p}")),
             bounds::angular_rate_rps(self.w_b).map(|p| format!("w_b: {p}")),
+            bounds::angular_accel_rps2(self.dw_b).map(|p| format!("dw_b: {p}")),
         ];
         if let Some(p) = problems.into_iter().flatten().next() {
             bail!("point: {p}");
@@ -133,12 +138,16 @@ impl PointSpec {
     }
 }
 
-/// A and H of `model` at `point`, regressors evaluated at the single sample (f_b, w_b).
+/// A and H of `model` at `point`, regressors evaluated at the single sample (f_b, w_b, dw_b).
 pub fn jacobian(model: &Model, point: &PointSpec, runtime: bool) -> Result<JacobianOut> {
     point.validate()?;
     let nav = point.nav_point();
     let mut acc = model.accumulator();
-    acc.add(&Vector3::from(point.f_b), &Vector3::from(point.w_b));
+    acc.add(
+        &Vector3::from(point.f_b),
+        &Vector3::from(point.w_b),
+        &Vector3::from(point.dw_b),
+    );
     let r = acc.mean();
     let n = model.n();
     let mut a = vec![0.0; n * n];

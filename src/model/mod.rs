@@ -407,8 +407,29 @@ pub struct RegressorAccumulator {
     generated: Option<AccumulateFn>,
 }
 
-/// A generated regressor accumulator: adds one sample (f [m/s²], w [rad/s]) to running sums.
-pub type AccumulateFn = fn(&mut [f64], &Vector3<f64>, &Vector3<f64>);
+/// A generated regressor accumulator: adds one sample (f [m/s²], w [rad/s], dw [rad/s²]) to
+/// running sums.
+pub type AccumulateFn = fn(&mut [f64], &Vector3<f64>, &Vector3<f64>, &Vector3<f64>);
+
+/// The body's angular acceleration dw [rad/s²] from consecutive IMU rates: the change of a
+/// sample's mean rate from the previous sample's, over the time between their midpoints (zero
+/// for the first sample). Summed over a filter step it telescopes to the step's rate change.
+#[derive(Debug, Clone, Default)]
+pub struct AngularAccel {
+    prev: Option<(Vector3<f64>, f64)>,
+}
+
+impl AngularAccel {
+    /// dw at a sample of mean rate `w` [rad/s] spanning `dt` [s].
+    pub fn next(&mut self, w: &Vector3<f64>, dt: f64) -> Vector3<f64> {
+        let out = match self.prev {
+            Some((wp, dtp)) if dt + dtp > 0.0 => (w - wp) / (0.5 * (dt + dtp)),
+            _ => Vector3::zeros(),
+        };
+        self.prev = Some((*w, dt));
+        out
+    }
+}
 
 impl RegressorAccumulator {
     /// An accumulator of the given regressors (indices into `common::REGRESSORS`).
@@ -421,13 +442,14 @@ impl RegressorAccumulator {
         }
     }
 
-    /// Adds one sample: specific force f [m/s²] and rate w [rad/s], FRD body frame.
-    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>) {
+    /// Adds one sample: specific force f [m/s²], rate w [rad/s] and angular acceleration dw
+    /// [rad/s²], FRD body frame.
+    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, dw: &Vector3<f64>) {
         match self.generated {
-            Some(acc) => acc(&mut self.sum, f, w),
+            Some(acc) => acc(&mut self.sum, f, w, dw),
             None => {
                 for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
-                    *s += common::regressor_value(id, f, w);
+                    *s += common::regressor_value(id, f, w, dw);
                 }
             }
         }

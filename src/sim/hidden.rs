@@ -15,6 +15,35 @@ pub const GROUPS: [&str; 7] = ["d", "kaq", "kas", "kao", "kgf", "kgq", "size"];
 /// step's specific force, which vibration faster than the offset would not average.
 pub const GNSS_GROUPS: [&str; 3] = ["gnss_time", "gnss_time_kgf", "gnss_lever"];
 
+/// Groups hidden on a turntable (a multi-position rotation sequence at rest, static aiding): an
+/// accelerometer's off-axis inner lever arm (`size_i_j`, 20–60 mm times `effect`), seen in
+/// the tangential kicks as a rotation starts and stops and in the centripetal terms.
+pub const TURNTABLE_GROUPS: [&str; 1] = ["inner_lever"];
+
+/// A system-level calibration sequence: 60 s at rest, then 18 rotations of ±90° in 5 s
+/// (about 20 deg/s) about x, y and z — four about each axis, then x, y, z, −z, −y, −x — with
+/// 20 s at rest after each.
+pub fn turntable_segments() -> String {
+    let mut s = String::from("[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n");
+    let seq = ["x", "x", "x", "x", "y", "y", "y", "y", "z", "z", "z", "z"]
+        .iter()
+        .map(|a| (*a, 90.0))
+        .chain([
+            ("x", 90.0),
+            ("y", 90.0),
+            ("z", 90.0),
+            ("z", -90.0),
+            ("y", -90.0),
+            ("x", -90.0),
+        ]);
+    for (axis, angle) in seq {
+        s.push_str(&format!(
+            "[[segment]]\nkind = \"rotate\"\naxis = \"{axis}\"\nangle_deg = {angle:.1}\nduration_s = 5.0\n[[segment]]\nkind = \"rest\"\nduration_s = 20.0\n"
+        ));
+    }
+    s
+}
+
 /// A drive for the GNSS cases: 60 s at rest, a start to 20 m/s, then minute-long cycles of a
 /// turn (±6 deg/s for 15 s), a speed change (±1 m/s² for 10 s) and straight driving.
 fn drive_segments(seconds: f64) -> String {
@@ -66,6 +95,13 @@ pub struct HiddenCase {
     /// Prior σ (SI) the case declares for candidate terms, replacing the spec's RLG-grade ones
     /// where the hidden magnitude belongs to another sensor class (as `--prior` would).
     pub priors: Vec<(String, f64)>,
+    /// Candidate terms withheld from explain (a compromise case: the hidden effect is outside
+    /// the candidates explain may name; see [`HiddenCase::withholding`]).
+    pub withheld: Vec<String>,
+    /// The aiding is static (a turntable): explain runs as with `--static-aid`, without GNSS
+    /// candidates (no antenna, no receiver clock) or noise levels (the aiding σ is a tuning
+    /// choice).
+    pub static_aid: bool,
 }
 
 impl HiddenCase {
@@ -77,6 +113,25 @@ impl HiddenCase {
             m.push_str(t);
         }
         m
+    }
+
+    /// The same case with the candidates whose names start with one of `prefixes` withheld from
+    /// explain: the hidden effect is then outside what explain may name, and whatever it fits
+    /// stands in for it.
+    pub fn withholding(&self, prefixes: &[&str]) -> HiddenCase {
+        let mut c = self.clone();
+        c.withheld.extend(
+            common::TERMS
+                .iter()
+                .filter(|t| prefixes.iter().any(|p| t.name.starts_with(p)))
+                .map(|t| t.name.to_string()),
+        );
+        c.description = format!(
+            "{} (candidates {}* withheld)",
+            c.description,
+            prefixes.join("*, ")
+        );
+        c
     }
 
     /// The same case with every hidden value multiplied by `k` (the scenario is rewritten).
@@ -333,12 +388,28 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
                     // 0.1–2 m
                     hidden.push((name.into(), sgn * effect * (0.1 + 1.9 * rng.uniform())));
                 }
+                "inner_lever" => {
+                    segments = turntable_segments();
+                    let name = *pick(
+                        &mut rng,
+                        &[
+                            "size_x_y", "size_x_z", "size_y_x", "size_y_z", "size_z_x", "size_z_y",
+                        ],
+                    );
+                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                    // 20–60 mm
+                    hidden.push((name.into(), sgn * effect * (0.02 + 0.04 * rng.uniform())));
+                }
                 other => panic!("unknown group {other}"),
             }
             let info = common::TERMS.iter().find(|t| t.name == hidden[0].0);
             let size = match info.map(|t| t.sensor) {
                 Some(crate::model::catalog::Sensor::Gyro) => format!("{effect} deg/h"),
-                // a GNSS term: its value
+                // a GNSS term or a lever arm: its value
+                Some(_) if g == "inner_lever" => {
+                    let t = info.expect("matched");
+                    format!("{:.1} {}", hidden[0].1 / t.display_to_si, t.display)
+                }
                 Some(crate::model::catalog::Sensor::Gnss) => {
                     let t = info.expect("matched");
                     format!("{:.3} {}", hidden[0].1 / t.display_to_si, t.display)
@@ -353,8 +424,15 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
     for (name, v) in &hidden {
         errors.push_str(&format!("{name} = \"{v:e} {}\"\n", unit_of(name)));
     }
+    // a turntable has no vibration to sample: 200 Hz resolves its rate ramps; its aiding
+    // (from the truth rows) at 10 Hz sees the kicks of each rotation
+    let (imu_rate, truth_rate) = if TURNTABLE_GROUPS.contains(&group.as_str()) {
+        ("200.0", "10.0")
+    } else {
+        ("2000.0", "1.0")
+    };
     let scenario = format!(
-        "name = \"hidden-{group}-{seed}\"\nimu_rate_hz = 2000.0\ntruth_rate_hz = 1.0\nseed = {seed}\n\
+        "name = \"hidden-{group}-{seed}\"\nimu_rate_hz = {imu_rate}\ntruth_rate_hz = {truth_rate}\nseed = {seed}\n\
          [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}\
          [noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n"
     );
@@ -370,6 +448,7 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
     } else {
         Vec::new()
     };
+    let static_aid = TURNTABLE_GROUPS.contains(&group.as_str());
     HiddenCase {
         seed,
         group,
@@ -379,5 +458,7 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
         description,
         effect,
         priors,
+        withheld: Vec::new(),
+        static_aid,
     }
 }

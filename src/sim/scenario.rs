@@ -31,7 +31,8 @@ pub struct Start {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Segment {
-    /// `rest` (speed must be 0), `cruise` (constant speed), `accelerate`, `turn`.
+    /// `rest` (speed must be 0), `cruise` (constant speed), `accelerate`, `turn`, `rotate` (a
+    /// turntable rotation about a body axis, at rest).
     pub kind: String,
     /// Duration [s].
     pub duration_s: f64,
@@ -41,7 +42,43 @@ pub struct Segment {
     /// Yaw rate for `turn` [deg/s].
     #[serde(default)]
     pub yaw_rate_deg_s: f64,
+    /// Body axis of a `rotate` segment: `x`, `y` or `z` (FRD).
+    #[serde(default)]
+    pub axis: Option<String>,
+    /// Angle of a `rotate` segment [deg], positive right-handed about `axis`.
+    #[serde(default)]
+    pub angle_deg: f64,
 }
+
+/// Checks a `rotate` segment: a body axis, a finite angle within ±3600°, and a rate within
+/// ±1e4 °/s.
+fn check_rotate(s: &Segment, where_: &str) -> Result<()> {
+    match s.axis.as_deref() {
+        Some("x" | "y" | "z") => {}
+        Some(a) => bail!("{where_}: axis = \"{a}\" must be a body axis: x, y or z"),
+        None => bail!("{where_}: a rotate segment needs `axis` (x, y or z) and `angle_deg`"),
+    }
+    if !(s.angle_deg.is_finite() && s.angle_deg.abs() <= 3600.0) {
+        bail!(
+            "{where_}: angle_deg = {} must be within ±3600 deg",
+            s.angle_deg
+        );
+    }
+    let rate = s.angle_deg / (s.duration_s - rotate_ramp(s.duration_s));
+    if rate.abs() > 1e4 {
+        bail!("{where_}: angle_deg / duration_s needs a rate of {rate:.0} deg/s, beyond ±1e4 deg/s (rad given as deg? or ms as s?)");
+    }
+    Ok(())
+}
+
+/// The rate ramp [s] of a `rotate` segment lasting `duration_s`.
+pub fn rotate_ramp(duration_s: f64) -> f64 {
+    ROTATE_RAMP_S.min(0.25 * duration_s)
+}
+
+/// Length [s] of the raised-cosine rate ramps at each end of a `rotate` segment (a quarter of
+/// the segment when that is shorter).
+pub const ROTATE_RAMP_S: f64 = 0.5;
 
 /// A vibration source.
 #[derive(Debug, Clone, Deserialize)]
@@ -336,19 +373,42 @@ impl Scenario {
                     s.yaw_rate_deg_s
                 );
             }
+            if s.kind != "rotate" && (s.axis.is_some() || s.angle_deg != 0.0) {
+                bail!("{where_}: `axis` and `angle_deg` belong to `rotate` segments");
+            }
             match s.kind.as_str() {
                 "rest" if speed != 0.0 => {
                     bail!("{where_}: rest needs zero speed (speed is {speed} m/s)")
                 }
                 "rest" | "cruise" | "turn" => {}
                 "accelerate" => speed += s.accel_mps2 * s.duration_s,
-                other => bail!("{where_}: unknown kind `{other}` (rest, cruise, accelerate, turn)"),
+                "rotate" => check_rotate(s, &where_)?,
+                other => bail!(
+                    "{where_}: unknown kind `{other}` (rest, cruise, accelerate, turn, rotate)"
+                ),
             }
             if speed < 0.0 {
                 bail!("{where_}: speed would become negative");
             }
             if speed > 1e4 {
                 bail!("{where_}: speed would exceed 1e4 m/s");
+            }
+        }
+        if raw.segment.iter().any(|s| s.kind == "rotate") {
+            if raw.start.speed_mps != 0.0
+                || raw
+                    .segment
+                    .iter()
+                    .any(|s| !matches!(s.kind.as_str(), "rest" | "rotate"))
+            {
+                bail!(
+                    "{origin}: a `rotate` segment is a turntable rotation at rest: the scenario may then hold only `rest` and `rotate` segments, from speed_mps = 0"
+                );
+            }
+            if raw.vibration.iter().any(|v| v.kind == "angular") {
+                bail!(
+                    "{origin}: angular vibration and `rotate` segments cannot be combined (the turntable sets the attitude)"
+                );
             }
         }
         for v in &raw.vibration {

@@ -57,6 +57,9 @@ fn body_signals(
     (ct * f_n, ct * (e.w_ie + w_en) + k.w_nb, rate)
 }
 
+/// Half-step [s] of the central difference that gives the true angular acceleration.
+const DW_STEP: f64 = 1e-5;
+
 /// How far before a fix the kinematics that move it through the GNSS terms' H are taken [s]:
 /// the acceleration of the IMU step that ends at the fix, as the filter sees it (a scenario's
 /// segment accelerations jump at segment boundaries, which fall on fix times; the left limit
@@ -123,6 +126,10 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
             value,
         })
         .collect();
+    // the true angular acceleration is formed only when an injected regressor reads it
+    let needs_dw = injected
+        .iter()
+        .any(|inj| common::REGRESSORS[inj.regressor].contains("dw."));
     let mut rng = Rng::new(sc.seed);
     // GNSS velocity noise on a stream of its own: adding velocities changes no other draw
     let mut rng_v = Rng::new(sc.seed ^ 0xbb67_ae85_84ca_a73b);
@@ -184,11 +191,20 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         for s in 0..sub {
             let a = t0 + s as f64 * hsub;
             for (x, w) in GL_NODES.iter().zip(GL_WEIGHTS) {
-                let k = traj.at(a + 0.5 * hsub * (x + 1.0));
+                let tn = a + 0.5 * hsub * (x + 1.0);
+                let k = traj.at(tn);
                 let (f, mut om, rate) = body_signals(&e, &k);
+                let dw = if needs_dw {
+                    // d(ω_ib^b)/dt of the analytic motion, by a central difference
+                    let (_, om_p, _) = body_signals(&e, &traj.at(tn + DW_STEP));
+                    let (_, om_m, _) = body_signals(&e, &traj.at(tn - DW_STEP));
+                    (om_p - om_m) / (2.0 * DW_STEP)
+                } else {
+                    Vector3::zeros()
+                };
                 let mut fm = f;
                 for inj in &injected {
-                    let r = common::regressor_value(inj.regressor, &f, &om);
+                    let r = common::regressor_value(inj.regressor, &f, &om, &dw);
                     match inj.sensor {
                         Sensor::Gyro => om[inj.axis] += inj.value * r,
                         Sensor::Accel => fm[inj.axis] += inj.value * r,

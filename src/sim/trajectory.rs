@@ -173,6 +173,9 @@ pub struct Trajectory {
     seg_accel: Vec<f64>,
     seg_yaw_rate: Vec<f64>,
     seg_dcm: Vec<Matrix3<f64>>,
+    /// Turntable scenarios (`rotate` segments): per segment (body axis, angle [rad], duration
+    /// [s]) of its rotation, `None` at rest; empty otherwise.
+    seg_rotation: Vec<Option<(usize, f64, f64)>>,
     roll0: f64,
     pitch0: f64,
     linear: Vec<Linear>,
@@ -273,12 +276,33 @@ impl Trajectory {
                 }
             }
         }
-        let seg_dcm = seg_yaw0
+        let mut seg_dcm: Vec<Matrix3<f64>> = seg_yaw0
             .iter()
             .map(|&y| dcm_from_euler(sc.start.euler_deg[0] * d, sc.start.euler_deg[1] * d, y))
             .collect();
+        let mut seg_rotation = Vec::new();
+        if sc.segments.iter().any(|s| s.kind == "rotate") {
+            // a turntable: each segment starts at the attitude the rotations before it left
+            let mut c = seg_dcm[0];
+            for (k, s) in sc.segments.iter().enumerate() {
+                seg_dcm[k] = c;
+                let rot = (s.kind == "rotate").then(|| {
+                    let axis = match s.axis.as_deref() {
+                        Some("y") => 1,
+                        Some("z") => 2,
+                        _ => 0,
+                    };
+                    (axis, s.angle_deg * d, s.duration_s)
+                });
+                if let Some((axis, angle, _)) = rot {
+                    c *= axis_rotation(axis, angle);
+                }
+                seg_rotation.push(rot);
+            }
+        }
         Trajectory {
             seg_dcm,
+            seg_rotation,
             seg_start,
             seg_speed0,
             seg_yaw0,
@@ -315,7 +339,23 @@ impl Trajectory {
             );
         }
         let mut euler = Vector3::new(self.roll0, self.pitch0, yaw_base);
-        let (c, w_nb) = if self.angular.is_empty() && yaw_rate == 0.0 {
+        let (c, w_nb) = if !self.seg_rotation.is_empty() {
+            // turntable: C = C_start R_axis(θ(τ)), ω_nb^b = e_axis θ'(τ)
+            match self.seg_rotation[i] {
+                Some((axis, angle, duration)) => {
+                    let (th, rate) = rotation_profile(angle, duration, tau);
+                    let c = self.seg_dcm[i] * axis_rotation(axis, th);
+                    euler = crate::nav::attitude::euler_from_dcm(&c);
+                    let mut w = Vector3::zeros();
+                    w[axis] = rate;
+                    (c, w)
+                }
+                None => {
+                    euler = crate::nav::attitude::euler_from_dcm(&self.seg_dcm[i]);
+                    (self.seg_dcm[i], Vector3::zeros())
+                }
+            }
+        } else if self.angular.is_empty() && yaw_rate == 0.0 {
             (self.seg_dcm[i], Vector3::zeros())
         } else {
             let mut euler_rate = Vector3::new(0.0, 0.0, yaw_rate);
@@ -359,6 +399,96 @@ impl Trajectory {
             c,
             w_nb,
             euler,
+        }
+    }
+}
+
+/// The rotation matrix of a body turned by `angle` [rad] about its own axis `axis` (0 = x):
+/// C_b^n after = C_b^n before · this.
+fn axis_rotation(axis: usize, angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    match axis {
+        0 => Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c),
+        1 => Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c),
+        _ => Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+    }
+}
+
+/// Angle [rad] and rate [rad/s] at `tau` [s] into a turntable rotation of `angle` [rad] over
+/// `duration` [s]: raised-cosine rate ramps of [`crate::sim::scenario::rotate_ramp`] at each end,
+/// a constant rate between (the ramps average half the rate, so the rate is angle / (T − ramp)).
+fn rotation_profile(angle: f64, duration: f64, tau: f64) -> (f64, f64) {
+    let ramp = crate::sim::scenario::rotate_ramp(duration);
+    let rate = angle / (duration - ramp);
+    let up = |t: f64| {
+        let x = PI * t / ramp;
+        (
+            0.5 * rate * (t - ramp / PI * x.sin()),
+            0.5 * rate * (1.0 - x.cos()),
+        )
+    };
+    let tau = tau.clamp(0.0, duration);
+    if tau < ramp {
+        up(tau)
+    } else if tau <= duration - ramp {
+        (0.5 * rate * ramp + rate * (tau - ramp), rate)
+    } else {
+        let (th, r) = up(duration - tau);
+        (angle - th, r)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::scenario::Scenario;
+
+    fn turntable() -> Trajectory {
+        let text = "name = \"t\"\nseed = 1\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = 116.0\nh_m = 50.0\neuler_deg = [0.0, 0.0, 30.0]\nspeed_mps = 0.0\n\
+            [[segment]]\nkind = \"rest\"\nduration_s = 2.0\n\
+            [[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 90.0\nduration_s = 9.0\n\
+            [[segment]]\nkind = \"rotate\"\naxis = \"z\"\nangle_deg = -90.0\nduration_s = 9.0\n\
+            [[segment]]\nkind = \"rest\"\nduration_s = 2.0\n";
+        Trajectory::new(&Scenario::parse(text, "test").unwrap())
+    }
+
+    #[test]
+    fn turntable_rotations_end_where_they_should_and_rates_match_attitude() {
+        let tr = turntable();
+        let d = PI / 180.0;
+        // after +90° about x then −90° about z: C = Rz(30°) Rx(90°) Rz(−90°)
+        let want = dcm_from_euler(0.0, 0.0, 30.0 * d)
+            * axis_rotation(0, 90.0 * d)
+            * axis_rotation(2, -90.0 * d);
+        assert!((tr.at(21.5).c - want).abs().max() < 1e-12);
+        assert_eq!(tr.at(21.5).w_nb, Vector3::zeros());
+        // dC/dt = C [ω_nb]× at points on the ramps and between
+        for t in [2.1, 2.4, 5.0, 10.8, 11.3, 15.0, 19.9] {
+            let h = 1e-6;
+            let dc = (tr.at(t + h).c - tr.at(t - h).c) / (2.0 * h);
+            let k = tr.at(t);
+            let want = k.c * crate::nav::attitude::skew(&k.w_nb);
+            assert!((dc - want).abs().max() < 1e-6, "t = {t}: {dc} vs {want}");
+        }
+        // the ramps: zero rate at the ends, the full rate in the middle (90° / (9 − 0.5) s)
+        assert!(tr.at(2.0 + 1e-9).w_nb.norm() < 1e-6);
+        assert!((tr.at(6.5).w_nb.x - 90.0 * d / 8.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rotate_segments_are_checked() {
+        let base = "name = \"t\"\nseed = 1\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = 116.0\nh_m = 50.0\neuler_deg = [0.0, 0.0, 0.0]\n";
+        let bad = [
+            ("[[segment]]\nkind = \"rotate\"\nangle_deg = 90.0\nduration_s = 9.0\n", "needs `axis`"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"roll\"\nangle_deg = 90.0\nduration_s = 9.0\n", "body axis"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 9e5\nduration_s = 9.0\n", "±3600"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 3000.0\nduration_s = 0.01\n", "rate"),
+            ("[[segment]]\nkind = \"rest\"\naxis = \"x\"\nduration_s = 9.0\n", "belong to `rotate`"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 90.0\nduration_s = 9.0\n[[segment]]\nkind = \"cruise\"\nduration_s = 9.0\n", "turntable"),
+        ];
+        for (seg, want) in bad {
+            let e = Scenario::parse(&format!("{base}{seg}"), "sc.toml").unwrap_err();
+            assert!(format!("{e:#}").contains(want), "{seg}: {e:#}");
         }
     }
 }

@@ -91,6 +91,8 @@ pub const MAX_SQRT_DEPTH: usize = 4;
 pub const DIM_ACCEL: Dim = Dim([2, -4, 0]);
 /// Dimension of an angular rate, rad/s.
 pub const DIM_RATE: Dim = Dim([0, -2, 2]);
+/// Dimension of an angular acceleration, rad/s².
+pub const DIM_ANG_ACCEL: Dim = Dim([0, -4, 2]);
 /// Dimensionless.
 pub const DIM_ONE: Dim = ONE;
 
