@@ -192,6 +192,51 @@ fn a_withheld_inner_lever_arm_gives_no_confident_finding() {
     }
 }
 
+/// A baseline term 10× beyond its prior (an accelerometer bias of 1 mg and a scale factor of
+/// 1000 ppm held to the navigation-grade 100 µg and 100 ppm) on a turntable: explain says the
+/// priors are too tight, with the data's values and a prior that holds them, runs again with
+/// those and names nothing (with the tight priors alone the biased baseline made kao_y look
+/// significant).
+#[test]
+fn a_baseline_prior_too_tight_is_said() {
+    let mut case = generate(1, CaseKind::One("inner_lever"), SECONDS, 1.0).scaled(0.0);
+    case.scenario = case.scenario.replace(
+        "[errors]\n",
+        "[errors]\nnabla_y = \"1000 ug\"\nka_22 = \"1000 ppm\"\n",
+    );
+    // the generator's own values for them go (a scenario key given twice is refused)
+    let keep: Vec<&str> = case
+        .scenario
+        .lines()
+        .filter(|l| {
+            !(l.starts_with("nabla_y = \"") || l.starts_with("ka_22 = \"")) || l.contains("1000")
+        })
+        .collect();
+    case.scenario = keep.join("\n") + "\n";
+    case.baseline = "P31+vertical".into();
+    let out = run_hidden_case(&case, &ExplainOptions::default()).expect("explain runs");
+    let e = &out.explanation;
+    let w: Vec<(&str, f64, f64)> = e
+        .baseline_priors_tight
+        .iter()
+        .map(|p| (p.term.as_str(), p.estimate, p.suggested))
+        .collect();
+    let find = |name: &str| w.iter().find(|x| x.0 == name).copied();
+    let (_, nabla, to) = find("nabla_y").unwrap_or_else(|| panic!("nabla_y not flagged: {w:?}"));
+    assert!((nabla - 1000.0).abs() < 100.0 && to >= 3000.0, "{w:?}");
+    // the scale factor stays biased by its tight prior (short static spans): beyond 3 prior σ,
+    // and the suggested prior holds the true value
+    let (_, ka, to) = find("ka_22").unwrap_or_else(|| panic!("ka_22 not flagged: {w:?}"));
+    assert!(ka > 300.0 && to >= 1000.0, "{w:?}");
+    assert_eq!(w.len(), 2, "only the two: {w:?}");
+    assert!(e.summary[0].contains("too tight"), "{:?}", e.summary);
+    assert!(
+        e.findings.is_empty(),
+        "named {:?}",
+        e.findings.iter().map(|f| &f.term).collect::<Vec<_>>()
+    );
+}
+
 /// The turntable with nothing hidden (the lever arm scaled to zero) names nothing.
 #[test]
 fn names_nothing_on_a_clean_turntable() {

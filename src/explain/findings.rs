@@ -89,6 +89,11 @@ pub struct Finding {
     /// Why it probably stands in for an effect the candidates do not describe (it needs
     /// ≫ its prior, or it explains little of the misfit); absent for a finding read as a cause.
     pub stand_in: Option<String>,
+    /// Why no member of its equivalence class is named as the cause: the values they would need
+    /// differ by 10× or more in prior σ and even the most plausible lies beyond 3 prior σ (the
+    /// priors, which do not fit this sensor, would choose, not the data); the finding then
+    /// stands for its class and is kept out of `extended.toml`.
+    pub not_attributed: Option<String>,
     /// A noise finding's maximum-likelihood scale of the stated value (white noise density, or
     /// the aiding's stated 1-σ).
     pub scale: Option<f64>,
@@ -105,6 +110,13 @@ pub struct Finding {
     /// A term finding's tests that it holds across the data: per split of the updates (time,
     /// speed, motion), its estimate from each group alone and whether they agree.
     pub consistency: Vec<Consistency>,
+}
+
+impl Finding {
+    /// True when the finding is read as a cause: neither a stand-in nor an unattributed class.
+    pub fn is_cause(&self) -> bool {
+        self.stand_in.is_none() && self.not_attributed.is_none()
+    }
 }
 
 /// A finding's test that it holds across the data: its estimate from each group of one split
@@ -136,6 +148,25 @@ pub struct GroupEstimate {
     pub estimate: f64,
     /// Its σ (display unit).
     pub sigma: f64,
+}
+
+/// A baseline term whose prior σ the data show to be too tight for this sensor.
+#[derive(Debug, Clone, Serialize)]
+pub struct TightPrior {
+    /// Term name.
+    pub term: String,
+    /// Its estimate at the end of the first run's extended pass (display unit).
+    pub estimate: f64,
+    /// Its σ there (display unit).
+    pub sigma: f64,
+    /// The prior σ it had (display unit).
+    pub prior: f64,
+    /// |estimate| in units of that prior σ.
+    pub prior_sigmas: f64,
+    /// A prior σ that holds the data's value (display unit): 3 |estimate|, rounded up.
+    pub suggested: f64,
+    /// Display unit.
+    pub unit: String,
 }
 
 /// A term the data cannot tell from a finding, and the value it would need.
@@ -208,6 +239,16 @@ pub struct Explanation {
     /// Fraction of the baseline's excess mean NIS the extended model leaves; absent when the
     /// baseline's mean NIS is within its 95 % band.
     pub misfit_unexplained: Option<f64>,
+    /// Baseline terms whose prior looks too tight for these data: in the extended model (the
+    /// findings added) their estimate still lies beyond 3 prior σ and 3 own σ. Explain then
+    /// ran again from the baseline with each prior widened to `suggested`.
+    pub baseline_priors_tight: Vec<TightPrior>,
+    /// True when this explanation is that second run: the widened priors raised the
+    /// baseline's innovation log-likelihood (the data's evidence for them) by more than their
+    /// BIC penalty.
+    pub baseline_priors_widened: bool,
+    /// 2Δ log-likelihood of the baseline with the widened priors over the priors as given.
+    pub baseline_priors_gain: Option<f64>,
     /// Normalised innovations (t, channel, ν/√S) of the baseline and extended passes, for plots.
     #[serde(skip)]
     pub innovations_before: Vec<(f64, String, f64)>,

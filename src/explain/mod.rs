@@ -36,7 +36,7 @@ mod words;
 pub use diagnostics::{innovation_loglik, ChannelStats, PassStats, SegmentStats, TruthCheck};
 pub use findings::{
     CandidateTest, Consistency, EquivalentTerm, Explanation, Finding, Gain, GroupEstimate,
-    Implausible,
+    Implausible, TightPrior,
 };
 pub use selection::prior_sigma;
 pub use words::{separation_hint, sig3};
@@ -285,36 +285,75 @@ pub fn explain(
         .copied()
         .filter(|&t| !baseline.states.contains(&StateRef::Term(t)))
         .collect();
-    let cfg = config_for(baseline)?;
-    let base = run_pass(baseline, &cands, data, &cfg, &mut |f| progress(1, f))?;
-    let base_stats = base.stats.clone();
-    let innovations_before = normalised(&base.run);
-    let model_error_before = model_error_series(&base.run);
-    let (tests, eligible) = candidate_tests(&base.sig, opts);
-    let not_testable: Vec<String> = tests
-        .iter()
-        .filter(|t| !t.testable)
-        .map(|t| t.term.clone())
-        .collect();
-    let not_separable: Vec<(String, String)> = tests
-        .iter()
-        .filter(|t| t.testable)
-        .filter_map(|t| Some((t.term.clone(), t.confounded_with.clone()?)))
-        .collect();
-    let ctx = Context {
+    let first = Context {
         baseline,
         data,
         config_for,
         opts,
     };
-    let r = select_and_retest(&ctx, cands, base, &eligible, progress)?;
-    let (noise_findings, noise_pass) = noise::stage(&ctx, &r, &base_stats, progress)?;
+    let mut stage = baseline_and_select(&first, &cands, progress)?;
+    // a baseline term the data put beyond a few of its prior σ even with the findings added:
+    // its prior is too tight for this sensor and the baseline biased (before the findings, such
+    // a term may only be absorbing what a missing term does); explain runs again with priors
+    // that hold the data's values
+    let tight = tight_priors(
+        baseline,
+        &stage.r.model,
+        &stage.r.pass.run,
+        &config_for(&stage.r.model)?,
+    );
+    let widen: Vec<(usize, f64)> = tight
+        .iter()
+        .filter_map(|p| {
+            let t = common::TERMS.iter().position(|x| x.name == p.term)?;
+            Some((t, p.suggested * common::TERMS[t].display_to_si))
+        })
+        .collect();
+    let config_widened = |m: &Model| -> anyhow::Result<FilterConfig> {
+        let mut c = config_for(m)?;
+        for &(t, sigma) in &widen {
+            if let Some(i) = m.index_of(common::TERMS[t].name) {
+                c.prior_sigma[i] = c.prior_sigma[i].max(sigma);
+            }
+        }
+        Ok(c)
+    };
+    let widened = Context {
+        config_for: &config_widened,
+        ..first
+    };
+    // the priors are hyperparameters: the baseline's innovation log-likelihood is the data's
+    // evidence for them, so the run with the widened priors is kept only when its baseline
+    // gains more than their BIC penalty
+    let mut prior_gain = None;
+    let mut ctx = &first;
+    if !widen.is_empty() {
+        let again = baseline_and_select(&widened, &cands, progress)?;
+        let gain = 2.0 * (again.base_stats.loglik - stage.base_stats.loglik);
+        let n = again.r.pass.run.innovations.len().max(2) as f64;
+        prior_gain = Some(gain);
+        if gain > widen.len() as f64 * n.ln() {
+            stage = again;
+            ctx = &widened;
+        }
+    }
+    let widened_kept = std::ptr::eq(ctx, &widened);
+    let Stage {
+        base_stats,
+        innovations_before,
+        model_error_before,
+        tests,
+        not_testable,
+        not_separable,
+        r,
+    } = stage;
+    let (noise_findings, noise_pass) = noise::stage(ctx, &r, &base_stats, progress)?;
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let last_pass = noise_pass.as_ref().unwrap_or(&r.pass);
     let excess = baseline_excess(&base_stats);
     // the share of the baseline's excess the extended model leaves
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
-    let mut findings = complete_findings(&ctx, &r, excess, misfit_unexplained)?;
+    let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
     findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
@@ -347,6 +386,9 @@ pub fn explain(
         alpha: opts.alpha,
         summary: Vec::new(),
         misfit_unexplained: misfit_unexplained.map(|u| u.max(0.0)),
+        baseline_priors_tight: tight,
+        baseline_priors_widened: widened_kept,
+        baseline_priors_gain: prior_gain,
         innovations_before,
         innovations_after: normalised(&last_pass.run),
         model_error_before,
@@ -354,6 +396,98 @@ pub fn explain(
     };
     expl.summary = summary(&expl);
     Ok(expl)
+}
+
+/// The instrument terms of `baseline` whose final estimate in `run` (a pass of `model`, the
+/// baseline or its extension) lies beyond [`TIGHT_PRIOR_SIGMAS`] of their prior σ (in `cfg`)
+/// and beyond 3 of their own σ: the data determine a value the prior calls implausible.
+fn tight_priors(
+    baseline: &Model,
+    model: &Model,
+    run: &FilterRun,
+    cfg: &FilterConfig,
+) -> Vec<TightPrior> {
+    let Some(last) = run.records.last() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (i, s) in model.states.iter().enumerate() {
+        let StateRef::Term(t) = *s else { continue };
+        if !baseline.states.contains(s) {
+            continue;
+        }
+        let info = &common::TERMS[t];
+        let (x, sd, prior) = (last.x[i], last.sigma[i], cfg.prior_sigma[i]);
+        if !(prior > 0.0 && x.abs() > TIGHT_PRIOR_SIGMAS * prior && x.abs() > 3.0 * sd) {
+            continue;
+        }
+        let k = 1.0 / info.display_to_si;
+        out.push(TightPrior {
+            term: info.name.to_string(),
+            estimate: x * k,
+            sigma: sd * k,
+            prior: prior * k,
+            prior_sigmas: x.abs() / prior,
+            suggested: round_up_1(3.0 * x.abs() * k),
+            unit: info.display.to_string(),
+        });
+    }
+    out
+}
+
+/// `v` > 0 rounded up to one significant digit (0.0123 → 0.02, 340 → 400).
+fn round_up_1(v: f64) -> f64 {
+    let p = 10f64.powf(v.log10().floor());
+    (v / p).ceil() * p
+}
+
+/// Prior σ beyond which a baseline term's estimate says its prior is too tight.
+const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
+
+/// The baseline pass and the selection rounds on it.
+struct Stage {
+    base_stats: PassStats,
+    innovations_before: Vec<(f64, String, f64)>,
+    model_error_before: Vec<(f64, f64, f64)>,
+    tests: Vec<CandidateTest>,
+    not_testable: Vec<String>,
+    not_separable: Vec<(String, String)>,
+    r: Rounds,
+}
+
+/// Runs the baseline pass with the candidates' signatures, tests every candidate and selects
+/// and re-tests terms in rounds.
+fn baseline_and_select(
+    ctx: &Context,
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Stage> {
+    let cfg = (ctx.config_for)(ctx.baseline)?;
+    let base = run_pass(ctx.baseline, cands, ctx.data, &cfg, &mut |f| progress(1, f))?;
+    let base_stats = base.stats.clone();
+    let innovations_before = normalised(&base.run);
+    let model_error_before = model_error_series(&base.run);
+    let (tests, eligible) = candidate_tests(&base.sig, ctx.opts);
+    let not_testable: Vec<String> = tests
+        .iter()
+        .filter(|t| !t.testable)
+        .map(|t| t.term.clone())
+        .collect();
+    let not_separable: Vec<(String, String)> = tests
+        .iter()
+        .filter(|t| t.testable)
+        .filter_map(|t| Some((t.term.clone(), t.confounded_with.clone()?)))
+        .collect();
+    let r = select_and_retest(ctx, cands.to_vec(), base, &eligible, progress)?;
+    Ok(Stage {
+        base_stats,
+        innovations_before,
+        model_error_before,
+        tests,
+        not_testable,
+        not_separable,
+        r,
+    })
 }
 
 /// What every phase of one explain run shares: the baseline, the data, the filter set-up of a
@@ -406,6 +540,8 @@ struct Named {
     separate_by: Vec<String>,
     /// Its GLR estimate and σ from each group of each split of the updates alone (display unit).
     splits: Vec<(Split, Vec<(f64, f64)>)>,
+    /// Largest over smallest prior-σ count in its class (≥ 10: not attributed).
+    prior_ratio: f64,
     /// Its share of its round's gain: 2Δℓ, and the mean NIS removed.
     two_delta_loglik: f64,
     nis_removed: f64,
@@ -450,6 +586,7 @@ impl Named {
                 .map(|c| separation_hint(t, sig.cands[c.0]))
                 .collect(),
             splits: s.splits.clone(),
+            prior_ratio: s.prior_ratio,
             two_delta_loglik: 0.0,
             nis_removed: 0.0,
         }
@@ -654,6 +791,35 @@ fn complete_findings(
             misfit_share: excess.map(|e| n.nis_removed / e),
             prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
             stand_in: None,
+            // the priors choose within a class when they differ by an order of magnitude; they
+            // are credible for that only while the chosen member sits within 3 of its prior σ
+            not_attributed: (n.prior_ratio >= selection::UNATTRIBUTED_RATIO
+                && !n.equivalent_estimates.is_empty()
+                && (estimate / to_display).abs() > 3.0 * prior_sigma(t, ctx.opts))
+            .then(|| {
+                format!(
+                    "the data cannot tell {} from {}, the values they would need differ by {}× in prior σ ({}), and even the most plausible is beyond 3 prior σ: priors that do not fit this sensor would choose, not the data; an excitation that separates them decides",
+                    info.name,
+                    n.equivalent_estimates
+                        .iter()
+                        .map(|e| e.term.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    sig3(n.prior_ratio),
+                    std::iter::once(format!(
+                        "{} {}",
+                        info.name,
+                        sig3((estimate / to_display).abs() / prior_sigma(t, ctx.opts))
+                    ))
+                    .chain(
+                        n.equivalent_estimates
+                            .iter()
+                            .map(|e| format!("{} {}", e.term, sig3(e.prior_sigmas.abs())))
+                    )
+                    .collect::<Vec<_>>()
+                    .join(", ")
+                )
+            }),
             scale: None,
             scale_interval: None,
             halves: split_halves(&n.splits, "time"),
@@ -808,6 +974,7 @@ mod tests {
             misfit_share,
             prior_sigmas,
             stand_in: None,
+            not_attributed: None,
             scale: None,
             scale_interval: None,
             halves: None,

@@ -333,6 +333,7 @@ fn noise_finding(
         misfit_share,
         prior_sigmas: 0.0,
         stand_in: None,
+        not_attributed: None,
         scale: Some(f.scale),
         scale_interval: Some(f.interval),
         halves: None,

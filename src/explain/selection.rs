@@ -116,7 +116,14 @@ pub(super) struct Selected {
     pub(super) glr_sigma: f64,
     /// The other members: (candidate index, conditional GLR estimate, σ, display unit).
     pub(super) class: Vec<(usize, f64, f64)>,
+    /// The values the members would need differ by [`UNATTRIBUTED_RATIO`] or more in prior σ:
+    /// the priors, not the data, chose the named one (largest over smallest).
+    pub(super) prior_ratio: f64,
 }
+
+/// Ratio of the prior-σ counts within an equivalence class at which the priors, not the data,
+/// would choose its member: the class is reported, no member named as a cause.
+pub(super) const UNATTRIBUTED_RATIO: f64 = 10.0;
 
 /// Forward selection on one pass's joint information (prior-scaled) over the `eligible`
 /// candidates, with `innovations` scalar innovations in the pass.
@@ -243,6 +250,8 @@ fn select(
             p: (stats::chi2_sf(named_llr, 1.0) * pool.len() as f64).min(1.0),
             glr,
             glr_sigma,
+            prior_ratio: members.last().map_or(1.0, |l| l.1.abs())
+                / theta.abs().max(f64::MIN_POSITIVE),
             class: members[1..]
                 .iter()
                 .map(|&(a, th, ia)| {
@@ -469,6 +478,28 @@ mod tests {
         assert_eq!(sel[0].class.len(), 1);
         assert_eq!(sel[0].class[0].0, 1);
         assert!(sel[0].class[0].1.abs() > sel[0].glr.abs());
+        // the second needs 2ρ× the prior σ of the first: the data and the priors agree enough
+        assert!(
+            (sel[0].prior_ratio - 2.0 * rho).abs() < 1e-9,
+            "{}",
+            sel[0].prior_ratio
+        );
+        // the second's information 400× smaller: it would need 20× the prior σ, an order of
+        // magnitude; the priors, not the data, choose
+        let (i0, i1): (f64, f64) = (400.0, 1.0);
+        let j = DMatrix::from_row_slice(
+            2,
+            2,
+            &[i0, rho * (i0 * i1).sqrt(), rho * (i0 * i1).sqrt(), i1],
+        );
+        let b = [i0 * theta0, rho * (i0 * i1).sqrt() * theta0];
+        let (sel, _) = select(&sc(j, &b), &[0, 1], &[true; 2], 1000, &opts());
+        assert_eq!(sel[0].class.len(), 1);
+        assert!(
+            sel[0].prior_ratio >= UNATTRIBUTED_RATIO,
+            "{}",
+            sel[0].prior_ratio
+        );
     }
 
     #[test]

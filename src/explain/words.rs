@@ -235,6 +235,10 @@ fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
         s.push_str(&format!(
             ". It probably stands in for an effect the candidates do not describe ({why}){what_else}"
         ));
+    } else if let Some(why) = &f.not_attributed {
+        s.push_str(&format!(
+            ". No member of its class is named as the cause: {why}"
+        ));
     }
     s
 }
@@ -308,6 +312,40 @@ pub(super) fn channel_word(c: &str) -> String {
 /// The plain-words summary: what the baseline gets wrong, what was found, the gain.
 pub(super) fn summary(e: &Explanation) -> Vec<String> {
     let mut out = Vec::new();
+    if !e.baseline_priors_tight.is_empty() {
+        let w = &e.baseline_priors_tight;
+        let values = w
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} = {} ± {} {} is {} of its {} {} prior σ",
+                    p.term,
+                    sig3(p.estimate),
+                    sig3(p.sigma),
+                    p.unit,
+                    sig3(p.prior_sigmas),
+                    sig3(p.prior),
+                    p.unit
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ");
+        let options = w
+            .iter()
+            .map(|p| format!("--prior '{}={} {}'", p.term, sig3(p.suggested), p.unit))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let gain = sig3(e.baseline_priors_gain.unwrap_or(0.0));
+        out.push(if e.baseline_priors_widened {
+            format!(
+                "The baseline's priors are too tight for this sensor: even with the findings added, {values}. A baseline held to priors the data reject is biased and its bias would be explained, so explain ran again with {options}: the baseline's log-likelihood rises by 2Δℓ {gain}, and what follows is that run. Give them, or the --grade of your sensor, yourself."
+            )
+        } else {
+            format!(
+                "Even with the findings added, {values}; but widening those priors ({options}) does not raise the baseline's likelihood enough (2Δℓ {gain}): the data do not ask for them, and what follows keeps the priors as given. Such values usually pair with a term fitted beside them (see the stand-ins below)."
+            )
+        });
+    }
     // data times (GPS seconds on real data) are counted from the first update when large
     let t_ref = if e.baseline.t_start.abs() > 1e5 {
         e.baseline.t_start.floor()
@@ -390,6 +428,8 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
     for f in &e.findings {
         if f.stand_in.is_some() {
             out.push(format!("Fitted, but not a cause: {}.", f.words));
+        } else if f.not_attributed.is_some() {
+            out.push(format!("Fitted, not attributed: {}.", f.words));
         } else {
             out.push(format!("Found: {}.", f.words));
         }

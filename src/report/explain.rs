@@ -66,7 +66,7 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
     let causes: Vec<&crate::explain::Finding> = e
         .findings
         .iter()
-        .filter(|f| f.stand_in.is_none() && f.kind != "noise")
+        .filter(|f| f.is_cause() && f.kind != "noise")
         .collect();
     if causes.is_empty() {
         return None;
@@ -95,6 +95,13 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
             f.term
         ));
     }
+    for f in e.findings.iter().filter(|f| f.not_attributed.is_some()) {
+        s.push_str(&format!(
+            "# {} is left out: the data cannot tell it from {} and the priors would choose.\n",
+            f.term,
+            f.equivalent.join(", ")
+        ));
+    }
     for f in e.findings.iter().filter(|f| f.kind == "noise") {
         s.push_str(&format!(
             "# noise, not a term: {} = {} {} ({}× the stated; give it with --noise or the aiding's σ).\n",
@@ -106,7 +113,7 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
     }
     if e.findings
         .iter()
-        .any(|f| f.stand_in.is_some() || f.kind == "noise")
+        .any(|f| !f.is_cause() || f.kind == "noise")
     {
         s.push_str(&format!(
             "# the extended pass explain reports ({}) also held the lines above.\n",
@@ -244,6 +251,8 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
             "- {}**{}** = {} ± {} {} (llr {:.1}, p {}; pass {}). {}\n",
             if f.stand_in.is_some() {
                 "*fitted, not a cause:* "
+            } else if f.not_attributed.is_some() {
+                "*fitted, not attributed:* "
             } else {
                 ""
             },
