@@ -16,7 +16,10 @@ fn inputs() -> ([[f64; 31]; 31], [[f64; 31]; 31], [f64; 31]) {
     let f = Vector3::new(0.1, -0.2, -9.79);
     let nav = NavPoint::new(0.4925, 50.0, Vector3::new(1.0, -2.0, 0.1), &c, &f);
     let mut acc = p31::Regressors::default();
-    acc.add(&f, &Vector3::new(1e-3, -2e-3, 5e-4), &Vector3::zeros());
+    acc.add(&sinsmodel::model::ImuSignals::new(
+        f,
+        Vector3::new(1e-3, -2e-3, 5e-4),
+    ));
     let mut a = [[0.0; 31]; 31];
     p31::fill_a(&nav, &acc.mean(), &mut a);
     let mut p = [[0.0; 31]; 31];

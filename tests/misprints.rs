@@ -24,7 +24,7 @@ impl Filled {
         let w = Vector3::new(0.2, -0.4, 0.7);
         let nav = NavPoint::new(0.6, 250.0, Vector3::new(120.0, 80.0, -3.0), &c, &f);
         let mut acc = m.accumulator();
-        acc.add(&f, &w, &Vector3::zeros());
+        acc.add(&sinsmodel::model::ImuSignals::new(f, w));
         let mut a = vec![0.0; m.n() * m.n()];
         m.fill_a(&nav, &acc.mean(), &mut a);
         Filled { m, a, nav, f, w }

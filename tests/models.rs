@@ -4,7 +4,7 @@
 use nalgebra::{DMatrix, Vector3};
 use sinsmodel::model::covariance::{propagate_dense, SparsePropagator};
 use sinsmodel::model::generated::PRESETS;
-use sinsmodel::model::Model;
+use sinsmodel::model::{ImuSignals, Model};
 use sinsmodel::nav::attitude::dcm_from_euler;
 use sinsmodel::nav::nav_point::NavPoint;
 
@@ -127,9 +127,19 @@ fn preset_path_equals_runtime_path() {
         for _ in 0..50 {
             let (nav, f, w) = random_point(&mut rng);
             let mut acc = m.accumulator();
-            let dw = w.cross(&f) * 0.7;
-            acc.add(&f, &w, &dw);
-            acc.add(&(f * 0.5), &(w * -0.3), &(dw * 1.9));
+            let sig = ImuSignals {
+                f,
+                w,
+                dw: w.cross(&f) * 0.7,
+                df: f.cross(&w) * -1.3,
+            };
+            acc.add(&sig);
+            acc.add(&ImuSignals {
+                f: f * 0.5,
+                w: w * -0.3,
+                dw: sig.dw * 1.9,
+                df: sig.df * 0.4,
+            });
             let r = acc.mean();
             let mut a1 = vec![0.0; n * n];
             let mut a2 = vec![0.0; n * n];
@@ -178,7 +188,7 @@ fn covariance_kernels_match_dense_reference() {
         let n = m.n();
         let (nav, f, w) = random_point(&mut rng);
         let mut acc = m.accumulator();
-        acc.add(&f, &w, &Vector3::zeros());
+        acc.add(&ImuSignals::new(f, w));
         let mut a = vec![0.0; n * n];
         m.fill_a(&nav, &acc.mean(), &mut a);
         // a random symmetric positive definite P
@@ -224,11 +234,10 @@ fn accumulator_uses_mean_of_squares() {
     let samples = 2000;
     for i in 0..samples {
         let fx = amp * (2.0 * std::f64::consts::PI * i as f64 / 20.0).cos();
-        acc.add(
-            &Vector3::new(fx, 0.0, -9.8),
-            &Vector3::zeros(),
-            &Vector3::zeros(),
-        );
+        acc.add(&ImuSignals::new(
+            Vector3::new(fx, 0.0, -9.8),
+            Vector3::zeros(),
+        ));
     }
     let r = acc.mean();
     assert!(

@@ -76,6 +76,11 @@ class MisprintsAreCaught(unittest.TestCase):
         self.assertEqual(code, 1, f"reversed tangential part not caught:\n{out}")
         self.assertIn("][size_x_y]:", out, f"wrong entry named:\n{out}")
 
+    def test_reversed_accelerometer_delay_is_named(self):
+        code, out = run("--corrupt", "11", "--models", "P31+tau_y")
+        self.assertEqual(code, 1, f"reversed delay not caught:\n{out}")
+        self.assertIn("][tau_y]:", out, f"wrong entry named:\n{out}")
+
     def test_every_spec_term_is_checked_by_default(self):
         models = vj.default_models()
         named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}
@@ -88,8 +93,8 @@ class RegressorTranslation(unittest.TestCase):
         f, w, dw = ca.DM([1.5, -2.0, 3.0]), ca.DM([0.1, 0.2, -0.3]), ca.DM([4.0, 5.0, 6.0])
         for text, want in [("1", 1.0), ("f.x * f.y", -3.0), ("f.z.powi(2)", 9.0), ("f.y.abs()", 2.0),
                            ("f.y * f.y.abs()", -4.0), ("-(w.y.powi(2) + w.z.powi(2))", -0.13),
-                           ("f.x / 2.0 - w.x", 0.65), ("w.x * w.y - dw.z", -5.98)]:
-            got = float(vj.translate_regressor(text, "t")(f, w, dw))
+                           ("f.x / 2.0 - w.x", 0.65), ("w.x * w.y - dw.z", -5.98), ("-df.y", -8.0)]:
+            got = float(vj.translate_regressor(text, "t")(f, w, dw, ca.DM([7.0, 8.0, 9.0])))
             self.assertAlmostEqual(got, want, places=12, msg=text)
 
     def test_rejects_what_it_cannot_translate(self):

@@ -98,7 +98,7 @@ _METHODS = {
 
 def translate_regressor(text, term):
     """Turns a spec regressor (Rust syntax: `f.x * f.y`, `f.z.powi(2)`, `-(w.y.powi(2) + w.z.powi(2))`,
-    `w.x * w.y - dw.z`) into a function (f, w, dw) -> CasADi expression. Only literals, f.x..dw.z,
+    `w.x * w.y - dw.z`) into a function (f, w, dw, df) -> CasADi expression. Only literals, f.x..df.z,
     + - * /, unary minus and the methods abs sqrt sin cos tan powi(integer) are accepted; anything
     else raises."""
     try:
@@ -109,7 +109,7 @@ def translate_regressor(text, term):
     def fail(node, why):
         raise SpecTranslationError(f"term `{term}`: regressor `{text}`: cannot translate `{ast.unparse(node)}` ({why})")
 
-    signals = ("f", "w", "dw")
+    signals = ("f", "w", "dw", "df")
 
     def tr(node):
         if isinstance(node, ast.Constant) and type(node.value) in (int, float):
@@ -119,7 +119,7 @@ def translate_regressor(text, term):
             if node.value.id in signals and node.attr in ("x", "y", "z"):
                 i, k = signals.index(node.value.id), "xyz".index(node.attr)
                 return lambda s: s[i][k]
-            fail(node, "signals are f.x f.y f.z, w.x w.y w.z and dw.x dw.y dw.z")
+            fail(node, "signals are f.x f.y f.z, w.x w.y w.z, dw.x dw.y dw.z and df.x df.y df.z")
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
             inner = tr(node.operand)
             return (lambda s: -inner(s)) if isinstance(node.op, ast.USub) else inner
@@ -142,10 +142,10 @@ def translate_regressor(text, term):
                 m = _METHODS[name]
                 return lambda s: m(recv(s))
             fail(node, f"methods are {' '.join(sorted(_METHODS))} powi")
-        fail(node, "not arithmetic over f, w and dw")
+        fail(node, "not arithmetic over f, w, dw and df")
 
     body = tr(tree.body)
-    return lambda f, w, dw=(0, 0, 0): body((f, w, dw))
+    return lambda f, w, dw=(0, 0, 0), df=(0, 0, 0): body((f, w, dw, df))
 
 
 # Accelerometer inner lever arms, written independently of the spec: accelerometer i sits at
@@ -154,6 +154,11 @@ def translate_regressor(text, term):
 # name -> (accelerometer axis i, coordinate j)
 INNER_LEVER = {f"size_{i}" + ("" if i == j else f"_{j}"): ("xyz".index(i), "xyz".index(j))
                for i in "xyz" for j in "xyz"}
+
+# Accelerometer delays behind the gyros, written independently of the spec: accelerometer i
+# reads at stamp t the specific force of t - theta, the signal about the point being
+# f(s) = f_b + s df_b (df_b its body-frame rate of change). name -> accelerometer axis i
+ACCEL_DELAY = {f"tau_{i}": "xyz".index(i) for i in "xyz"}
 
 
 # GNSS measurement terms, written independently of the spec: what each one does to the fix.
@@ -195,6 +200,12 @@ def load_spec_terms(spec_dir=SPEC_DIR):
                 raise SpecTranslationError(f"term `{name}`: an inner lever arm of the {'xyz'[i]} accelerometer, "
                                            f"but the spec says {t['sensor']} {t['axis']}")
             terms[name] = ("accel", i, ("inner_lever", j))
+        elif name in ACCEL_DELAY:
+            i = ACCEL_DELAY[name]
+            if t["sensor"] != "accel" or "xyz".index(t["axis"]) != i:
+                raise SpecTranslationError(f"term `{name}`: the delay of the {'xyz'[i]} accelerometer, "
+                                           f"but the spec says {t['sensor']} {t['axis']}")
+            terms[name] = ("accel", i, ("delay",))
         else:
             terms[name] = (t["sensor"], "xyz".index(t["axis"]), translate_regressor(t["regressor"], name))
         if t.get("library", False):
@@ -223,11 +234,11 @@ MEAS_STATES = {"vel_ne": ["dv_n", "dv_e"], "pos_ne": ["dlat", "dlon"], "pos_h": 
 # ---------------------------------------------------------------- the nonlinear error dynamics
 def build_jacobian_function():
     """CasADi function: point parameters -> (J_A [9 x (9+T)] at zero error, J_H, sparsity)."""
-    p = ca.SX.sym("p", 17)  # lat, h, vn ve vd, roll pitch yaw, f_b(3), w_b(3), dw_b(3)
+    p = ca.SX.sym("p", 20)  # lat, h, vn ve vd, roll pitch yaw, f_b(3), w_b(3), dw_b(3), df_b(3)
     lat, h = p[0], p[1]
     v = p[2:5]
     c = dcm_from_euler(p[5], p[6], p[7])
-    f_b, w_b, dw_b = p[8:11], p[11:14], p[14:17]
+    f_b, w_b, dw_b, df_b = p[8:11], p[11:14], p[14:17], p[17:20]
     rm0, rn0 = radii(lat)  # frozen at the true latitude
 
     x = ca.SX.sym("x", len(ALL_STATES))
@@ -258,7 +269,12 @@ def build_jacobian_function():
         sensor, axis, reg = TERMS[name]
         if sensor == "gnss":
             continue
-        if isinstance(reg, tuple):
+        if isinstance(reg, tuple) and reg[0] == "delay":
+            # the accelerometer reads the signal of theta earlier
+            def f_at(s):
+                return f_b + s * df_b
+            contrib = f_at(-theta[k])[axis] - f_b[axis]
+        elif isinstance(reg, tuple):
             # an inner lever arm: the accelerometer at r = theta e_j
             r = ca.SX.zeros(3)
             r[reg[1]] = theta[k]
@@ -349,6 +365,11 @@ def corrupt(kind, out, pt):
         # a lever arm's velocity rows with the cross product reversed (l x w for w x l)
         col = idx["lever_y"]
         out["h"]["vel_ne"][0][col] = -out["h"]["vel_ne"][0][col]
+    elif kind == 11 and "tau_y" in idx:
+        # an accelerometer delay with its sign reversed (a lead taken for a lag)
+        for k, row in enumerate(["dv_n", "dv_e", "dv_d"]):
+            if row in idx:
+                a[idx[row]][idx["tau_y"]] = cm[k, 1] * pt["df_b"][1]
     elif kind == 10 and "size_x_y" in idx:
         # an off-axis inner lever arm with its tangential part reversed (r x dw for dw x r)
         dwz = pt["dw_b"][2]
@@ -373,13 +394,15 @@ def random_points(n, rng):
             "f_b": [float(x) for x in rand_vec(20 * 9.80665)],
             "w_b": [float(x) for x in rand_vec(3.0)],
             "dw_b": [float(x) for x in rand_vec(30.0)],
+            "df_b": [float(x) for x in rand_vec(300.0)],
         })
     return pts
 
 
 def point_vector(pt):
     return [math.radians(pt["lat_deg"]), pt["h_m"], *pt["v_ned"],
-            *[math.radians(v) for v in pt["euler_deg"]], *pt["f_b"], *pt["w_b"], *pt.get("dw_b", [0, 0, 0])]
+            *[math.radians(v) for v in pt["euler_deg"]], *pt["f_b"], *pt["w_b"], *pt.get("dw_b", [0, 0, 0]),
+            *pt.get("df_b", [0, 0, 0])]
 
 
 def run_sinsmodel(binary, model, points, runtime):
@@ -510,7 +533,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed; the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed; the check must fail")
     args = ap.parse_args()
 
     models = args.models or default_models()

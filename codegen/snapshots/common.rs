@@ -7,8 +7,8 @@ use crate::model::catalog::{
     ResidualState, Sensor, TermInfo, WhiteNoise,
 };
 
+use crate::model::ImuSignals;
 use crate::nav::nav_point::NavPoint;
-use nalgebra::Vector3;
 
 /// Number of navigation states with the vertical channel.
 pub const NAV_COUNT: usize = 9;
@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 61;
+pub const TERM_COUNT: usize = 64;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -938,6 +938,48 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         library: true,
     },
     TermInfo {
+        name: "tau_x",
+        sensor: Sensor::Accel,
+        axis: 0,
+        regressor: 28,
+        unit: "s",
+        display: "ms",
+        display_to_si: 0.001,
+        sigma: 0.001,
+        noise: 0.0,
+        group: "accelerometer delay",
+        doc: "x accelerometer delay behind the gyros (regressor -df_x/dt)",
+        library: true,
+    },
+    TermInfo {
+        name: "tau_y",
+        sensor: Sensor::Accel,
+        axis: 1,
+        regressor: 29,
+        unit: "s",
+        display: "ms",
+        display_to_si: 0.001,
+        sigma: 0.001,
+        noise: 0.0,
+        group: "accelerometer delay",
+        doc: "y accelerometer delay behind the gyros (regressor -df_y/dt)",
+        library: true,
+    },
+    TermInfo {
+        name: "tau_z",
+        sensor: Sensor::Accel,
+        axis: 2,
+        regressor: 30,
+        unit: "s",
+        display: "ms",
+        display_to_si: 0.001,
+        sigma: 0.001,
+        noise: 0.0,
+        group: "accelerometer delay",
+        doc: "z accelerometer delay behind the gyros (regressor -df_z/dt)",
+        library: true,
+    },
+    TermInfo {
         name: "dt_gnss",
         sensor: Sensor::Gnss,
         axis: 0,
@@ -1098,6 +1140,9 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
+    &[DV_N, DV_E, DV_D],
     &[],
     &[],
     &[],
@@ -1105,7 +1150,7 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
 ];
 
 /// Number of distinct regressors.
-pub const REGRESSOR_COUNT: usize = 28;
+pub const REGRESSOR_COUNT: usize = 31;
 
 /// Regressor expressions over the body-frame signals f [m/s²] and w [rad/s].
 pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [
@@ -1137,13 +1182,16 @@ pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [
     "w.y * w.z - dw.x",
     "w.x * w.z - dw.y",
     "w.y * w.z + dw.x",
+    "-df.x",
+    "-df.y",
+    "-df.z",
 ];
 
 /// True for regressors that use no IMU signal (no accumulation needed).
 pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [
     true, false, false, false, false, false, false, false, false, false, false, false,
     false, false, false, false, false, false, false, false, false, false, false, false,
-    false, false, false, false,
+    false, false, false, false, false, false, false,
 ];
 
 /// Gyro angle random walk [rad/√s] (spec default).
@@ -1224,6 +1272,9 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             5.041195218559906e-9,
             5.041195218559906e-9,
             5.041195218559906e-9,
+            0.01,
+            0.01,
+            0.01,
             0.01,
             0.01,
             0.01,
@@ -1316,6 +1367,9 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.01,
             0.01,
             0.1,
+            0.1,
+            0.1,
+            0.1,
             1.0,
             1.0,
             1.0,
@@ -1377,13 +1431,9 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
     },
 ];
 
-/// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], dw [rad/s²], FRD body frame).
-pub fn regressor_value(
-    id: usize,
-    f: &Vector3<f64>,
-    w: &Vector3<f64>,
-    dw: &Vector3<f64>,
-) -> f64 {
+/// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
+pub fn regressor_value(id: usize, s: &ImuSignals) -> f64 {
+    let ImuSignals { f, w, dw, df, .. } = s;
     match id {
         0 => 1.0,
         1 => w.x,
@@ -1413,6 +1463,9 @@ pub fn regressor_value(
         25 => w.y * w.z - dw.x,
         26 => w.x * w.z - dw.y,
         27 => w.y * w.z + dw.x,
+        28 => -df.x,
+        29 => -df.y,
+        30 => -df.z,
         _ => panic!("regressor index {id} out of range"),
     }
 }
@@ -2144,15 +2197,51 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
             col[DV_D] = c33 * r;
         }
         57 => {
-            // dt_gnss: Gnss x axis, regressor 1
+            // tau_x: Accel x axis, regressor -df.x
+            let c11 = nav.c[0][0];
+            let c21 = nav.c[1][0];
+            let c31 = nav.c[2][0];
+            // A[dv_n][tau_x] = C11 * <-df.x>
+            col[DV_N] = c11 * r;
+            // A[dv_e][tau_x] = C21 * <-df.x>
+            col[DV_E] = c21 * r;
+            // A[dv_d][tau_x] = C31 * <-df.x>
+            col[DV_D] = c31 * r;
         }
         58 => {
-            // lever_x: Gnss x axis, regressor 1
+            // tau_y: Accel y axis, regressor -df.y
+            let c12 = nav.c[0][1];
+            let c22 = nav.c[1][1];
+            let c32 = nav.c[2][1];
+            // A[dv_n][tau_y] = C12 * <-df.y>
+            col[DV_N] = c12 * r;
+            // A[dv_e][tau_y] = C22 * <-df.y>
+            col[DV_E] = c22 * r;
+            // A[dv_d][tau_y] = C32 * <-df.y>
+            col[DV_D] = c32 * r;
         }
         59 => {
-            // lever_y: Gnss x axis, regressor 1
+            // tau_z: Accel z axis, regressor -df.z
+            let c13 = nav.c[0][2];
+            let c23 = nav.c[1][2];
+            let c33 = nav.c[2][2];
+            // A[dv_n][tau_z] = C13 * <-df.z>
+            col[DV_N] = c13 * r;
+            // A[dv_e][tau_z] = C23 * <-df.z>
+            col[DV_E] = c23 * r;
+            // A[dv_d][tau_z] = C33 * <-df.z>
+            col[DV_D] = c33 * r;
         }
         60 => {
+            // dt_gnss: Gnss x axis, regressor 1
+        }
+        61 => {
+            // lever_x: Gnss x axis, regressor 1
+        }
+        62 => {
+            // lever_y: Gnss x axis, regressor 1
+        }
+        63 => {
             // lever_z: Gnss x axis, regressor 1
         }
         _ => panic!("term index {term} out of range"),

@@ -4,8 +4,8 @@
 
 use super::common::NAV_COUNT;
 use crate::model::catalog::StateRef;
+use crate::model::ImuSignals;
 use crate::nav::nav_point::NavPoint;
-use nalgebra::Vector3;
 
 /// Model name.
 pub const NAME: &str = "P13";
@@ -152,10 +152,9 @@ pub struct Regressors {
 }
 
 impl Regressors {
-    /// Adds one IMU sample: specific force f [m/s²], rate w [rad/s] and angular
-    /// acceleration dw [rad/s²], FRD body frame.
+    /// Adds one IMU sample's signals (FRD body frame).
     #[inline]
-    pub fn add(&mut self, _f: &Vector3<f64>, _w: &Vector3<f64>, _dw: &Vector3<f64>) {
+    pub fn add(&mut self, _s: &ImuSignals) {
         self.count += 1;
     }
     /// Mean of each regressor (mean of squares, never square of means); zeros when empty.
@@ -179,14 +178,8 @@ impl Regressors {
     }
 }
 
-/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s],
-/// dw [rad/s²]).
-pub fn accumulate_dyn(
-    _sum: &mut [f64],
-    _f: &Vector3<f64>,
-    _w: &Vector3<f64>,
-    _dw: &Vector3<f64>,
-) {}
+/// Adds one IMU sample's regressors to running sums `sum` (NR entries).
+pub fn accumulate_dyn(_sum: &mut [f64], _s: &ImuSignals) {}
 
 /// Writes the structural non-zeros of A(t) at `nav` with regressor step means `r`.
 pub fn fill_a(nav: &NavPoint, _r: &[f64; NR], a: &mut [[f64; N]; N]) {

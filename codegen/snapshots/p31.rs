@@ -4,8 +4,8 @@
 
 use super::common::NAV_COUNT;
 use crate::model::catalog::StateRef;
+use crate::model::ImuSignals;
 use crate::nav::nav_point::NavPoint;
-use nalgebra::Vector3;
 
 /// Model name.
 pub const NAME: &str = "P31";
@@ -286,10 +286,10 @@ pub struct Regressors {
 }
 
 impl Regressors {
-    /// Adds one IMU sample: specific force f [m/s²], rate w [rad/s] and angular
-    /// acceleration dw [rad/s²], FRD body frame.
+    /// Adds one IMU sample's signals (FRD body frame).
     #[inline]
-    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, _dw: &Vector3<f64>) {
+    pub fn add(&mut self, s: &ImuSignals) {
+        let ImuSignals { f, w, .. } = s;
         self.sum[0] += w.x;
         self.sum[1] += w.y;
         self.sum[2] += w.z;
@@ -322,14 +322,9 @@ impl Regressors {
     }
 }
 
-/// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s],
-/// dw [rad/s²]).
-pub fn accumulate_dyn(
-    sum: &mut [f64],
-    f: &Vector3<f64>,
-    w: &Vector3<f64>,
-    _dw: &Vector3<f64>,
-) {
+/// Adds one IMU sample's regressors to running sums `sum` (NR entries).
+pub fn accumulate_dyn(sum: &mut [f64], s: &ImuSignals) {
+    let ImuSignals { f, w, .. } = s;
     let sum: &mut [f64; NR] = sum.try_into().expect("NR sums");
     sum[0] += w.x;
     sum[1] += w.y;

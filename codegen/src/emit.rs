@@ -203,9 +203,7 @@ pub fn common_module(spec: &Spec) -> String {
         quote!(#i => #ast,)
     });
     let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
-    let (uses_f, uses_w, uses_dw) = signals_used(spec, &all_regs);
-    let (f_param, w_param, dw_param) =
-        (param("f", uses_f), param("w", uses_w), param("dw", uses_dw));
+    let (s_param, s_bind) = signals_binding(spec, &all_regs);
     let r_param = param(
         "r",
         spec.terms
@@ -376,8 +374,8 @@ pub fn common_module(spec: &Spec) -> String {
     });
     let tokens = quote! {
         use crate::model::catalog::{Aiding, AidRecord, GradeInfo, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
+        use crate::model::ImuSignals;
         use crate::nav::nav_point::NavPoint;
-        use nalgebra::Vector3;
 
         /// Number of navigation states with the vertical channel.
         pub const NAV_COUNT: usize = #n_nav;
@@ -411,8 +409,9 @@ pub fn common_module(spec: &Spec) -> String {
         /// Measurement types.
         pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
 
-        /// Value of regressor `id` at one IMU sample (f [m/s²], w [rad/s], dw [rad/s²], FRD body frame).
-        pub fn regressor_value(id: usize, #f_param: &Vector3<f64>, #w_param: &Vector3<f64>, #dw_param: &Vector3<f64>) -> f64 {
+        /// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
+        pub fn regressor_value(id: usize, #s_param: &ImuSignals) -> f64 {
+            #s_bind
             match id {
                 #(#reg_arms)*
                 _ => panic!("regressor index {id} out of range"),
@@ -502,17 +501,30 @@ fn param(name: &str, used: bool) -> syn::Ident {
     }
 }
 
-/// Which IMU signals (`f`, `w`, `dw`) the given regressors read.
-fn signals_used(spec: &Spec, regs: &[usize]) -> (bool, bool, bool) {
-    let mut used = (false, false, false);
+/// The parameter (`s`, or `_s` when unused) and the binding of the IMU signals (`f`, `w`,
+/// `dw`, `df`) the given regressors read: `let ImuSignals { f, w, .. } = s;`.
+fn signals_binding(spec: &Spec, regs: &[usize]) -> (syn::Ident, TokenStream) {
+    let mut used: Vec<&str> = Vec::new();
     for &r in regs {
-        for s in spec.regressors[r].expr.symbols() {
-            used.0 |= s.starts_with("f.");
-            used.1 |= s.starts_with("w.");
-            used.2 |= s.starts_with("dw.");
+        for sym in spec.regressors[r].expr.symbols() {
+            if let Some((base, _)) = sym.split_once('.') {
+                if let Some(name) = crate::expr::IMU_SIGNALS.iter().find(|n| **n == base) {
+                    if !used.contains(name) {
+                        used.push(name);
+                    }
+                }
+            }
         }
     }
-    used
+    if used.is_empty() {
+        return (param("s", false), quote!());
+    }
+    used.sort_by_key(|n| crate::expr::IMU_SIGNALS.iter().position(|x| x == n));
+    let fields = used.iter().map(|n| format_ident!("{}", n));
+    (
+        param("s", true),
+        quote!(let ImuSignals { #(#fields),*, .. } = s;),
+    )
 }
 
 /// One preset module: index constants, the regressor accumulator, `fill_a`, `fill_h_*`, the
@@ -531,8 +543,8 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let tokens = quote! {
         use super::common::NAV_COUNT;
         use crate::model::catalog::StateRef;
+        use crate::model::ImuSignals;
         use crate::nav::nav_point::NavPoint;
-        use nalgebra::Vector3;
         #constants
         #accumulator
         #fill_a
@@ -601,8 +613,7 @@ fn preset_constants(
 /// The step-mean accumulator of the model's regressors (struct and slice form).
 fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
     let regs = layout.regressors(spec);
-    let (uses_f, uses_w, uses_dw) = signals_used(spec, &regs);
-    let (f, w, dw) = (param("f", uses_f), param("w", uses_w), param("dw", uses_dw));
+    let (s_param, s_bind) = signals_binding(spec, &regs);
     let sum = param("sum", !regs.is_empty());
     let reg_add = regs.iter().enumerate().map(|(k, &r)| {
         let ast = &spec.regressors[r].expr.ast;
@@ -626,10 +637,10 @@ fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
         }
 
         impl Regressors {
-            /// Adds one IMU sample: specific force f [m/s²], rate w [rad/s] and angular
-            /// acceleration dw [rad/s²], FRD body frame.
+            /// Adds one IMU sample's signals (FRD body frame).
             #[inline]
-            pub fn add(&mut self, #f: &Vector3<f64>, #w: &Vector3<f64>, #dw: &Vector3<f64>) {
+            pub fn add(&mut self, #s_param: &ImuSignals) {
+                #s_bind
                 #(#reg_add)*
                 self.count += 1;
             }
@@ -654,9 +665,9 @@ fn preset_accumulator(spec: &Spec, layout: &Layout) -> TokenStream {
             }
         }
 
-        /// Adds one IMU sample's regressors to running sums `sum` (NR entries; f [m/s²], w [rad/s],
-        /// dw [rad/s²]).
-        pub fn accumulate_dyn(#sum: &mut [f64], #f: &Vector3<f64>, #w: &Vector3<f64>, #dw: &Vector3<f64>) {
+        /// Adds one IMU sample's regressors to running sums `sum` (NR entries).
+        pub fn accumulate_dyn(#sum: &mut [f64], #s_param: &ImuSignals) {
+            #s_bind
             #sum_array
             #(#reg_add_dyn)*
         }

@@ -95,8 +95,9 @@ pub const AID_POSITION_FIELDS: [&str; 6] = ["lat", "lon", "h", "sigma_n", "sigma
 pub const AID_VELOCITY_FIELDS: [&str; 4] = ["vn", "ve", "vd", "sigma_v"];
 
 /// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s],
-/// `dw.x dw.y dw.z` [rad/s²] (angular acceleration, the rate's change from the previous sample).
-pub const IMU_SIGNALS: [&str; 3] = ["f", "w", "dw"];
+/// `dw.x dw.y dw.z` [rad/s²] (angular acceleration) and `df.x df.y df.z` [m/s³] (the specific
+/// force's rate of change), each derivative the change from the previous sample.
+pub const IMU_SIGNALS: [&str; 4] = ["f", "w", "dw", "df"];
 
 /// Float methods an expression may call.
 pub const METHODS: [&str; 6] = ["sin", "cos", "tan", "abs", "sqrt", "powi"];
@@ -205,13 +206,14 @@ fn literals(e: &syn::Expr, out: &mut Vec<f64>) {
 }
 
 fn dimension(e: &syn::Expr) -> Result<crate::units::Dim, String> {
-    use crate::units::{DIM_ACCEL, DIM_ANG_ACCEL, DIM_ONE, DIM_RATE};
+    use crate::units::{DIM_ACCEL, DIM_ANG_ACCEL, DIM_JERK, DIM_ONE, DIM_RATE};
     match e {
         syn::Expr::Lit(_) => Ok(DIM_ONE),
         syn::Expr::Field(f) => match &*f.base {
             syn::Expr::Path(p) if p.path.is_ident("f") => Ok(DIM_ACCEL),
             syn::Expr::Path(p) if p.path.is_ident("w") => Ok(DIM_RATE),
             syn::Expr::Path(p) if p.path.is_ident("dw") => Ok(DIM_ANG_ACCEL),
+            syn::Expr::Path(p) if p.path.is_ident("df") => Ok(DIM_JERK),
             _ => Err(format!("no dimension for `{}`", f.to_token_stream())),
         },
         syn::Expr::Path(p) => p
@@ -358,7 +360,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                     nav_symbol_list()
                 )),
                 ExprKind::Regressor => Err(format!(
-                    "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2], w.x w.y w.z [rad/s] and dw.x dw.y dw.z [rad/s^2])"
+                    "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2], w.x w.y w.z [rad/s], dw.x dw.y dw.z [rad/s^2] and df.x df.y df.z [m/s^3])"
                 )),
             }
         }
@@ -384,7 +386,7 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
                 )),
                 (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
                 (ExprKind::Regressor, _) => Err(format!(
-                    "unknown signal `{}` (use f.x f.y f.z, w.x w.y w.z or dw.x dw.y dw.z)",
+                    "unknown signal `{}` (use f.x f.y f.z, w.x w.y w.z, dw.x dw.y dw.z or df.x df.y df.z)",
                     f.to_token_stream().to_string().replace(' ', "")
                 )),
                 (ExprKind::Navigation, _) => Err(format!(

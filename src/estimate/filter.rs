@@ -270,8 +270,7 @@ impl FilterRun {
 /// update with its gain. `explain` propagates candidate-term signatures through it.
 pub trait Observer {
     /// One IMU sample as the filter uses it: specific force f [m/s²] and rate w [rad/s], FRD.
-    /// `dw` is the angular acceleration [rad/s²] ([`crate::model::AngularAccel`]).
-    fn sample(&mut self, _f: &Vector3<f64>, _w: &Vector3<f64>, _dw: &Vector3<f64>) {}
+    fn sample(&mut self, _sig: &crate::model::ImuSignals) {}
     /// After the propagation over a step of `dt` [s] ending at `t`: the navigation point and the
     /// model's A (n×n row-major; non-zeros at `pattern`) used for it.
     fn step(&mut self, _t: f64, _dt: f64, _np: &NavPoint, _a: &[f64], _pattern: &[(usize, usize)]) {
@@ -368,8 +367,8 @@ struct Engine<'a> {
     kernel: Kernel,
     a: Vec<f64>,
     acc: crate::model::RegressorAccumulator,
-    /// Angular acceleration from the measured rates (regressors with `dw`).
-    dw: crate::model::AngularAccel,
+    /// Derivatives of the measured signals (regressors with `dw`, `df`).
+    rates: crate::model::SignalRates,
     r_mean: Vec<f64>,
     f_sum: Vector3<f64>,
     /// Σ of the step's body rates [rad/s] (its mean is the point's w_b).
@@ -444,7 +443,7 @@ impl<'a> Engine<'a> {
             kernel,
             a: vec![0.0; n * n],
             acc: model.accumulator(),
-            dw: crate::model::AngularAccel::default(),
+            rates: crate::model::SignalRates::default(),
             r_mean: vec![0.0; model.regressor_ids.len()],
             f_sum: Vector3::zeros(),
             w_sum: Vector3::zeros(),
@@ -471,14 +470,12 @@ impl<'a> Engine<'a> {
     /// One IMU sample: closed-loop sensor corrections, strapdown step, regressor sums.
     fn navigate(&mut self, smp: &crate::io::imu::ImuSample, dt: f64, obs: &mut dyn Observer) {
         let (mut dth, mut dvel) = (smp.dtheta, smp.dv);
-        let dw = self.dw.next(&(dth / dt), dt);
+        let measured = self.rates.next(&(dvel / dt), &(dth / dt), dt);
         if self.cfg.mode == Mode::ClosedLoop {
-            let f_meas = dvel / dt;
-            let w_meas = dth / dt;
             for &(i, t) in &self.terms {
                 if self.correction[i] != 0.0 {
                     let info = &common::TERMS[t];
-                    let r = common::regressor_value(info.regressor, &f_meas, &w_meas, &dw);
+                    let r = common::regressor_value(info.regressor, &measured);
                     match info.sensor {
                         Sensor::Gyro => dth[info.axis] -= self.correction[i] * r * dt,
                         Sensor::Accel => dvel[info.axis] -= self.correction[i] * r * dt,
@@ -492,8 +489,15 @@ impl<'a> Engine<'a> {
         self.nav.state.t = smp.t;
         let inv_dt = 1.0 / dt;
         let (f_c, w_c) = (dvel * inv_dt, dth * inv_dt);
-        self.acc.add(&f_c, &w_c, &dw);
-        obs.sample(&f_c, &w_c, &dw);
+        // the corrected signals, with the measured ones' derivatives (a correction is a step's
+        // constant; its change between samples is negligible beside the signals')
+        let sig = crate::model::ImuSignals {
+            f: f_c,
+            w: w_c,
+            ..measured
+        };
+        self.acc.add(&sig);
+        obs.sample(&sig);
         self.f_sum += f_c;
         self.w_sum += w_c;
         self.in_step += 1;

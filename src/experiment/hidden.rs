@@ -113,22 +113,21 @@ pub fn run_hidden_on(
 }
 
 /// Adds term `term` with value `theta` (SI) to IMU increments: the sensor's output along its
-/// axis gains θ · regressor(f, ω, ω̇) · Δt, the regressor formed from each increment's mean
-/// rates (ω̇ from consecutive increments).
+/// axis gains θ · regressor · Δt, the regressor formed from each increment's mean signals
+/// (their derivatives from consecutive increments).
 /// A GNSS term changes nothing here (the simulator puts it into the aiding).
 pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
     let info = &common::TERMS[term];
     let mut prev = start_t;
-    let mut dw_of = crate::model::AngularAccel::default();
+    let mut rates = crate::model::SignalRates::default();
     for smp in &mut imu.samples {
         let dt = smp.t - prev;
         prev = smp.t;
         if dt <= 0.0 {
             continue;
         }
-        let w = smp.dtheta / dt;
-        let dw = dw_of.next(&w, dt);
-        let r = common::regressor_value(info.regressor, &(smp.dv / dt), &w, &dw);
+        let sig = rates.next(&(smp.dv / dt), &(smp.dtheta / dt), dt);
+        let r = common::regressor_value(info.regressor, &sig);
         match info.sensor {
             Sensor::Accel => smp.dv[info.axis] += theta * r * dt,
             Sensor::Gyro => smp.dtheta[info.axis] += theta * r * dt,

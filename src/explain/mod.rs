@@ -347,13 +347,34 @@ pub fn explain(
         not_separable,
         r,
     } = stage;
+    let excess = baseline_excess(&base_stats);
+    // which findings are causes, judged on the rounds' extended pass; the causes' values then
+    // come from the model they recommend, without the stand-ins (a stand-in beside a cause
+    // takes part of its value)
+    let judged = complete_findings(ctx, &r, excess, None)?;
+    let r = without_stand_ins(ctx, r, &judged, progress)?;
     let (noise_findings, noise_pass) = noise::stage(ctx, &r, &base_stats, progress)?;
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let last_pass = noise_pass.as_ref().unwrap_or(&r.pass);
-    let excess = baseline_excess(&base_stats);
     // the share of the baseline's excess the extended model leaves
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
+    for (f, j) in findings.iter_mut().zip(judged) {
+        if !j.is_cause() {
+            // a stand-in keeps the value it was fitted with; its words say what is left now
+            *f = j;
+            f.stand_in = f
+                .stand_in
+                .as_ref()
+                .and(stand_in_reason(f, misfit_unexplained, ctx.opts));
+            let t = common::TERMS
+                .iter()
+                .position(|x| x.name == f.term)
+                .expect("a finding is a spec term");
+            let info = &common::TERMS[t];
+            f.words = finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+        }
+    }
     findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
@@ -609,6 +630,31 @@ struct Rounds {
     implausible: Vec<Implausible>,
     /// Filter passes made.
     rounds: usize,
+}
+
+/// The rounds with the model that holds only the causes among `findings` (no stand-in, no
+/// unattributed class) and its pass, when that differs from the rounds' model; else as given.
+fn without_stand_ins(
+    ctx: &Context,
+    mut r: Rounds,
+    findings: &[Finding],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Rounds> {
+    if findings.iter().all(Finding::is_cause) {
+        return Ok(r);
+    }
+    let mut text = ctx.baseline.name.clone();
+    for f in findings.iter().filter(|f| f.is_cause()) {
+        text.push('+');
+        text.push_str(&f.term);
+    }
+    let model = Model::parse(&text)?;
+    let cfg = ctx.extended_config(&model, &r.widened)?;
+    let round = r.rounds + 1;
+    r.pass = run_pass(&model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
+    r.model = model;
+    r.rounds = round;
+    Ok(r)
 }
 
 /// Selection on the baseline pass, then rounds of adding the selected terms, re-running the
@@ -871,9 +917,14 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
         // a value within a few prior σ that explains little is a small effect beside larger
         // ones, not a stand-in
         if share < opts.stand_in_share && f.prior_sigmas > 3.0 {
+            // (its prior σ said once: the clause before may have given them)
+            let needs = if f.prior_sigmas > opts.stand_in_prior_sigmas {
+                "and it".to_string()
+            } else {
+                format!("it needs {} prior σ yet", sig3(f.prior_sigmas))
+            };
             why.push(format!(
-                "it needs {} prior σ yet removes only {} % of the baseline's excess misfit{}",
-                sig3(f.prior_sigmas),
+                "{needs} removes only {} % of the baseline's excess misfit{}",
                 sig3(100.0 * share.max(0.0)),
                 unexplained
                     .filter(|l| *l >= 0.01)
@@ -892,15 +943,14 @@ fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f6
     let mut sums = vec![0.0; terms.len()];
     let mut c = 0usize;
     let mut samples = data.imu.samples()?;
-    let mut dw_of = crate::model::AngularAccel::default();
+    let mut rates = crate::model::SignalRates::default();
     while let Some(smp) = samples.next_sample()? {
         let dt = smp.t - prev;
         prev = smp.t;
         if dt > 0.0 {
-            let (f, w) = (smp.dv / dt, smp.dtheta / dt);
-            let dw = dw_of.next(&w, dt);
+            let sig = rates.next(&(smp.dv / dt), &(smp.dtheta / dt), dt);
             for (sum, &t) in sums.iter_mut().zip(terms) {
-                *sum += common::regressor_value(common::TERMS[t].regressor, &f, &w, &dw);
+                *sum += common::regressor_value(common::TERMS[t].regressor, &sig);
             }
             c += 1;
         }

@@ -20,6 +20,10 @@ pub(super) struct Scaled {
     pub(super) splits: Vec<(Split, Vec<InfoScore>)>,
 }
 
+/// Specific-force spread within a filter step [m/s², rms about the step mean] above which the
+/// run counts as vibrating (a car's ride is ~0.5; a sensor at rest shows its noise, < 0.05).
+const MIN_VIBRATION: f64 = 0.1;
+
 /// A prior-scaled information matrix J' and score b'.
 pub(super) type InfoScore = (DMatrix<f64>, Vec<f64>);
 
@@ -224,28 +228,9 @@ fn select(
             pool.retain(|a| !members.iter().any(|m| m.0 == *a));
             continue;
         }
-        // the named member's estimate from each group of the data alone (given the chosen set)
-        let splits = sc
-            .splits
-            .iter()
-            .map(|(split, groups)| {
-                let est = groups
-                    .iter()
-                    .map(|(jh, bh)| {
-                        let (ih, bch) = conditional(jh, bh, &chosen, named);
-                        if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
-                            display(named, bch / ih, ih)
-                        } else {
-                            (f64::NAN, f64::INFINITY)
-                        }
-                    })
-                    .collect();
-                (*split, est)
-            })
-            .collect();
         out.push(Selected {
             idx: named,
-            splits,
+            splits: Vec::new(),
             llr: named_llr,
             p: (stats::chi2_sf(named_llr, 1.0) * pool.len() as f64).min(1.0),
             glr,
@@ -262,6 +247,32 @@ fn select(
         });
         chosen.push(named);
         pool.retain(|a| !members.iter().any(|m| m.0 == *a));
+    }
+    // each named term's estimate from each group of the data alone, the other named terms free
+    // there too (given only those named before it, a term selected first would carry what the
+    // later ones describe, and its groups would disagree)
+    for sel in &mut out {
+        let named = sel.idx;
+        let others: Vec<usize> = chosen.iter().copied().filter(|&c| c != named).collect();
+        let to_display = sd[named] / common::TERMS[cands[named]].display_to_si;
+        sel.splits = sc
+            .splits
+            .iter()
+            .map(|(split, groups)| {
+                let est = groups
+                    .iter()
+                    .map(|(jh, bh)| {
+                        let (ih, bch) = conditional(jh, bh, &others, named);
+                        if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
+                            (bch / ih * to_display, to_display / ih.sqrt())
+                        } else {
+                            (f64::NAN, f64::INFINITY)
+                        }
+                    })
+                    .collect();
+                (*split, est)
+            })
+            .collect();
     }
     (out, implausible)
 }
@@ -280,12 +291,16 @@ pub(super) fn candidate_tests(
     // of the body rate needs a rotation (without one its step means are the gyros' noise,
     // which the signatures would take for excitation)
     let phi = sig.dispersion.max(1.0);
+    // (likewise a regressor of the specific force's rate of change needs a rotation or a
+    // vibration: at rest its step means are the accelerometers' noise)
     let rotated = sig.last_axis > 0;
+    let vibrated = sig.level.iter().any(|l| l.1 > MIN_VIBRATION);
     let testable: Vec<bool> = (0..m)
         .map(|c| {
-            let reads_rate =
-                common::REGRESSORS[super::signatures::reg_id(sig.cands[c])].contains("w.");
-            j[(c, c)] * phi > opts.min_information && (rotated || !reads_rate)
+            let reg = common::REGRESSORS[super::signatures::reg_id(sig.cands[c])];
+            let excited =
+                (rotated || !reg.contains("w.")) && (rotated || vibrated || !reg.contains("df."));
+            j[(c, c)] * phi > opts.min_information && excited
         })
         .collect();
     let p: Vec<f64> = (0..m)

@@ -255,10 +255,10 @@ pub(super) fn sparse_mul_block(
 }
 
 impl Observer for Signatures {
-    fn sample(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, dw: &Vector3<f64>) {
-        self.acc.add(f, w, dw);
-        self.f_sum += f;
-        self.f2_sum += f.norm_squared();
+    fn sample(&mut self, sig: &crate::model::ImuSignals) {
+        self.acc.add(sig);
+        self.f_sum += sig.f;
+        self.f2_sum += sig.f.norm_squared();
         self.count += 1;
     }
 

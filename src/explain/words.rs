@@ -4,45 +4,56 @@ use super::findings::{Explanation, Finding};
 use super::G0;
 use crate::model::catalog::Sensor;
 use crate::model::generated::common;
+use crate::model::ImuSignals;
 use nalgebra::Vector3;
 
 /// Homogeneous degree of a regressor in the IMU signals (1 for f_x, |f_x|; 2 for f_x², f_x f_y,
-/// ω², ω̇; 0 for a constant), found numerically (ω̇ scales as ω² does: a faster motion).
+/// ω², ω̇; 0 for a constant), found numerically (ω̇ scales as ω² does, ḟ as f ω: a faster
+/// motion).
 pub(super) fn regressor_degree(id: usize) -> i32 {
-    let (f, w, dw) = base_signals();
-    let r1 = common::regressor_value(id, &f, &w, &dw);
-    let r2 = common::regressor_value(id, &(f * 2.0), &(w * 2.0), &(dw * 4.0));
+    let s = base_signals();
+    let r1 = common::regressor_value(id, &s);
+    let s2 = ImuSignals {
+        f: s.f * 2.0,
+        w: s.w * 2.0,
+        dw: s.dw * 4.0,
+        df: s.df * 4.0,
+    };
+    let r2 = common::regressor_value(id, &s2);
     if r1 == 0.0 || r2 == 0.0 {
         return 0;
     }
     (r2 / r1).abs().log2().round() as i32
 }
 
-/// A generic point of the IMU signals (f [m/s²], w [rad/s], dw [rad/s²]) for probing regressors.
-fn base_signals() -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
-    (
-        Vector3::new(3.1, -2.3, 1.7),
-        Vector3::new(0.7, -0.4, 0.9),
-        Vector3::new(0.3, 0.8, -0.6),
-    )
+/// A generic point of the IMU signals for probing regressors.
+fn base_signals() -> ImuSignals {
+    ImuSignals {
+        f: Vector3::new(3.1, -2.3, 1.7),
+        w: Vector3::new(0.7, -0.4, 0.9),
+        dw: Vector3::new(0.3, 0.8, -0.6),
+        df: Vector3::new(-1.1, 0.5, 2.2),
+    }
 }
 
-/// Which body signals a regressor depends on (`f.x` … `w.z`, `dw.x` … `dw.z`).
+/// Which body signals a regressor depends on (`f.x` … `w.z`, `dw.x` … `df.z`).
 pub(super) fn regressor_signals(id: usize) -> Vec<&'static str> {
     let names = [
-        "f.x", "f.y", "f.z", "w.x", "w.y", "w.z", "dw.x", "dw.y", "dw.z",
+        "f.x", "f.y", "f.z", "w.x", "w.y", "w.z", "dw.x", "dw.y", "dw.z", "df.x", "df.y", "df.z",
     ];
-    let (base_f, base_w, base_dw) = base_signals();
-    let r0 = common::regressor_value(id, &base_f, &base_w, &base_dw);
-    (0..9)
+    let base = base_signals();
+    let r0 = common::regressor_value(id, &base);
+    (0..12)
         .filter(|&k| {
-            let (mut f, mut w, mut dw) = (base_f, base_w, base_dw);
-            match k {
-                0..=2 => f[k] *= 1.37,
-                3..=5 => w[k - 3] *= 1.37,
-                _ => dw[k - 6] *= 1.37,
-            }
-            (common::regressor_value(id, &f, &w, &dw) - r0).abs() > 1e-12 * r0.abs().max(1.0)
+            let mut s = base;
+            let v = match k / 3 {
+                0 => &mut s.f,
+                1 => &mut s.w,
+                2 => &mut s.dw,
+                _ => &mut s.df,
+            };
+            v[k % 3] *= 1.37;
+            (common::regressor_value(id, &s) - r0).abs() > 1e-12 * r0.abs().max(1.0)
         })
         .map(|k| names[k])
         .collect()
@@ -162,18 +173,34 @@ pub(super) fn finding_words(
         .group
         .trim_start_matches("accel ")
         .trim_start_matches("gyro ");
-    let mut s = format!(
-        "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {} along {axis}",
-        f.term,
-        sig3(f.estimate),
-        sig3(f.sigma),
-        f.unit,
-        sig3(f.regressor_mean),
-        f.regressor_unit,
-        sig3(f.effect),
-        f.effect_unit,
-        if info.sensor == Sensor::Accel { "bias" } else { "drift" },
-    );
+    let bias = if info.sensor == Sensor::Accel {
+        "bias"
+    } else {
+        "drift"
+    };
+    let mut s = if reg.contains("dw.") || reg.contains("df.") {
+        // a regressor of the signals' rates of change averages to nothing over a run: the term
+        // acts while the motion changes, not as a constant
+        format!(
+            "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): it acts while the motion changes (regressor {reg}), not as a constant {bias}",
+            f.term,
+            sig3(f.estimate),
+            sig3(f.sigma),
+            f.unit,
+        )
+    } else {
+        format!(
+            "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {bias} along {axis}",
+            f.term,
+            sig3(f.estimate),
+            sig3(f.sigma),
+            f.unit,
+            sig3(f.regressor_mean),
+            f.regressor_unit,
+            sig3(f.effect),
+            f.effect_unit,
+        )
+    };
     if !f.equivalent.is_empty() {
         let others: Vec<String> = f
             .equivalent_estimates

@@ -45,6 +45,12 @@ pub fn angular_accel_rps2(dw: [f64; 3]) -> Option<String> {
         .then(|| format!("angular acceleration {dw:?} beyond ±1e5 rad/s²"))
 }
 
+/// `None` when every component of a specific force's rate of change is within ±1e6 m/s³.
+pub fn jerk_mps3(df: [f64; 3]) -> Option<String> {
+    (!df.iter().all(|x| x.abs() <= 1e6))
+        .then(|| format!("rate of change of the specific force {df:?} beyond ±1e6 m/s³"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

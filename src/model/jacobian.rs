@@ -28,6 +28,10 @@ pub struct PointSpec {
     /// Angular acceleration, FRD body [rad/s²] (regressors with `dw`; zero when absent).
     #[serde(default)]
     pub dw_b: [f64; 3],
+    /// Rate of change of the specific force, FRD body [m/s³] (regressors with `df`; zero when
+    /// absent).
+    #[serde(default)]
+    pub df_b: [f64; 3],
 }
 
 /// The JSON printed by `sinsmodel jacobian`.
@@ -89,7 +93,8 @@ impl PointSpec {
             .chain(self.euler_deg)
             .chain(self.f_b)
             .chain(self.w_b)
-            .chain(self.dw_b);
+            .chain(self.dw_b)
+            .chain(self.df_b);
         if all.into_iter().any(|v| !v.is_finite()) {
             bail!("point has a non-finite number");
         }
@@ -104,6 +109,7 @@ impl PointSpec {
             bounds::specific_force_mps2(self.f_b).map(|p| format!("f_b: {p}")),
             bounds::angular_rate_rps(self.w_b).map(|p| format!("w_b: {p}")),
             bounds::angular_accel_rps2(self.dw_b).map(|p| format!("dw_b: {p}")),
+            bounds::jerk_mps3(self.df_b).map(|p| format!("df_b: {p}")),
         ];
         if let Some(p) = problems.into_iter().flatten().next() {
             bail!("point: {p}");
@@ -138,16 +144,17 @@ impl PointSpec {
     }
 }
 
-/// A and H of `model` at `point`, regressors evaluated at the single sample (f_b, w_b, dw_b).
+/// A and H of `model` at `point`, regressors evaluated at the single sample (f_b, w_b, dw_b, df_b).
 pub fn jacobian(model: &Model, point: &PointSpec, runtime: bool) -> Result<JacobianOut> {
     point.validate()?;
     let nav = point.nav_point();
     let mut acc = model.accumulator();
-    acc.add(
-        &Vector3::from(point.f_b),
-        &Vector3::from(point.w_b),
-        &Vector3::from(point.dw_b),
-    );
+    acc.add(&crate::model::ImuSignals {
+        f: Vector3::from(point.f_b),
+        w: Vector3::from(point.w_b),
+        dw: Vector3::from(point.dw_b),
+        df: Vector3::from(point.df_b),
+    });
     let r = acc.mean();
     let n = model.n();
     let mut a = vec![0.0; n * n];

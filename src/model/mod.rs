@@ -407,27 +407,59 @@ pub struct RegressorAccumulator {
     generated: Option<AccumulateFn>,
 }
 
-/// A generated regressor accumulator: adds one sample (f [m/s²], w [rad/s], dw [rad/s²]) to
-/// running sums.
-pub type AccumulateFn = fn(&mut [f64], &Vector3<f64>, &Vector3<f64>, &Vector3<f64>);
+/// A generated regressor accumulator: adds one sample's signals to running sums.
+pub type AccumulateFn = fn(&mut [f64], &ImuSignals);
 
-/// The body's angular acceleration dw [rad/s²] from consecutive IMU rates: the change of a
-/// sample's mean rate from the previous sample's, over the time between their midpoints (zero
-/// for the first sample). Summed over a filter step it telescopes to the step's rate change.
-#[derive(Debug, Clone, Default)]
-pub struct AngularAccel {
-    prev: Option<(Vector3<f64>, f64)>,
+/// The body-frame (FRD) signals of one IMU sample that regressors read.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ImuSignals {
+    /// Specific force f [m/s²] (the sample's mean).
+    pub f: Vector3<f64>,
+    /// Angular rate w [rad/s] (the sample's mean).
+    pub w: Vector3<f64>,
+    /// Angular acceleration dw [rad/s²] ([`SignalRates`]).
+    pub dw: Vector3<f64>,
+    /// Rate of change of the specific force df [m/s³] ([`SignalRates`]).
+    pub df: Vector3<f64>,
 }
 
-impl AngularAccel {
-    /// dw at a sample of mean rate `w` [rad/s] spanning `dt` [s].
-    pub fn next(&mut self, w: &Vector3<f64>, dt: f64) -> Vector3<f64> {
-        let out = match self.prev {
-            Some((wp, dtp)) if dt + dtp > 0.0 => (w - wp) / (0.5 * (dt + dtp)),
-            _ => Vector3::zeros(),
+impl ImuSignals {
+    /// A sample's f [m/s²] and w [rad/s] with zero derivatives.
+    pub fn new(f: Vector3<f64>, w: Vector3<f64>) -> ImuSignals {
+        ImuSignals {
+            f,
+            w,
+            ..Default::default()
+        }
+    }
+}
+
+/// The derivatives of the IMU signals from consecutive samples: each sample's mean rate and
+/// specific force minus the previous sample's, over the time between their midpoints (zero for
+/// the first sample). Summed over a filter step they telescope to the step's change.
+#[derive(Debug, Clone, Default)]
+pub struct SignalRates {
+    prev: Option<(Vector3<f64>, Vector3<f64>, f64)>,
+}
+
+impl SignalRates {
+    /// The signals of a sample of mean specific force `f` [m/s²] and rate `w` [rad/s] spanning
+    /// `dt` [s], with dw and df from the previous sample.
+    pub fn next(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, dt: f64) -> ImuSignals {
+        let (dw, df) = match self.prev {
+            Some((fp, wp, dtp)) if dt + dtp > 0.0 => {
+                let k = 1.0 / (0.5 * (dt + dtp));
+                ((w - wp) * k, (f - fp) * k)
+            }
+            _ => (Vector3::zeros(), Vector3::zeros()),
         };
-        self.prev = Some((*w, dt));
-        out
+        self.prev = Some((*f, *w, dt));
+        ImuSignals {
+            f: *f,
+            w: *w,
+            dw,
+            df,
+        }
     }
 }
 
@@ -442,14 +474,13 @@ impl RegressorAccumulator {
         }
     }
 
-    /// Adds one sample: specific force f [m/s²], rate w [rad/s] and angular acceleration dw
-    /// [rad/s²], FRD body frame.
-    pub fn add(&mut self, f: &Vector3<f64>, w: &Vector3<f64>, dw: &Vector3<f64>) {
+    /// Adds one sample's signals (FRD body frame).
+    pub fn add(&mut self, sig: &ImuSignals) {
         match self.generated {
-            Some(acc) => acc(&mut self.sum, f, w, dw),
+            Some(acc) => acc(&mut self.sum, sig),
             None => {
                 for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
-                    *s += common::regressor_value(id, f, w, dw);
+                    *s += common::regressor_value(id, sig);
                 }
             }
         }

@@ -57,7 +57,7 @@ fn body_signals(
     (ct * f_n, ct * (e.w_ie + w_en) + k.w_nb, rate)
 }
 
-/// Half-step [s] of the central difference that gives the true angular acceleration.
+/// Half-step [s] of the central difference that gives the true signal derivatives.
 const DW_STEP: f64 = 1e-5;
 
 /// How far before a fix the kinematics that move it through the GNSS terms' H are taken [s]:
@@ -126,10 +126,11 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
             value,
         })
         .collect();
-    // the true angular acceleration is formed only when an injected regressor reads it
-    let needs_dw = injected
-        .iter()
-        .any(|inj| common::REGRESSORS[inj.regressor].contains("dw."));
+    // the true derivatives are formed only when an injected regressor reads them
+    let needs_rates = injected.iter().any(|inj| {
+        let r = common::REGRESSORS[inj.regressor];
+        r.contains("dw.") || r.contains("df.")
+    });
     let mut rng = Rng::new(sc.seed);
     // GNSS velocity noise on a stream of its own: adding velocities changes no other draw
     let mut rng_v = Rng::new(sc.seed ^ 0xbb67_ae85_84ca_a73b);
@@ -194,17 +195,17 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                 let tn = a + 0.5 * hsub * (x + 1.0);
                 let k = traj.at(tn);
                 let (f, mut om, rate) = body_signals(&e, &k);
-                let dw = if needs_dw {
-                    // d(ω_ib^b)/dt of the analytic motion, by a central difference
-                    let (_, om_p, _) = body_signals(&e, &traj.at(tn + DW_STEP));
-                    let (_, om_m, _) = body_signals(&e, &traj.at(tn - DW_STEP));
-                    (om_p - om_m) / (2.0 * DW_STEP)
-                } else {
-                    Vector3::zeros()
-                };
+                let mut sig = crate::model::ImuSignals::new(f, om);
+                if needs_rates {
+                    // d(ω_ib^b)/dt and d(f^b)/dt of the analytic motion, by a central difference
+                    let (f_p, om_p, _) = body_signals(&e, &traj.at(tn + DW_STEP));
+                    let (f_m, om_m, _) = body_signals(&e, &traj.at(tn - DW_STEP));
+                    sig.dw = (om_p - om_m) / (2.0 * DW_STEP);
+                    sig.df = (f_p - f_m) / (2.0 * DW_STEP);
+                }
                 let mut fm = f;
                 for inj in &injected {
-                    let r = common::regressor_value(inj.regressor, &f, &om, &dw);
+                    let r = common::regressor_value(inj.regressor, &sig);
                     match inj.sensor {
                         Sensor::Gyro => om[inj.axis] += inj.value * r,
                         Sensor::Accel => fm[inj.axis] += inj.value * r,

@@ -93,6 +93,8 @@ pub const DIM_ACCEL: Dim = Dim([2, -4, 0]);
 pub const DIM_RATE: Dim = Dim([0, -2, 2]);
 /// Dimension of an angular acceleration, rad/s².
 pub const DIM_ANG_ACCEL: Dim = Dim([0, -4, 2]);
+/// Dimension of a specific force's rate of change, m/s³.
+pub const DIM_JERK: Dim = Dim([2, -6, 0]);
 /// Dimensionless.
 pub const DIM_ONE: Dim = ONE;
 
