@@ -244,6 +244,13 @@ fn finds_a_gyro_accelerometer_asynchrony_on_a_turntable() {
     check_found(CaseKind::One("accel_delay"), 1);
 }
 
+/// Both on one turntable (an off-axis lever arm and the asynchrony, beside the baseline's
+/// biases and scale factors): all four named with their values, nothing else.
+#[test]
+fn finds_an_inner_lever_arm_and_an_asynchrony_together() {
+    check_found(CaseKind::One("inner_lever_delay"), 1);
+}
+
 /// The asynchrony withheld from the candidates: whatever explain fits instead is labelled a
 /// stand-in (measured over seeds 1–10: 10 of 10).
 #[test]

@@ -462,6 +462,12 @@ fn round_up_1(v: f64) -> f64 {
     (v / p).ceil() * p
 }
 
+/// Prior σ beyond which a finding that removes little of the misfit is read as a stand-in (a
+/// value within a few prior σ that explains little is a small effect beside larger ones: an
+/// off-axis lever arm of 36 mm, 3.6 of the spec's 10 mm, beside a gyro–accelerometer
+/// asynchrony that explains most).
+const SMALL_SHARE_PRIOR_SIGMAS: f64 = 5.0;
+
 /// Prior σ beyond which a baseline term's estimate says its prior is too tight.
 const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
 
@@ -901,7 +907,8 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 }
 
 /// Why finding `f` probably stands in for something the candidates do not describe, if it
-/// does: it needs more than `stand_in_prior_sigmas` of its prior, or, beyond 3 prior σ, its
+/// does: it needs more than `stand_in_prior_sigmas` of its prior, or, beyond
+/// [`SMALL_SHARE_PRIOR_SIGMAS`] prior σ, its
 /// round removed less than `stand_in_share` of the baseline's excess misfit (`unexplained`, the
 /// share the extended model leaves, is said with it).
 fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
@@ -916,7 +923,7 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
     if let Some(share) = f.misfit_share {
         // a value within a few prior σ that explains little is a small effect beside larger
         // ones, not a stand-in
-        if share < opts.stand_in_share && f.prior_sigmas > 3.0 {
+        if share < opts.stand_in_share && f.prior_sigmas > SMALL_SHARE_PRIOR_SIGMAS {
             // (its prior σ said once: the clause before may have given them)
             let needs = if f.prior_sigmas > opts.stand_in_prior_sigmas {
                 "and it".to_string()

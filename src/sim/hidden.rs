@@ -19,8 +19,9 @@ pub const GNSS_GROUPS: [&str; 3] = ["gnss_time", "gnss_time_kgf", "gnss_lever"];
 /// accelerometer's off-axis inner lever arm (`size_i_j`, 20–60 mm times `effect`), seen in
 /// the tangential kicks as a rotation starts and stops and in the centripetal terms.
 /// And a gyro–accelerometer asynchrony: all three accelerometers' delay behind the gyros
-/// (`tau_x tau_y tau_z`, one value of 1–3 ms times `effect`).
-pub const TURNTABLE_GROUPS: [&str; 2] = ["inner_lever", "accel_delay"];
+/// (`tau_x tau_y tau_z`, one value of 1–3 ms times `effect`); and both together
+/// (`inner_lever_delay`: what a real unit's calibration sequence holds).
+pub const TURNTABLE_GROUPS: [&str; 3] = ["inner_lever", "accel_delay", "inner_lever_delay"];
 
 /// A system-level calibration sequence: 60 s at rest, then 18 rotations of ±90° in 5 s
 /// (about 20 deg/s) about x, y and z — four about each axis, then x, y, z, −z, −y, −x — with
@@ -390,25 +391,27 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
                     // 0.1–2 m
                     hidden.push((name.into(), sgn * effect * (0.1 + 1.9 * rng.uniform())));
                 }
-                "inner_lever" => {
+                "inner_lever" | "accel_delay" | "inner_lever_delay" => {
                     segments = turntable_segments();
-                    let name = *pick(
-                        &mut rng,
-                        &[
-                            "size_x_y", "size_x_z", "size_y_x", "size_y_z", "size_z_x", "size_z_y",
-                        ],
-                    );
-                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                    // 20–60 mm
-                    hidden.push((name.into(), sgn * effect * (0.02 + 0.04 * rng.uniform())));
-                }
-                "accel_delay" => {
-                    segments = turntable_segments();
-                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                    // 1–3 ms, the same for the three accelerometers
-                    let tau = sgn * effect * (1e-3 + 2e-3 * rng.uniform());
-                    for a in ["x", "y", "z"] {
-                        hidden.push((format!("tau_{a}"), tau));
+                    if g != "accel_delay" {
+                        let name = *pick(
+                            &mut rng,
+                            &[
+                                "size_x_y", "size_x_z", "size_y_x", "size_y_z", "size_z_x",
+                                "size_z_y",
+                            ],
+                        );
+                        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                        // 20–60 mm
+                        hidden.push((name.into(), sgn * effect * (0.02 + 0.04 * rng.uniform())));
+                    }
+                    if g != "inner_lever" {
+                        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                        // 1–3 ms, the same for the three accelerometers
+                        let tau = sgn * effect * (1e-3 + 2e-3 * rng.uniform());
+                        for a in ["x", "y", "z"] {
+                            hidden.push((format!("tau_{a}"), tau));
+                        }
                     }
                 }
                 other => panic!("unknown group {other}"),
@@ -417,7 +420,7 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
             let size = match info.map(|t| t.sensor) {
                 Some(crate::model::catalog::Sensor::Gyro) => format!("{effect} deg/h"),
                 // a GNSS term or a lever arm: its value
-                Some(_) if g == "inner_lever" || g == "accel_delay" => {
+                Some(_) if TURNTABLE_GROUPS.contains(&g) => {
                     let t = info.expect("matched");
                     format!("{:.1} {}", hidden[0].1 / t.display_to_si, t.display)
                 }
