@@ -1049,14 +1049,15 @@ mod tests {
         assert!(stand_in_reason(&finding(3.0, None), None, &o).is_none());
         let far = stand_in_reason(&finding(91.0, Some(0.9)), Some(0.05), &o).unwrap();
         assert!(far.contains("91.0 prior σ"), "{far}");
-        let little = stand_in_reason(&finding(5.0, Some(0.08)), Some(0.9), &o).unwrap();
+        let little = stand_in_reason(&finding(6.0, Some(0.08)), Some(0.9), &o).unwrap();
         assert!(
             little.contains("8.00 %") && little.contains("leaves 90.0 %"),
             "{little}"
         );
-        // explaining little counts beyond 3 prior σ (within them: a small effect beside larger
-        // ones), whatever is left
-        assert!(stand_in_reason(&finding(5.0, Some(0.08)), Some(0.0), &o).is_some());
+        // explaining little counts beyond 5 prior σ (within them: a small effect beside larger
+        // ones, e.g. a 3.6 σ lever arm beside an asynchrony), whatever is left
+        assert!(stand_in_reason(&finding(6.0, Some(0.08)), Some(0.0), &o).is_some());
+        assert!(stand_in_reason(&finding(3.6, Some(0.08)), Some(0.0), &o).is_none());
         assert!(stand_in_reason(&finding(0.6, Some(0.06)), Some(0.53), &o).is_none());
         assert!(stand_in_reason(&finding(5.0, Some(0.5)), Some(0.0), &o).is_none());
     }
