@@ -301,6 +301,26 @@ fn explain_refuses_bad_input_with_the_reason() {
     std::fs::remove_dir_all(&foreign).unwrap();
 }
 
+/// A prior beyond a term's physical limit (the spec's `limit`) is refused as a unit slip, before
+/// any pass runs.
+#[test]
+fn a_prior_beyond_the_spec_limit_is_a_unit_slip() {
+    let out = tmp("limit");
+    for (prior, want) in [
+        ("tau_x=5 s", "5000 ms is beyond the 100 ms"),
+        ("size_*=40 m", "40000 mm is beyond the 1000 mm"),
+    ] {
+        let mut args = rlg_static_explain(&out);
+        args.extend(["--prior".to_string(), prior.to_string()]);
+        let (ok, _, stderr) = sinsmodel(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(
+            !ok && stderr.contains(want) && stderr.contains("--prior"),
+            "{stderr}"
+        );
+    }
+    assert!(!out.exists(), "nothing written");
+}
+
 /// Candidates the baseline already has are skipped with a note; "not testable" is listed.
 #[test]
 fn candidates_in_the_baseline_are_skipped_and_untestable_ones_listed() {

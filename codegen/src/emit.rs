@@ -193,7 +193,12 @@ pub fn common_module(spec: &Spec) -> String {
         let to_si = f64_lit(t.display_to_si);
         let sigma = f64_lit(t.sigma);
         let noise = f64_lit(t.noise);
-        quote!(TermInfo { name: #name, sensor: #sensor, axis: #axis, regressor: #reg, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, noise: #noise, group: #group, doc: #doc, library: #library })
+        let limit = if t.limit.is_finite() {
+            f64_lit(t.limit)
+        } else {
+            quote!(f64::INFINITY)
+        };
+        quote!(TermInfo { name: #name, sensor: #sensor, axis: #axis, regressor: #reg, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, noise: #noise, limit: #limit, group: #group, doc: #doc, library: #library })
     });
     let n_reg = spec.regressors.len();
     let reg_sources = spec.regressors.iter().map(|r| r.expr.source.clone());

@@ -135,6 +135,9 @@ pub struct Term {
     pub sigma: f64,
     /// Random-walk density of the state, SI per √s (0 = random constant).
     pub noise: f64,
+    /// Largest physically plausible |value|, SI (`limit` in terms.toml; ∞ when not given): a
+    /// prior or an injected value beyond it is refused as a unit mistake.
+    pub limit: f64,
     /// Group label for listings.
     pub group: String,
     /// One-line description.
@@ -324,6 +327,8 @@ struct RawTerm {
     sigma: Spanned<String>,
     #[serde(default)]
     noise: Option<Spanned<String>>,
+    #[serde(default)]
+    limit: Option<Spanned<String>>,
     group: String,
     doc: String,
     #[serde(default)]
@@ -829,6 +834,20 @@ fn load_terms(
             )?,
             None => 0.0,
         };
+        let limit = match &t.limit {
+            Some(l) => {
+                let v = quantity(src, l, t.unit.get_ref(), &item, "limit")?;
+                if v.partial_cmp(&sigma) != Some(std::cmp::Ordering::Greater) {
+                    return Err(src.error(
+                        l.span(),
+                        &item,
+                        "limit must be larger than sigma (it bounds what is physically plausible)",
+                    ));
+                }
+                v
+            }
+            None => f64::INFINITY,
+        };
         terms.push(Term {
             name: t.name.get_ref().clone(),
             sensor,
@@ -839,6 +858,7 @@ fn load_terms(
             display_to_si: display.to_si / unit.to_si,
             sigma,
             noise,
+            limit,
             group: t.group.clone(),
             doc: t.doc.clone(),
             library: t.library,

@@ -115,6 +115,18 @@ fn syntax_error_in_an_expression() {
 }
 
 #[test]
+fn a_limit_below_the_prior() {
+    expect_error(
+        "terms.toml",
+        "limit = \"100 ms\"",
+        "limit = \"0.1 ms\"",
+        "limit = \"0.1 ms\"",
+        "term `tau_x`",
+        "limit must be larger than sigma",
+    );
+}
+
+#[test]
 fn duplicate_term_name() {
     expect_error(
         "terms.toml",

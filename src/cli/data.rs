@@ -526,6 +526,9 @@ impl DataArgs {
                     if !(si.is_finite() && si > 0.0) {
                         bail!("--prior `{spec}`: a prior σ must be positive and finite");
                     }
+                    if let Some(why) = info.beyond_limit(si) {
+                        bail!("--prior `{spec}`: {}: {why}", info.name);
+                    }
                     out.retain(|x| x.0 != t);
                     out.push((t, si));
                 }
@@ -1100,6 +1103,12 @@ impl DataArgs {
                     .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
                 if !(si.is_finite() && si > 0.0) {
                     bail!("--prior `{spec}`: a prior σ must be positive and finite");
+                }
+                if let sinsmodel::model::catalog::StateRef::Term(t) = model.states[i] {
+                    let info = &sinsmodel::model::generated::common::TERMS[t];
+                    if let Some(why) = info.beyond_limit(si) {
+                        bail!("--prior `{spec}`: {}: {why}", info.name);
+                    }
                 }
                 cfg.prior_sigma[i] = si;
             }

@@ -461,7 +461,17 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             out.push(format!("Found: {}.", f.words));
         }
     }
-    if !e.findings.is_empty() {
+    // every finding a term that is no cause (no noise level either): nothing is added
+    if !e.findings.is_empty()
+        && e.findings
+            .iter()
+            .all(|f| f.kind != "noise" && !f.is_cause())
+    {
+        out.push(format!(
+            "No term is added: every term fitted is a stand-in or not attributed, so the model stays {}.",
+            e.baseline_model
+        ));
+    } else if !e.findings.is_empty() {
         let mut s = format!(
             "Extended model {}: mean NIS {} → {}, log-likelihood {:+.1}",
             e.extended_model,
@@ -471,10 +481,14 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
         );
         if let (Some(b), Some(a)) = (e.gain.model_error_rms_before, e.gain.model_error_rms_after) {
             s.push_str(&format!(
-                "; model error (truth) {} → {} arcsec RMS ({}× smaller)",
+                "; model error (truth) {} → {} arcsec RMS ({})",
                 sig3(b),
                 sig3(a),
-                sig3(b / a)
+                if a <= b {
+                    format!("{}× smaller", sig3(b / a))
+                } else {
+                    format!("{}× larger", sig3(a / b))
+                }
             ));
         }
         s.push('.');

@@ -67,12 +67,33 @@ pub struct TermInfo {
     pub sigma: f64,
     /// Random-walk density of the state [SI/√s]; 0 for a random constant.
     pub noise: f64,
+    /// Largest physically plausible |value|, SI (∞ when the spec gives none): a prior or an
+    /// injected value beyond it is refused as a unit mistake.
+    pub limit: f64,
     /// Group label.
     pub group: &'static str,
     /// One-line description.
     pub doc: &'static str,
     /// Candidate library term (DESIGN §7).
     pub library: bool,
+}
+
+impl TermInfo {
+    /// Why `value` [SI] (a prior σ or an injected value) is no physically plausible value of
+    /// this term, if it is not: beyond the spec's `limit` (a unit slip, s for ms or m for mm).
+    pub fn beyond_limit(&self, value: f64) -> Option<String> {
+        (value.abs() > self.limit).then(|| {
+            let k = 1.0 / self.display_to_si;
+            format!(
+                "{} {} is beyond the {} {} the term can physically have (its `limit` in model-spec/terms.toml): a larger unit written where {} was meant?",
+                crate::explain::sig3(value * k),
+                self.display,
+                crate::explain::sig3(self.limit * k),
+                self.display,
+                self.display
+            )
+        })
+    }
 }
 
 /// A sensor grade as declared in `model-spec/grades.toml`: white noise and the prior of every

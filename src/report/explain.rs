@@ -52,6 +52,9 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
             .iter()
             .map(|(c, b)| json!({"term": c, "like": b}))
             .collect::<Vec<_>>(),
+        "baseline_priors_tight": e.baseline_priors_tight,
+        "baseline_priors_widened": e.baseline_priors_widened,
+        "baseline_priors_gain": e.baseline_priors_gain,
         "alpha": e.alpha,
         "rounds": e.rounds,
         "summary": e.summary,

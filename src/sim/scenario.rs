@@ -47,29 +47,63 @@ pub struct Segment {
     pub axis: Option<String>,
     /// Angle of a `rotate` segment [deg], positive right-handed about `axis`.
     #[serde(default)]
-    pub angle_deg: f64,
+    pub angle_deg: Option<f64>,
 }
 
-/// Checks a `rotate` segment: a body axis, a finite angle within ±3600°, and a rate within
-/// ±1e4 °/s.
-fn check_rotate(s: &Segment, where_: &str) -> Result<()> {
+/// Checks a `rotate` segment: a body axis, a finite non-zero angle within ±3600°, a rate
+/// within ±1e4 °/s, no `accel_mps2` or `yaw_rate_deg_s`, and at least [`MIN_ROTATE_SAMPLES`]
+/// IMU periods (its rate ramps are integrated sample by sample). An angle that is π/4, π/2, π,
+/// 3π/2 or 2π is pushed to `warnings` (radians written as degrees?).
+fn check_rotate(
+    s: &Segment,
+    where_: &str,
+    imu_rate_hz: f64,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
     match s.axis.as_deref() {
         Some("x" | "y" | "z") => {}
         Some(a) => bail!("{where_}: axis = \"{a}\" must be a body axis: x, y or z"),
         None => bail!("{where_}: a rotate segment needs `axis` (x, y or z) and `angle_deg`"),
     }
-    if !(s.angle_deg.is_finite() && s.angle_deg.abs() <= 3600.0) {
+    let Some(angle) = s.angle_deg else {
         bail!(
-            "{where_}: angle_deg = {} must be within ±3600 deg",
-            s.angle_deg
+            "{where_}: a rotate segment needs `angle_deg` (degrees, right-handed about its axis)"
+        );
+    };
+    if !(angle.is_finite() && angle.abs() <= 3600.0) {
+        bail!("{where_}: angle_deg = {angle} must be within ±3600 deg");
+    }
+    if angle == 0.0 {
+        bail!("{where_}: angle_deg = 0: a rotation of nothing (use a `rest` segment)");
+    }
+    if s.accel_mps2 != 0.0 || s.yaw_rate_deg_s != 0.0 {
+        bail!("{where_}: `accel_mps2` and `yaw_rate_deg_s` do not apply to a rotate segment (its rate follows from angle_deg and duration_s)");
+    }
+    let min = MIN_ROTATE_SAMPLES / imu_rate_hz;
+    if s.duration_s < min {
+        bail!(
+            "{where_}: duration_s = {} is under {MIN_ROTATE_SAMPLES} IMU periods ({min} s at {imu_rate_hz} Hz): its rate ramps would not be resolved (ms read as s?)",
+            s.duration_s
         );
     }
-    let rate = s.angle_deg / (s.duration_s - rotate_ramp(s.duration_s));
+    let rate = angle / (s.duration_s - rotate_ramp(s.duration_s));
     if rate.abs() > 1e4 {
-        bail!("{where_}: angle_deg / duration_s needs a rate of {rate:.0} deg/s, beyond ±1e4 deg/s (rad given as deg? or ms as s?)");
+        bail!("{where_}: angle_deg / duration_s needs a peak rate of {rate:.0} deg/s (after the rate ramps), beyond ±1e4 deg/s (rad given as deg? or ms as s?)");
+    }
+    let pi = std::f64::consts::PI;
+    if [0.25, 0.5, 1.0, 1.5, 2.0]
+        .iter()
+        .any(|k| (angle.abs() - k * pi).abs() < 1e-3)
+    {
+        warnings.push(format!(
+            "{where_}: angle_deg = {angle} is a multiple of π/4 in radians: radians written as degrees? (a rotation of {angle}°)"
+        ));
     }
     Ok(())
 }
+
+/// Fewest IMU periods a `rotate` segment may last.
+pub const MIN_ROTATE_SAMPLES: f64 = 20.0;
 
 /// The rate ramp [s] of a `rotate` segment lasting `duration_s`.
 pub fn rotate_ramp(duration_s: f64) -> f64 {
@@ -373,7 +407,7 @@ impl Scenario {
                     s.yaw_rate_deg_s
                 );
             }
-            if s.kind != "rotate" && (s.axis.is_some() || s.angle_deg != 0.0) {
+            if s.kind != "rotate" && (s.axis.is_some() || s.angle_deg.is_some()) {
                 bail!("{where_}: `axis` and `angle_deg` belong to `rotate` segments");
             }
             match s.kind.as_str() {
@@ -382,7 +416,7 @@ impl Scenario {
                 }
                 "rest" | "cruise" | "turn" => {}
                 "accelerate" => speed += s.accel_mps2 * s.duration_s,
-                "rotate" => check_rotate(s, &where_)?,
+                "rotate" => check_rotate(s, &where_, imu_rate_hz, &mut warnings)?,
                 other => bail!(
                     "{where_}: unknown kind `{other}` (rest, cruise, accelerate, turn, rotate)"
                 ),
@@ -548,6 +582,9 @@ impl Scenario {
             })?;
             if !si.is_finite() {
                 bail!("{at_e}: [errors] {name} = {value} is not finite in SI units");
+            }
+            if let Some(why) = common::TERMS[k].beyond_limit(si) {
+                bail!("{at_e}: [errors] {name} = {value}: {why}");
             }
             errors.push((k, si));
         }

@@ -292,7 +292,7 @@ impl Trajectory {
                         Some("z") => 2,
                         _ => 0,
                     };
-                    (axis, s.angle_deg * d, s.duration_s)
+                    (axis, s.angle_deg.unwrap_or(0.0) * d, s.duration_s)
                 });
                 if let Some((axis, angle, _)) = rot {
                     c *= axis_rotation(axis, angle);
@@ -482,13 +482,45 @@ mod tests {
             ("[[segment]]\nkind = \"rotate\"\nangle_deg = 90.0\nduration_s = 9.0\n", "needs `axis`"),
             ("[[segment]]\nkind = \"rotate\"\naxis = \"roll\"\nangle_deg = 90.0\nduration_s = 9.0\n", "body axis"),
             ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 9e5\nduration_s = 9.0\n", "±3600"),
-            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 3000.0\nduration_s = 0.01\n", "rate"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 3000.0\nduration_s = 0.2\n", "peak rate"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 1.0\nduration_s = 0.001\n", "IMU periods"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nduration_s = 9.0\n", "needs `angle_deg`"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 0.0\nduration_s = 9.0\n", "rotation of nothing"),
+            ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 90.0\nduration_s = 9.0\nyaw_rate_deg_s = 5.0\n", "do not apply"),
+            ("[[segment]]\nkind = \"rest\"\nangle_deg = 0.0\nduration_s = 9.0\n", "belong to `rotate`"),
             ("[[segment]]\nkind = \"rest\"\naxis = \"x\"\nduration_s = 9.0\n", "belong to `rotate`"),
             ("[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 90.0\nduration_s = 9.0\n[[segment]]\nkind = \"cruise\"\nduration_s = 9.0\n", "turntable"),
         ];
         for (seg, want) in bad {
             let e = Scenario::parse(&format!("{base}{seg}"), "sc.toml").unwrap_err();
             assert!(format!("{e:#}").contains(want), "{seg}: {e:#}");
+        }
+        // π/2 written as degrees: run, with a warning
+        let sc = Scenario::parse(
+            &format!("{base}[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 1.5708\nduration_s = 9.0\n"),
+            "sc.toml",
+        )
+        .unwrap();
+        assert!(
+            sc.warnings.iter().any(|w| w.contains("radians")),
+            "{:?}",
+            sc.warnings
+        );
+    }
+
+    #[test]
+    fn injected_values_beyond_the_spec_limit_are_refused() {
+        let base = "name = \"t\"\nseed = 1\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = 116.0\nh_m = 50.0\neuler_deg = [0.0, 0.0, 0.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 9.0\n[errors]\n";
+        for (line, want) in [
+            ("tau_x = \"2 s\"\n", "2000 ms is beyond the 100 ms"),
+            ("size_x_y = \"40 m\"\n", "40000 mm is beyond the 1000 mm"),
+        ] {
+            let e = Scenario::parse(&format!("{base}{line}"), "sc.toml").unwrap_err();
+            let e = format!("{e:#}");
+            assert!(e.contains(want) && e.contains("sc.toml:"), "{line}: {e}");
+        }
+        for line in ["tau_x = \"2 ms\"\n", "size_x_y = \"40 mm\"\n"] {
+            Scenario::parse(&format!("{base}{line}"), "sc.toml").unwrap();
         }
     }
 }
