@@ -160,6 +160,12 @@ INNER_LEVER = {f"size_{i}" + ("" if i == j else f"_{j}"): ("xyz".index(i), "xyz"
 # f(s) = f_b + s df_b (df_b its body-frame rate of change). name -> accelerometer axis i
 ACCEL_DELAY = {f"tau_{i}": "xyz".index(i) for i in "xyz"}
 
+# the accelerometer terms derived from this file's physics: name -> (axis, kind, what it is)
+ACCEL_PHYSICS = {
+    **{n: (i, ("inner_lever", j), "an inner lever arm") for n, (i, j) in INNER_LEVER.items()},
+    **{n: (i, ("delay",), "the delay") for n, i in ACCEL_DELAY.items()},
+}
+
 
 # GNSS measurement terms, written independently of the spec: what each one does to the fix.
 # ("time_offset",): the fix stamped t is the trajectory at t + theta [s];
@@ -193,19 +199,14 @@ def load_spec_terms(spec_dir=SPEC_DIR):
             continue
         if t["sensor"] not in ("gyro", "accel") or t["axis"] not in ("x", "y", "z"):
             raise SpecTranslationError(f"term `{name}`: sensor `{t['sensor']}` / axis `{t['axis']}` unknown to the checker")
-        if name in INNER_LEVER:
-            # its physics is this file's own (INNER_LEVER); the spec's regressor is not read
-            i, j = INNER_LEVER[name]
+        physics = ACCEL_PHYSICS.get(name)
+        if physics:
+            # its physics is this file's own (ACCEL_PHYSICS); the spec's regressor is not read
+            i, kind, what = physics
             if t["sensor"] != "accel" or "xyz".index(t["axis"]) != i:
-                raise SpecTranslationError(f"term `{name}`: an inner lever arm of the {'xyz'[i]} accelerometer, "
+                raise SpecTranslationError(f"term `{name}`: {what} of the {'xyz'[i]} accelerometer, "
                                            f"but the spec says {t['sensor']} {t['axis']}")
-            terms[name] = ("accel", i, ("inner_lever", j))
-        elif name in ACCEL_DELAY:
-            i = ACCEL_DELAY[name]
-            if t["sensor"] != "accel" or "xyz".index(t["axis"]) != i:
-                raise SpecTranslationError(f"term `{name}`: the delay of the {'xyz'[i]} accelerometer, "
-                                           f"but the spec says {t['sensor']} {t['axis']}")
-            terms[name] = ("accel", i, ("delay",))
+            terms[name] = ("accel", i, kind)
         else:
             terms[name] = (t["sensor"], "xyz".index(t["axis"]), translate_regressor(t["regressor"], name))
         if t.get("library", False):

@@ -1258,6 +1258,41 @@ pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [
     false, false, false, false, false, false, false,
 ];
 
+/// The IMU signals (`f`, `w`, `dw`, `df`) each regressor reads.
+pub const REGRESSOR_SIGNALS: [&[&str]; REGRESSOR_COUNT] = [
+    &[],
+    &["w"],
+    &["w"],
+    &["w"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["f"],
+    &["w"],
+    &["w"],
+    &["w"],
+    &["w", "dw"],
+    &["w", "dw"],
+    &["w", "dw"],
+    &["w", "dw"],
+    &["w", "dw"],
+    &["w", "dw"],
+    &["df"],
+    &["df"],
+    &["df"],
+];
+
 /// Gyro angle random walk [rad/√s] (spec default).
 pub const GYRO_ARW: f64 = 2.908882086657216e-6;
 

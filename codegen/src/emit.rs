@@ -202,6 +202,10 @@ pub fn common_module(spec: &Spec) -> String {
     });
     let n_reg = spec.regressors.len();
     let reg_sources = spec.regressors.iter().map(|r| r.expr.source.clone());
+    let reg_signals = (0..spec.regressors.len()).map(|r| {
+        let names = signals_read(spec, &[r]);
+        quote!(&[#(#names),*])
+    });
     let reg_const = spec.regressors.iter().map(|r| r.constant);
     let reg_arms = spec.regressors.iter().enumerate().map(|(i, r)| {
         let ast = &r.expr.ast;
@@ -401,6 +405,8 @@ pub fn common_module(spec: &Spec) -> String {
         pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [#(#reg_sources),*];
         /// True for regressors that use no IMU signal (no accumulation needed).
         pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [#(#reg_const),*];
+        /// The IMU signals (`f`, `w`, `dw`, `df`) each regressor reads.
+        pub const REGRESSOR_SIGNALS: [&[&str]; REGRESSOR_COUNT] = [#(#reg_signals),*];
         /// Gyro angle random walk [rad/√s] (spec default).
         pub const GYRO_ARW: f64 = #arw;
         /// Accelerometer velocity random walk [m/s/√s] (spec default).
@@ -506,25 +512,30 @@ fn param(name: &str, used: bool) -> syn::Ident {
     }
 }
 
-/// The parameter (`s`, or `_s` when unused) and the binding of the IMU signals (`f`, `w`,
-/// `dw`, `df`) the given regressors read: `let ImuSignals { f, w, .. } = s;`.
+/// The IMU signals (`f`, `w`, `dw`, `df`, in that order) the given regressors read.
+fn signals_read(spec: &Spec, regs: &[usize]) -> Vec<&'static str> {
+    crate::expr::IMU_SIGNALS
+        .iter()
+        .copied()
+        .filter(|name| {
+            regs.iter().any(|&r| {
+                spec.regressors[r]
+                    .expr
+                    .symbols()
+                    .iter()
+                    .any(|sym| sym.split_once('.').is_some_and(|(base, _)| base == *name))
+            })
+        })
+        .collect()
+}
+
+/// The parameter (`s`, or `_s` when unused) and the binding of the IMU signals the given
+/// regressors read: `let ImuSignals { f, w, .. } = s;`.
 fn signals_binding(spec: &Spec, regs: &[usize]) -> (syn::Ident, TokenStream) {
-    let mut used: Vec<&str> = Vec::new();
-    for &r in regs {
-        for sym in spec.regressors[r].expr.symbols() {
-            if let Some((base, _)) = sym.split_once('.') {
-                if let Some(name) = crate::expr::IMU_SIGNALS.iter().find(|n| **n == base) {
-                    if !used.contains(name) {
-                        used.push(name);
-                    }
-                }
-            }
-        }
-    }
+    let used = signals_read(spec, regs);
     if used.is_empty() {
         return (param("s", false), quote!());
     }
-    used.sort_by_key(|n| crate::expr::IMU_SIGNALS.iter().position(|x| x == n));
     let fields = used.iter().map(|n| format_ident!("{}", n));
     (
         param("s", true),

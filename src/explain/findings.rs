@@ -155,6 +155,9 @@ pub struct GroupEstimate {
 pub struct TightPrior {
     /// Term name.
     pub term: String,
+    /// Term index in the spec.
+    #[serde(skip)]
+    pub index: usize,
     /// Its estimate at the end of the first run's extended pass (display unit).
     pub estimate: f64,
     /// Its σ there (display unit).
@@ -284,15 +287,20 @@ pub struct Implausible {
 const SPLIT_P: f64 = 0.0027;
 
 impl Consistency {
-    /// The test over `split`'s groups (`labels`), given each group's estimate and σ in the
-    /// finding's display unit (groups without information, σ = ∞ or NaN, are left out).
-    pub(super) fn test(split: &str, labels: &[&str], est: &[(f64, f64)]) -> Consistency {
-        let groups: Vec<GroupEstimate> = labels
+    /// The test over `split`'s groups (group k named `label(k)`), given each group's estimate
+    /// and σ in the finding's display unit (groups without information, σ = ∞ or NaN, are left
+    /// out).
+    pub(super) fn test(
+        split: &str,
+        label: &dyn Fn(usize) -> String,
+        est: &[(f64, f64)],
+    ) -> Consistency {
+        let groups: Vec<GroupEstimate> = est
             .iter()
-            .zip(est)
+            .enumerate()
             .filter(|(_, (e, s))| e.is_finite() && s.is_finite() && *s > 0.0)
-            .map(|(l, &(estimate, sigma))| GroupEstimate {
-                group: l.to_string(),
+            .map(|(k, &(estimate, sigma))| GroupEstimate {
+                group: label(k),
                 estimate,
                 sigma,
             })

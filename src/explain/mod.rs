@@ -304,18 +304,11 @@ pub fn explain(
     );
     let widen: Vec<(usize, f64)> = tight
         .iter()
-        .filter_map(|p| {
-            let t = common::TERMS.iter().position(|x| x.name == p.term)?;
-            Some((t, p.suggested * common::TERMS[t].display_to_si))
-        })
+        .map(|p| (p.index, p.suggested * common::TERMS[p.index].display_to_si))
         .collect();
     let config_widened = |m: &Model| -> anyhow::Result<FilterConfig> {
         let mut c = config_for(m)?;
-        for &(t, sigma) in &widen {
-            if let Some(i) = m.index_of(common::TERMS[t].name) {
-                c.prior_sigma[i] = c.prior_sigma[i].max(sigma);
-            }
-        }
+        widen_priors(&mut c, m, &widen);
         Ok(c)
     };
     let widened = Context {
@@ -359,7 +352,8 @@ pub fn explain(
     // the share of the baseline's excess the extended model leaves
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
-    for (f, j) in findings.iter_mut().zip(judged) {
+    // (complete_findings gives one finding per named term, in order)
+    for ((f, j), n) in findings.iter_mut().zip(judged).zip(&r.named) {
         if !j.is_cause() {
             // a stand-in keeps the value it was fitted with; its words say what is left now
             *f = j;
@@ -367,10 +361,7 @@ pub fn explain(
                 .stand_in
                 .as_ref()
                 .and(stand_in_reason(f, misfit_unexplained, ctx.opts));
-            let t = common::TERMS
-                .iter()
-                .position(|x| x.name == f.term)
-                .expect("a finding is a spec term");
+            let t = n.term;
             let info = &common::TERMS[t];
             f.words = finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         }
@@ -445,6 +436,7 @@ fn tight_priors(
         let k = 1.0 / info.display_to_si;
         out.push(TightPrior {
             term: info.name.to_string(),
+            index: t,
             estimate: x * k,
             sigma: sd * k,
             prior: prior * k,
@@ -538,13 +530,28 @@ impl Context<'_> {
                 }
             }
         }
-        for &(t, sigma) in widened {
-            if let Some(i) = m.index_of(common::TERMS[t].name) {
-                cfg.prior_sigma[i] = cfg.prior_sigma[i].max(sigma);
-            }
-        }
+        widen_priors(&mut cfg, m, widened);
         Ok(cfg)
     }
+}
+
+/// Widens the prior σ of each term in `widened` ((term, least σ, SI)) that `m` holds.
+fn widen_priors(cfg: &mut FilterConfig, m: &Model, widened: &[(usize, f64)]) {
+    for &(t, sigma) in widened {
+        if let Some(i) = m.index_of(common::TERMS[t].name) {
+            cfg.prior_sigma[i] = cfg.prior_sigma[i].max(sigma);
+        }
+    }
+}
+
+/// The model `base` with the spec terms `terms` added.
+fn model_with(base: &str, terms: impl IntoIterator<Item = usize>) -> anyhow::Result<Model> {
+    let mut text = base.to_string();
+    for t in terms {
+        text.push('+');
+        text.push_str(common::TERMS[t].name);
+    }
+    Ok(Model::parse(&text)?)
 }
 
 /// A term the selection named in a round, before the extended filter has estimated it.
@@ -649,12 +656,13 @@ fn without_stand_ins(
     if findings.iter().all(Finding::is_cause) {
         return Ok(r);
     }
-    let mut text = ctx.baseline.name.clone();
-    for f in findings.iter().filter(|f| f.is_cause()) {
-        text.push('+');
-        text.push_str(&f.term);
-    }
-    let model = Model::parse(&text)?;
+    let causes = r
+        .named
+        .iter()
+        .zip(findings)
+        .filter(|(_, f)| f.is_cause())
+        .map(|(n, _)| n.term);
+    let model = model_with(&ctx.baseline.name, causes)?;
     let cfg = ctx.extended_config(&model, &r.widened)?;
     let round = r.rounds + 1;
     r.pass = run_pass(&model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
@@ -705,12 +713,7 @@ fn select_and_retest(
             r.named.push(named);
             added.push(t);
         }
-        let mut text = r.model.name.clone();
-        for &t in &added {
-            text.push('+');
-            text.push_str(common::TERMS[t].name);
-        }
-        let next_model = Model::parse(&text)?;
+        let next_model = model_with(&r.model.name, added.iter().copied())?;
         pool_terms.retain(|t| !excluded.contains(t));
         let last_round = r.rounds >= opts.max_rounds;
         let cfg = ctx.extended_config(&next_model, &r.widened)?;
@@ -879,7 +882,9 @@ fn complete_findings(
             consistency: n
                 .splits
                 .iter()
-                .map(|(split, est)| Consistency::test(split.name(), split.groups(), est))
+                .map(|(split, est)| {
+                    Consistency::test(split.name(), &|k| split.group_label(k), est)
+                })
                 .collect(),
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
@@ -1064,7 +1069,7 @@ mod tests {
 
     #[test]
     fn a_term_whose_groups_disagree_does_not_hold_across_the_data() {
-        let halves = ["first half", "second half"];
+        let halves = |k| Split::Time(0.0).group_label(k);
         let test = |e: &[(f64, f64)]| Consistency::test("time", &halves, e);
         // one constant: the halves agree within their σ
         assert!(test(&[(-0.34, 0.02), (-0.36, 0.02)]).holds);
@@ -1079,10 +1084,10 @@ mod tests {
         let c = test(&[(1.0, f64::INFINITY), (5.0, 0.1)]);
         assert!(c.holds && c.dof == 0 && c.groups.len() == 1);
         // four groups: three agree, one is far off; the words name every group
-        let motion = Split::Motion.groups();
+        let motion = |k| Split::Motion.group_label(k);
         let c = Consistency::test(
             "motion",
-            motion,
+            &motion,
             &[(10.0, 1.0), (11.0, 1.0), (9.5, 1.0), (40.0, 2.0)],
         );
         assert!(!c.holds && c.dof == 3, "{c:?}");
@@ -1091,14 +1096,14 @@ mod tests {
         // four groups within noise
         let c = Consistency::test(
             "motion",
-            motion,
+            &motion,
             &[(10.0, 1.0), (11.0, 1.0), (9.5, 1.0), (12.0, 2.0)],
         );
         assert!(c.holds, "{c:?}");
         let mut f = finding(0.9, Some(0.3));
         f.consistency = vec![Consistency::test(
             "speed",
-            Split::Speed(1.0).groups(),
+            &|k| Split::Speed(1.0).group_label(k),
             &[(-1.6, 0.02), (-0.4, 0.02)],
         )];
         let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default()).unwrap();

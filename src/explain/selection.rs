@@ -5,6 +5,7 @@ use super::signatures::{Signatures, Split};
 use super::ExplainOptions;
 use crate::estimate::stats;
 use crate::model::generated::common;
+use crate::model::regressor_reads;
 use nalgebra::DMatrix;
 
 /// A pass's information and score, prior-scaled: J' = D J D, b' = D b with D = diag(σ_prior),
@@ -297,9 +298,9 @@ pub(super) fn candidate_tests(
     let vibrated = sig.level.iter().any(|l| l.1 > MIN_VIBRATION);
     let testable: Vec<bool> = (0..m)
         .map(|c| {
-            let reg = common::REGRESSORS[super::signatures::reg_id(sig.cands[c])];
-            let excited =
-                (rotated || !reg.contains("w.")) && (rotated || vibrated || !reg.contains("df."));
+            let reg = super::signatures::reg_id(sig.cands[c]);
+            let excited = (rotated || !regressor_reads(reg, &["w", "dw"]))
+                && (rotated || vibrated || !regressor_reads(reg, &["df"]));
             j[(c, c)] * phi > opts.min_information && excited
         })
         .collect();

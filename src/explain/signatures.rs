@@ -90,19 +90,6 @@ pub(super) enum Split {
 /// Most groups of [`Split::Manoeuvre`].
 pub(super) const MAX_MANOEUVRES: usize = 64;
 
-/// Group labels of [`Split::Manoeuvre`].
-static MANOEUVRE_LABELS: std::sync::LazyLock<Vec<&'static str>> = std::sync::LazyLock::new(|| {
-    (0..MAX_MANOEUVRES)
-        .map(|k| -> &'static str {
-            match k {
-                0 => "before any rotation",
-                k if k + 1 == MAX_MANOEUVRES => "from rotation 63 on",
-                k => Box::leak(format!("rotation {k}").into_boxed_str()),
-            }
-        })
-        .collect()
-});
-
 impl Split {
     /// The split's name in the report and the JSON.
     pub(super) fn name(&self) -> &'static str {
@@ -114,18 +101,32 @@ impl Split {
         }
     }
 
-    /// Its groups, in words.
-    pub(super) fn groups(&self) -> &'static [&'static str] {
+    /// Its number of groups.
+    pub(super) fn group_count(&self) -> usize {
         match self {
-            Split::Time(_) => &["first half", "second half"],
-            Split::Speed(_) => &["slower half", "faster half"],
-            Split::Motion => &[
-                "before any rotation",
-                "after rotating about x",
-                "after rotating about y",
-                "after rotating about z",
-            ],
-            Split::Manoeuvre => &MANOEUVRE_LABELS,
+            Split::Time(_) | Split::Speed(_) => 2,
+            Split::Motion => 4,
+            Split::Manoeuvre => MAX_MANOEUVRES,
+        }
+    }
+
+    /// Group `k`, in words.
+    pub(super) fn group_label(&self, k: usize) -> String {
+        const MOTION: [&str; 4] = [
+            "before any rotation",
+            "after rotating about x",
+            "after rotating about y",
+            "after rotating about z",
+        ];
+        match (self, k) {
+            (Split::Time(_), 0) => "first half".into(),
+            (Split::Time(_), _) => "second half".into(),
+            (Split::Speed(_), 0) => "slower half".into(),
+            (Split::Speed(_), _) => "faster half".into(),
+            (Split::Motion, k) => MOTION[k.min(3)].into(),
+            (Split::Manoeuvre, 0) => "before any rotation".into(),
+            (Split::Manoeuvre, k) if k + 1 == MAX_MANOEUVRES => format!("from rotation {k} on"),
+            (Split::Manoeuvre, k) => format!("rotation {k}"),
         }
     }
 }
@@ -201,7 +202,7 @@ impl Signatures {
             splits: splits
                 .iter()
                 .map(|&split| {
-                    let k = split.groups().len();
+                    let k = split.group_count();
                     SplitAcc {
                         split,
                         info: vec![vec![0.0; m * m]; k],

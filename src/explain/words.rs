@@ -178,7 +178,7 @@ pub(super) fn finding_words(
     } else {
         "drift"
     };
-    let mut s = if reg.contains("dw.") || reg.contains("df.") {
+    let mut s = if crate::model::regressor_reads(info.regressor, &["dw", "df"]) {
         // a regressor of the signals' rates of change averages to nothing over a run: the term
         // acts while the motion changes, not as a constant
         format!(

@@ -407,6 +407,14 @@ pub struct RegressorAccumulator {
     generated: Option<AccumulateFn>,
 }
 
+/// True when regressor `id` (an index into `common::REGRESSORS`) reads one of the IMU signals
+/// `names` (`f`, `w`, `dw`, `df`).
+pub fn regressor_reads(id: usize, names: &[&str]) -> bool {
+    common::REGRESSOR_SIGNALS[id]
+        .iter()
+        .any(|s| names.contains(s))
+}
+
 /// A generated regressor accumulator: adds one sample's signals to running sums.
 pub type AccumulateFn = fn(&mut [f64], &ImuSignals);
 

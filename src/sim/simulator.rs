@@ -127,10 +127,9 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         })
         .collect();
     // the true derivatives are formed only when an injected regressor reads them
-    let needs_rates = injected.iter().any(|inj| {
-        let r = common::REGRESSORS[inj.regressor];
-        r.contains("dw.") || r.contains("df.")
-    });
+    let needs_rates = injected
+        .iter()
+        .any(|inj| crate::model::regressor_reads(inj.regressor, &["dw", "df"]));
     let mut rng = Rng::new(sc.seed);
     // GNSS velocity noise on a stream of its own: adding velocities changes no other draw
     let mut rng_v = Rng::new(sc.seed ^ 0xbb67_ae85_84ca_a73b);
