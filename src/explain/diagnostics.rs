@@ -80,6 +80,60 @@ pub struct PassStats {
     pub truth_check: Vec<TruthCheck>,
 }
 
+/// Bonferroni-corrected whiteness p at or below which a channel's innovations are called
+/// correlated in time.
+pub const STRUCTURE_WHITENESS_P: f64 = 0.01;
+/// |mean normalised innovation| × √count over a segment at or beyond which the segment is
+/// called biased (≈ a two-sided 6e-5 level: fifty segment-channel tests at 0.3 %).
+pub const STRUCTURE_SEGMENT_Z: f64 = 4.0;
+
+/// Structure left in one channel's innovations: time correlation, or a segment whose mean
+/// normalised innovation is far from zero for its count.
+#[derive(Debug, Clone, Serialize)]
+pub struct ResidualStructure {
+    /// Channel (`vel_n`, …).
+    pub channel: String,
+    /// Ljung–Box p, Bonferroni-corrected over the pass's channels (capped at 1).
+    pub whiteness_p: Option<f64>,
+    /// True when `whiteness_p` ≤ [`STRUCTURE_WHITENESS_P`].
+    pub correlated: bool,
+    /// The segment with the largest |mean ν/√S| × √count: start, end [s, data time].
+    pub segment: Option<[f64; 2]>,
+    /// That segment's mean normalised innovation × √count (a z-score; 0 expected).
+    pub segment_z: f64,
+    /// True when |`segment_z`| ≥ [`STRUCTURE_SEGMENT_Z`].
+    pub biased: bool,
+}
+
+impl PassStats {
+    /// The channels whose innovations show structure (correlated in time or biased over a
+    /// segment); empty for a pass whose innovations look white and unbiased.
+    pub fn structure(&self) -> Vec<ResidualStructure> {
+        let k = self.channels.len().max(1) as f64;
+        self.channels
+            .iter()
+            .filter_map(|c| {
+                let whiteness_p = c.whiteness_p.map(|p| (p * k).min(1.0));
+                let worst = c
+                    .segments
+                    .iter()
+                    .map(|s| (s, s.bias_sigma * (s.count as f64).sqrt()))
+                    .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+                let segment_z = worst.map(|w| w.1).unwrap_or(0.0);
+                let r = ResidualStructure {
+                    channel: c.channel.clone(),
+                    whiteness_p,
+                    correlated: whiteness_p.is_some_and(|p| p <= STRUCTURE_WHITENESS_P),
+                    segment: worst.map(|(s, _)| [s.t0, s.t1]),
+                    segment_z,
+                    biased: segment_z.abs() >= STRUCTURE_SEGMENT_Z,
+                };
+                (r.correlated || r.biased).then_some(r)
+            })
+            .collect()
+    }
+}
+
 /// Segments of constant excitation: 1-s bins of the level merged while within 30 % (and
 /// 0.05 g); runs shorter than 10 s join their neighbour; with one segment, ten fixed windows.
 pub(super) fn segments(level: &[(f64, f64)], t_start: f64, t_end: f64) -> Vec<(f64, f64, f64)> {

@@ -33,7 +33,9 @@ mod selection;
 mod signatures;
 mod words;
 
-pub use diagnostics::{innovation_loglik, ChannelStats, PassStats, SegmentStats, TruthCheck};
+pub use diagnostics::{
+    innovation_loglik, ChannelStats, PassStats, ResidualStructure, SegmentStats, TruthCheck,
+};
 pub use findings::{
     CandidateTest, Consistency, EquivalentTerm, Explanation, Finding, Gain, GroupEstimate,
     Implausible, TightPrior,
@@ -459,6 +461,9 @@ fn round_up_1(v: f64) -> f64 {
 /// off-axis lever arm of 36 mm, 3.6 of the spec's 10 mm, beside a gyro–accelerometer
 /// asynchrony that explains most).
 const SMALL_SHARE_PRIOR_SIGMAS: f64 = 5.0;
+/// The small-share rule spares a finding whose extended-filter support 2Δℓ is at least this many
+/// times the prior's objection z² (z = its value in prior σ).
+const SMALL_SHARE_SUPPORT: f64 = 4.0;
 
 /// Prior σ beyond which a baseline term's estimate says its prior is too tight.
 const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
@@ -913,38 +918,58 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 
 /// Why finding `f` probably stands in for something the candidates do not describe, if it
 /// does: it needs more than `stand_in_prior_sigmas` of its prior, or, beyond
-/// [`SMALL_SHARE_PRIOR_SIGMAS`] prior σ, its
-/// round removed less than `stand_in_share` of the baseline's excess misfit (`unexplained`, the
-/// share the extended model leaves, is said with it).
+/// [`SMALL_SHARE_PRIOR_SIGMAS`] prior σ, the extended filter's gain for it (2Δℓ) is below the
+/// prior's objection z² to a value at z prior σ, or, beyond that many prior σ and with a support
+/// below [`SMALL_SHARE_SUPPORT`] z², its round removed less than `stand_in_share` of the baseline's
+/// excess misfit (`unexplained`, the share the extended model leaves, is said with it).
 fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
     let mut why: Vec<String> = f
         .consistency
         .iter()
         .filter_map(|c| c.disagreement(&f.unit))
         .collect();
-    if f.prior_sigmas > opts.stand_in_prior_sigmas {
-        why.push(format!("it needs {} prior σ", sig3(f.prior_sigmas)));
+    let z = f.prior_sigmas;
+    // the posterior prefers the fitted value to none only when the data's support (2Δℓ)
+    // outweighs the prior's objection to a value at z prior σ (z²)
+    let unsupported = z > SMALL_SHARE_PRIOR_SIGMAS && f.two_delta_loglik < z * z;
+    // a value within a few prior σ that explains little is a small effect beside larger ones,
+    // not a stand-in; nor is one whose support exceeds the prior's objection several times over
+    // (where several causes share the misfit, each removes a small part of it)
+    let small_share = f.misfit_share.filter(|&share| {
+        share < opts.stand_in_share
+            && z > SMALL_SHARE_PRIOR_SIGMAS
+            && f.two_delta_loglik < SMALL_SHARE_SUPPORT * z * z
+    });
+    let mut clauses = Vec::new();
+    if z > opts.stand_in_prior_sigmas {
+        clauses.push(format!("it needs {} prior σ", sig3(z)));
+    } else if unsupported {
+        clauses.push(format!(
+            "at {} prior σ the sensor's prior objects to it by z² = {}, more than the data support it (2Δℓ {}): as a property of this sensor it is less credible than none, unless the prior is too tight for this unit",
+            sig3(z),
+            sig3(z * z),
+            sig3(f.two_delta_loglik)
+        ));
     }
-    if let Some(share) = f.misfit_share {
-        // a value within a few prior σ that explains little is a small effect beside larger
-        // ones, not a stand-in
-        if share < opts.stand_in_share && f.prior_sigmas > SMALL_SHARE_PRIOR_SIGMAS {
-            // (its prior σ said once: the clause before may have given them)
-            let needs = if f.prior_sigmas > opts.stand_in_prior_sigmas {
-                "and it".to_string()
+    if let Some(share) = small_share {
+        // (its prior σ said once: the clause before may have given them)
+        clauses.push(format!(
+            "{} removes only {} % of the baseline's excess misfit{}",
+            if clauses.is_empty() {
+                format!("it needs {} prior σ yet", sig3(z))
+            } else if z > opts.stand_in_prior_sigmas {
+                "and it".into()
             } else {
-                format!("it needs {} prior σ yet", sig3(f.prior_sigmas))
-            };
-            why.push(format!(
-                "{needs} removes only {} % of the baseline's excess misfit{}",
-                sig3(100.0 * share.max(0.0)),
-                unexplained
-                    .filter(|l| *l >= 0.01)
-                    .map(|l| format!(" (the extended model leaves {} % of it)", sig3(100.0 * l)))
-                    .unwrap_or_default()
-            ));
-        }
+                "it".into()
+            },
+            sig3(100.0 * share.max(0.0)),
+            unexplained
+                .filter(|l| *l >= 0.01)
+                .map(|l| format!(" (the extended model leaves {} % of it)", sig3(100.0 * l)))
+                .unwrap_or_default()
+        ));
     }
+    why.extend(clauses);
     (!why.is_empty()).then(|| why.join("; "))
 }
 
@@ -1068,6 +1093,28 @@ mod tests {
     }
 
     #[test]
+    fn a_finding_the_data_support_less_than_its_prior_objects_is_a_stand_in() {
+        let o = ExplainOptions::default();
+        let with = |z: f64, share: Option<f64>, two_dl: f64| {
+            let mut f = finding(z, share);
+            f.two_delta_loglik = two_dl;
+            stand_in_reason(&f, Some(0.0), &o)
+        };
+        // 19 prior σ (z² 361) on a consistent baseline, supported by 2Δℓ 15.8: a stand-in
+        let w = with(19.0, None, 15.8).unwrap();
+        assert!(w.contains("z² = 361") && w.contains("2Δℓ 15.8"), "{w}");
+        // the same value with overwhelming support: the prior is too tight, not the value wrong
+        assert!(with(19.0, None, 400.0).is_none());
+        // within 5 prior σ the prior's objection is not decisive
+        assert!(with(4.9, None, 1.0).is_none());
+        // a small share beside other causes is spared when the support is 4× the objection…
+        assert!(with(6.2, Some(0.09), 432.0).is_none());
+        // …and not below that
+        let w = with(8.2, Some(0.0016), 78.7).unwrap();
+        assert!(w.contains("it needs 8.20 prior σ yet removes only"), "{w}");
+    }
+
+    #[test]
     fn a_term_whose_groups_disagree_does_not_hold_across_the_data() {
         let halves = |k| Split::Time(0.0).group_label(k);
         let test = |e: &[(f64, f64)]| Consistency::test("time", &halves, e);
@@ -1136,5 +1183,58 @@ mod tests {
         assert!((e - 4.59).abs() < 1e-12);
         // with 10 innovations a mean NIS of 1.5 is within the band
         assert_eq!(baseline_excess(&pass(1.5, 10)), None);
+    }
+
+    #[test]
+    fn structure_left_is_time_correlation_or_a_biased_segment() {
+        let channel = |p: Option<f64>, bias: f64, count: usize| ChannelStats {
+            channel: "vel_n".into(),
+            count,
+            nis_mean: 1.0,
+            nis_band: [0.9, 1.1],
+            fraction_outside_95: 0.05,
+            ljung_box_q: None,
+            whiteness_p: p,
+            segments: vec![SegmentStats {
+                t0: 10.0,
+                t1: 20.0,
+                level_g: 0.0,
+                count,
+                nis_mean: 1.0,
+                bias_sigma: bias,
+            }],
+        };
+        let pass = |channels: Vec<ChannelStats>| PassStats {
+            model: "P28".into(),
+            t_start: 0.0,
+            loglik: 0.0,
+            nis_mean: 1.0,
+            whiteness_p: 1.0,
+            channels,
+            model_error_rms_arcsec: None,
+            truth_check: vec![],
+        };
+        // white and unbiased: nothing left
+        assert!(pass(vec![channel(Some(0.5), 0.01, 100)])
+            .structure()
+            .is_empty());
+        // a mean of 0.3σ over 100 innovations is a 3σ bias: not yet
+        assert!(pass(vec![channel(Some(0.5), 0.3, 100)])
+            .structure()
+            .is_empty());
+        // 0.5σ over 100 is 5σ: biased, with its segment
+        let s = pass(vec![channel(Some(0.5), -0.5, 100)]).structure();
+        assert!(s[0].biased && !s[0].correlated && s[0].segment == Some([10.0, 20.0]));
+        assert!((s[0].segment_z + 5.0).abs() < 1e-12);
+        // p 0.004 on one of three channels is 0.012 after Bonferroni: white; 0.003 is not
+        let three = |p| {
+            pass(vec![
+                channel(Some(p), 0.0, 100),
+                channel(None, 0.0, 100),
+                channel(None, 0.0, 100),
+            ])
+        };
+        assert!(three(0.004).structure().is_empty());
+        assert!(three(0.003).structure()[0].correlated);
     }
 }

@@ -508,6 +508,44 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             ));
         }
     }
+    // what the extended model leaves in the innovations (the baseline's was said above)
+    let left = e.extended.structure();
+    if e.findings.iter().any(|f| f.is_cause()) && !left.is_empty() {
+        let said: Vec<String> = left
+            .iter()
+            .map(|r| {
+                let mut parts = Vec::new();
+                if r.correlated {
+                    let p = r.whiteness_p.unwrap_or(0.0);
+                    parts.push(format!(
+                        "correlated in time (Ljung–Box p {})",
+                        if p < 1e-300 {
+                            "< 1e-300".to_string()
+                        } else {
+                            sig3(p)
+                        }
+                    ));
+                }
+                if let (true, Some([t0, t1])) = (r.biased, r.segment) {
+                    parts.push(format!(
+                        "biased by {:+.1}σ over {:.0}–{:.0} s",
+                        r.segment_z,
+                        t0 - t_ref,
+                        t1 - t_ref
+                    ));
+                }
+                format!(
+                    "{} innovations {}",
+                    channel_word(&r.channel),
+                    parts.join(" and ")
+                )
+            })
+            .collect();
+        out.push(format!(
+            "After the extension structure remains (a segment's bias is its mean normalised innovation × √count): {}. Something the extended model does not describe is still in the data; a finding may absorb part of it (its consistency splits say whether it holds across the data).",
+            said.join("; ")
+        ));
+    }
     if !e.implausible.is_empty() {
         let list: Vec<String> = e
             .implausible

@@ -21,6 +21,8 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
     };
     let mut extended = pass(&e.extended);
     extended["terms"] = json!(extended_names);
+    // what the extended model leaves: channels still correlated in time or biased somewhere
+    extended["residual_structure"] = json!(e.extended.structure());
     let mut gain = json!({
         "loglik": e.gain.loglik,
         "nis_mean_before": e.gain.nis_mean_before,
