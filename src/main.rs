@@ -55,7 +55,12 @@ fn main() -> ExitCode {
     // SAFETY: called first in main, before any thread exists; only resets a signal disposition.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        // past a file-size limit (`ulimit -f`) a write fails with an error naming the file,
+        // instead of the process dying without a word
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
+    #[cfg(unix)]
+    interrupts::remove_unfinished_outputs_on_signal();
     // A full disk or a closed file behind stdout/stderr makes println!/eprintln! panic: end with
     // status 2 and one line (when stderr still takes it), not a panic message.
     let default_hook = std::panic::take_hook();
@@ -105,6 +110,67 @@ fn main() -> ExitCode {
                 sinsmodel::io::lines::printable_message(&format!("{e:#}"))
             );
             ExitCode::from(2)
+        }
+    }
+}
+
+/// SIGINT, SIGTERM and SIGHUP end the run without leaving its unfinished outputs behind.
+#[cfg(unix)]
+mod interrupts {
+    use std::sync::atomic::{AtomicI32, Ordering};
+
+    /// Write end of the pipe the handler signals through.
+    static PIPE: AtomicI32 = AtomicI32::new(-1);
+
+    extern "C" fn on_signal(sig: libc::c_int) {
+        let b = sig as u8;
+        // SAFETY: write(2) is async-signal-safe; the fd is a pipe this process owns.
+        unsafe {
+            libc::write(PIPE.load(Ordering::Relaxed), (&b as *const u8).cast(), 1);
+        }
+    }
+
+    /// Installs the handlers: the signal's number goes down a pipe to a thread that removes
+    /// the temporaries and staging directories (never a committed output, nor the earlier run
+    /// a commit is replacing: the registry's lock waits for it), says so and exits 128 + signal.
+    pub fn remove_unfinished_outputs_on_signal() {
+        let mut fds = [0 as libc::c_int; 2];
+        // SAFETY: pipe(2) fills the two descriptors; checked below.
+        if unsafe { libc::pipe(fds.as_mut_ptr()) } != 0 {
+            return;
+        }
+        PIPE.store(fds[1], Ordering::Relaxed);
+        let read_end = fds[0];
+        std::thread::spawn(move || {
+            let mut b = 0u8;
+            // SAFETY: reads one byte into `b` from the pipe's read end.
+            while unsafe { libc::read(read_end, (&mut b as *mut u8).cast(), 1) } != 1 {}
+            let (n, _held) = sinsmodel::io::atomic_file::remove_unfinished();
+            let name = match b as libc::c_int {
+                libc::SIGINT => "SIGINT",
+                libc::SIGTERM => "SIGTERM",
+                _ => "SIGHUP",
+            };
+            let _ = std::io::Write::write_all(
+                &mut std::io::stderr(),
+                format!(
+                    "interrupted ({name}): {n} unfinished output{} removed; earlier results are left as they were\n",
+                    if n == 1 { "" } else { "s" }
+                )
+                .as_bytes(),
+            );
+            std::process::exit(128 + b as i32);
+        });
+        for sig in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            // SAFETY: installs a handler that only calls write(2); sa_mask empty, SA_RESTART so
+            // interrupted reads and writes resume.
+            unsafe {
+                let mut sa: libc::sigaction = std::mem::zeroed();
+                sa.sa_sigaction = on_signal as *const () as usize;
+                sa.sa_flags = libc::SA_RESTART;
+                libc::sigemptyset(&mut sa.sa_mask);
+                libc::sigaction(sig, &sa, std::ptr::null_mut());
+            }
         }
     }
 }

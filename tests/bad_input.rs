@@ -401,14 +401,19 @@ fn leftovers_of_killed_runs_are_cleaned_and_reruns_replace_whole() {
     let d = dir.path();
     let imu = d.join("imu.txt");
     std::fs::write(&imu, GOOD).unwrap();
-    // pid 4194304 is above Linux's pid_max: never a live process
-    std::fs::create_dir(d.join(".o.partial-4194304")).unwrap();
-    std::fs::write(d.join(".o.partial-4194304/states.txt"), "half").unwrap();
-    std::fs::create_dir(d.join(".o.old-4194304")).unwrap();
-    std::fs::write(d.join("nav.txt.partial-4194304-0"), "half").unwrap();
+    // pid 4194304 is above Linux's pid_max: never a live process (tests/output_guard.rs has
+    // the names that are left alone)
+    std::fs::create_dir(d.join(".o.sinsmodel-staging-4194304")).unwrap();
+    std::fs::write(
+        d.join(".o.sinsmodel-staging-4194304/.sinsmodel-staging"),
+        "sinsmodel staging directory: removed when its run ends\n",
+    )
+    .unwrap();
+    std::fs::write(d.join(".o.sinsmodel-staging-4194304/states.txt"), "half").unwrap();
+    std::fs::write(d.join("nav.txt.sinsmodel-partial-4194304-0"), "half").unwrap();
     let (ok, err) = navigate(&imu, &d.join("nav.txt"));
     assert!(ok, "{err}");
-    assert!(!d.join("nav.txt.partial-4194304-0").exists());
+    assert!(!d.join("nav.txt.sinsmodel-partial-4194304-0").exists());
     let sc = d.join("s.toml");
     std::fs::write(
         &sc,
@@ -425,11 +430,11 @@ fn leftovers_of_killed_runs_are_cleaned_and_reruns_replace_whole() {
         ]);
         assert!(ok, "{err}");
     }
-    assert!(!d.join(".o.partial-4194304").exists() && !d.join(".o.old-4194304").exists());
+    assert!(!d.join(".o.sinsmodel-staging-4194304").exists());
     let left: Vec<String> = std::fs::read_dir(d)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.contains("partial") || n.contains(".old-"))
+        .filter(|n| n.contains("sinsmodel-"))
         .collect();
     assert!(left.is_empty(), "{left:?}");
     assert!(o.join("imu.txt").exists() && o.join("gnss.txt").exists());

@@ -3,7 +3,7 @@
 use anyhow::Result;
 use clap::Args;
 use sinsmodel::estimate::align;
-use sinsmodel::io::atomic_file;
+use sinsmodel::io::atomic_file::{self, Provenance};
 use std::path::PathBuf;
 
 /// Arguments of `align`.
@@ -29,6 +29,10 @@ pub struct AlignArgs {
     /// JSON output {roll_deg, pitch_deg, heading_deg, heading_sigma_deg, lat_deg, lat_sigma_deg, …}.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Replace an existing output file that is not provably this command's earlier output (or
+    /// that a sinsmodel run directory lists as its result).
+    #[arg(long)]
+    force: bool,
 }
 
 /// Runs the command.
@@ -60,7 +64,8 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         }
     }
     if let Some(j) = &args.json {
-        args.src.check_output("--json", j)?;
+        args.src
+            .check_output("--json", j, Provenance::Json("align"), args.force)?;
     }
     let data = args.src.read()?;
     let d = std::f64::consts::PI / 180.0;
@@ -121,7 +126,10 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         a.gyro_bias_deg_h[0], a.gyro_bias_deg_h[1], a.gyro_bias_deg_h[2]
     );
     if let Some(j) = &args.json {
-        atomic_file::write_text(j, &serde_json::to_string_pretty(&a)?)?;
+        atomic_file::write_text(
+            j,
+            &atomic_file::with_written_by(&serde_json::to_string_pretty(&a)?, "align"),
+        )?;
         eprintln!("wrote {}", j.display());
     }
     Ok(())

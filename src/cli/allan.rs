@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sinsmodel::estimate::allan::{fit, oadev, AllanCurve, NoiseFit};
-use sinsmodel::io::atomic_file;
+use sinsmodel::io::atomic_file::{self, Provenance};
 use sinsmodel::io::imu::ImuData;
 use sinsmodel::report::plot::{line_plot, Scale, Series};
 use std::collections::BTreeMap;
@@ -29,6 +29,10 @@ pub struct AllanArgs {
     /// Plot prefix: writes PREFIX_gyro.png and PREFIX_accel.png (default: next to --json).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Replace an existing output file that is not provably this command's earlier output (or
+    /// that a sinsmodel run directory lists as its result).
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Serialize)]
@@ -48,7 +52,8 @@ const NAMES: [&str; 6] = [
 /// Runs the command.
 pub fn run(args: &AllanArgs) -> Result<()> {
     if let Some(j) = &args.json {
-        args.src.check_output("--json", j)?;
+        args.src
+            .check_output("--json", j, Provenance::Json("allan"), args.force)?;
     }
     if let Some(p) = prefix_shown(args) {
         // the prefix names files in a directory: not a device or a special path
@@ -65,7 +70,8 @@ pub fn run(args: &AllanArgs) -> Result<()> {
         }
         for suffix in ["gyro", "accel"] {
             let png = PathBuf::from(format!("{}_{suffix}.png", p.display()));
-            args.src.check_output("--plot", &png)?;
+            args.src
+                .check_output("--plot", &png, Provenance::Png, args.force)?;
         }
     }
     let data = args.src.read()?;
@@ -170,7 +176,10 @@ pub fn run(args: &AllanArgs) -> Result<()> {
         curves[0].span_s
     );
     if let Some(j) = &args.json {
-        atomic_file::write_text(j, &serde_json::to_string_pretty(&out)?)?;
+        atomic_file::write_text(
+            j,
+            &atomic_file::with_written_by(&serde_json::to_string_pretty(&out)?, "allan"),
+        )?;
     }
     if let Some(p) = prefix_shown(args) {
         let series = |range: std::ops::Range<usize>, scale: f64| -> Vec<Series> {

@@ -63,11 +63,18 @@ impl ImuSource {
         v
     }
 
-    /// Refuses an output file that is one of the inputs or not a regular file.
-    pub fn check_output(&self, option: &str, path: &std::path::Path) -> Result<()> {
+    /// Refuses an output file that is one of the inputs or not a regular file, and (unless
+    /// `force`) one that is another run's result or not provably this command's earlier output.
+    pub fn check_output(
+        &self,
+        option: &str,
+        path: &std::path::Path,
+        provenance: sinsmodel::io::atomic_file::Provenance,
+        force: bool,
+    ) -> Result<()> {
         let inputs = self.paths();
         let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
-        sinsmodel::io::atomic_file::check_output_file(option, path, &refs)
+        sinsmodel::io::atomic_file::check_output_file(option, path, &refs, provenance, force)
     }
 }
 
@@ -128,9 +135,10 @@ pub struct DataArgs {
     /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
     #[arg(long)]
     zupt: Option<f64>,
-    /// Run even when the initial roll and pitch contradict the measured gravity direction.
+    /// Run even when the initial roll and pitch contradict the measured gravity direction; with
+    /// explain, also replace a --json file that is not provably an earlier explain output.
     #[arg(long)]
-    force: bool,
+    pub force: bool,
     /// Sensor grade the priors and noise assume: navigation (the spec's defaults), tactical or
     /// mems; --prior and --noise override single values.
     #[arg(long)]

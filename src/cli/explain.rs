@@ -83,6 +83,13 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
                 );
             }
         }
+        atomic_file::check_output_file(
+            "--json",
+            j,
+            &[],
+            atomic_file::Provenance::Json("explain"),
+            args.data.force,
+        )?;
     }
     if args.data.any_given() {
         if args.demo_seconds.is_some() || args.demo_seed.is_some() {

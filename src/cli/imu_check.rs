@@ -4,7 +4,7 @@
 use anyhow::{bail, Result};
 use clap::Args;
 use sinsmodel::estimate::imu_check;
-use sinsmodel::io::atomic_file;
+use sinsmodel::io::atomic_file::{self, Provenance};
 use std::path::PathBuf;
 
 /// Arguments of `imu-check`.
@@ -27,6 +27,10 @@ pub struct ImuCheckArgs {
     /// JSON output of everything checked.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Replace an existing output file that is not provably this command's earlier output (or
+    /// that a sinsmodel run directory lists as its result).
+    #[arg(long)]
+    force: bool,
 }
 
 /// Runs the command.
@@ -43,7 +47,8 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         bail!("--seconds {}: expected seconds > 0", args.seconds);
     }
     if let Some(j) = &args.json {
-        args.src.check_output("--json", j)?;
+        args.src
+            .check_output("--json", j, Provenance::Json("imu-check"), args.force)?;
     }
     let data = args.src.read()?;
     let c = imu_check::check(
@@ -106,7 +111,10 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         println!("note: {n}");
     }
     if let Some(j) = &args.json {
-        atomic_file::write_text(j, &serde_json::to_string_pretty(&c)?)?;
+        atomic_file::write_text(
+            j,
+            &atomic_file::with_written_by(&serde_json::to_string_pretty(&c)?, "imu-check"),
+        )?;
         eprintln!("wrote {}", j.display());
     }
     if !c.problems.is_empty() {

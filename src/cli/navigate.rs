@@ -44,7 +44,8 @@ pub struct NavigateArgs {
     /// Output file (truth layout of DESIGN §9).
     #[arg(long)]
     out: PathBuf,
-    /// Run even when --att's roll and pitch contradict the measured gravity direction.
+    /// Run even when --att's roll and pitch contradict the measured gravity direction, and
+    /// replace an --out file that is not provably an earlier `navigate` output.
     #[arg(long)]
     force: bool,
     /// Read the whole IMU file before navigating (the pre-streaming path, kept as the baseline
@@ -86,7 +87,12 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             args.out_rate
         );
     }
-    args.src.check_output("--out", &args.out)?;
+    args.src.check_output(
+        "--out",
+        &args.out,
+        sinsmodel::io::atomic_file::Provenance::Text("navigate"),
+        args.force,
+    )?;
     // streamed: memory does not grow with the file; the output is written as it goes and
     // appears only when complete
     let mut data = args.src.open()?;

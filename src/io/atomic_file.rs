@@ -4,6 +4,75 @@
 use anyhow::{Context, Result};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
+
+/// Tag in the name of every temporary this crate makes (`NAME.sinsmodel-partial-PID-N`,
+/// `.NAME.sinsmodel-staging-PID`, `.NAME.sinsmodel-old-PID`): the sweep of killed runs'
+/// leftovers takes only names of exactly these forms, never a user's `nav.txt.old-2024`.
+const TEMP_TAG: &str = "sinsmodel";
+
+/// File inside every staging directory, written when it is created: a directory is swept as a
+/// killed run's staging only when it holds this file with [`STAGING_TEXT`].
+const STAGING_MARKER: &str = ".sinsmodel-staging";
+/// What [`STAGING_MARKER`] holds.
+const STAGING_TEXT: &str = "sinsmodel staging directory: removed when its run ends\n";
+
+/// First line of every [`RUN_MARKER`]; the run's files follow, one per line.
+const RUN_MARKER_HEADER: &str = "written by sinsmodel; its files:";
+
+/// Temporaries and staging directories of this process not yet committed: what a SIGINT or
+/// SIGTERM removes ([`remove_unfinished`]).
+static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn unfinished() -> MutexGuard<'static, Vec<PathBuf>> {
+    UNFINISHED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn register(p: &Path) {
+    unfinished().push(p.to_path_buf());
+}
+
+fn unregister(list: &mut Vec<PathBuf>, p: &Path) {
+    list.retain(|q| q != p);
+}
+
+/// Removes every unfinished output of this process (temporaries and staging directories) and
+/// returns how many, with the registry still locked: while the guard lives no output can be
+/// committed, so a caller that ends the process on a signal leaves either the earlier result
+/// or the complete new one, and no hidden leftover.
+pub fn remove_unfinished() -> (usize, MutexGuard<'static, Vec<PathBuf>>) {
+    let mut list = unfinished();
+    let mut n = 0;
+    for p in list.drain(..) {
+        if std::fs::remove_dir_all(&p)
+            .or_else(|_| std::fs::remove_file(&p))
+            .is_ok()
+        {
+            n += 1;
+        }
+    }
+    (n, list)
+}
+
+/// A unique temporary beside `target`: `TARGET.sinsmodel-partial-PID-N` plus `ext` (unique per
+/// process and file, so concurrent runs never share one); registered for removal on a signal.
+pub fn temporary_beside(target: &Path, ext: &str) -> PathBuf {
+    static SERIAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let mut tmp = target.as_os_str().to_owned();
+    tmp.push(format!(
+        ".{TEMP_TAG}-partial-{}-{k}{ext}",
+        std::process::id()
+    ));
+    let tmp = PathBuf::from(tmp);
+    register(&tmp);
+    tmp
+}
+
+/// Forgets a temporary made by [`temporary_beside`] (after it was moved into place or removed).
+pub fn forget_temporary(tmp: &Path) {
+    unregister(&mut unfinished(), tmp);
+}
 
 /// A file being written; it appears at its final path only on [`AtomicFile::commit`].
 pub struct AtomicFile {
@@ -41,8 +110,8 @@ impl Write for NamedWriter {
 }
 
 impl AtomicFile {
-    /// Starts writing `target` (through `target.partial-PID-N`, unique per process and file),
-    /// creating its directory.
+    /// Starts writing `target` (through `target.sinsmodel-partial-PID-N`, unique per process
+    /// and file), creating its directory.
     pub fn create(target: &Path) -> Result<AtomicFile> {
         if let Ok(m) = std::fs::symlink_metadata(target) {
             if !m.is_file() && !std::fs::metadata(target).is_ok_and(|m| m.is_file()) {
@@ -62,16 +131,13 @@ impl AtomicFile {
             } else {
                 dir
             };
-            remove_stale(dir, &format!("{}.", name.to_string_lossy()));
+            remove_stale(dir, &name.to_string_lossy());
         }
-        // unique per process and file: concurrent runs never share a temporary
-        static SERIAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-        let k = SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let mut tmp = target.as_os_str().to_owned();
-        tmp.push(format!(".partial-{}-{k}", std::process::id()));
-        let tmp = PathBuf::from(tmp);
-        let f = std::fs::File::create(&tmp)
-            .with_context(|| format!("cannot create {}", tmp.display()))?;
+        let tmp = temporary_beside(target, "");
+        let f = std::fs::File::create(&tmp).with_context(|| {
+            forget_temporary(&tmp);
+            format!("cannot create {}", tmp.display())
+        })?;
         Ok(AtomicFile {
             tmp,
             target: target.to_path_buf(),
@@ -93,6 +159,7 @@ impl AtomicFile {
         if let Err(e) = w.inner.flush().and_then(|_| w.inner.get_ref().sync_all()) {
             drop(w);
             let _ = std::fs::remove_file(&self.tmp);
+            forget_temporary(&self.tmp);
             anyhow::bail!(
                 "cannot write {} (for {}): {e}",
                 self.tmp.display(),
@@ -100,6 +167,9 @@ impl AtomicFile {
             );
         }
         drop(w);
+        // (under the registry's lock: a signal arriving now waits for the rename)
+        let mut list = unfinished();
+        unregister(&mut list, &self.tmp);
         std::fs::rename(&self.tmp, &self.target).map_err(|e| {
             let _ = std::fs::remove_file(&self.tmp);
             anyhow::anyhow!(
@@ -115,6 +185,7 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.out.is_some() {
             let _ = std::fs::remove_file(&self.tmp);
+            forget_temporary(&self.tmp);
         }
     }
 }
@@ -148,36 +219,58 @@ impl OutputDir {
             if !target.is_dir() {
                 anyhow::bail!("--out {}: exists and is not a directory", target.display());
             }
-            let empty = std::fs::read_dir(target)
+            let mut present: Vec<String> = std::fs::read_dir(target)
                 .with_context(|| format!("cannot read {}", target.display()))?
-                .next()
-                .is_none();
-            if !empty && !target.join(RUN_MARKER).exists() {
-                anyhow::bail!(
-                    "--out {}: the directory exists and was not written by sinsmodel; choose another (nothing is overwritten)",
-                    target.display()
-                );
-            }
-            if !empty {
-                // the marker lists the run's files (one per line after the first): anything
-                // else was put there since, and replacing the directory would lose it
-                let marker = std::fs::read_to_string(target.join(RUN_MARKER)).unwrap_or_default();
-                let listed: Vec<&str> = marker.lines().skip(1).collect();
-                if !listed.is_empty() {
-                    let mut foreign: Vec<String> = std::fs::read_dir(target)
-                        .with_context(|| format!("cannot read {}", target.display()))?
-                        .filter_map(|e| e.ok())
-                        .map(|e| e.file_name().to_string_lossy().into_owned())
-                        .filter(|n| n != RUN_MARKER && !listed.contains(&n.as_str()))
-                        .collect();
-                    if !foreign.is_empty() {
-                        foreign.sort();
-                        anyhow::bail!(
-                            "--out {}: holds files the earlier sinsmodel run did not write ({}); move them or choose another --out (nothing is overwritten)",
-                            target.display(),
-                            foreign.join(", ")
-                        );
+                .filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect();
+            present.sort();
+            if !present.is_empty() {
+                let shown = |names: &[String]| {
+                    let mut s = names
+                        .iter()
+                        .take(20)
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ");
+                    if names.len() > 20 {
+                        s.push_str(&format!(" and {} more", names.len() - 20));
                     }
+                    s
+                };
+                if !present.iter().any(|n| n == RUN_MARKER) {
+                    anyhow::bail!(
+                        "--out {}: the directory exists and was not written by sinsmodel (it holds {}); choose another (nothing is overwritten)",
+                        target.display(),
+                        shown(&present)
+                    );
+                }
+                // the marker must list the run's files: an empty, unreadable or foreign marker
+                // (or one of an older release, which listed none) proves nothing
+                let listed = run_listing(target).map_err(|why| {
+                    anyhow::anyhow!(
+                        "--out {}: cannot prove the directory holds only an earlier sinsmodel run's files ({why}); it holds {}. Nothing is overwritten: move what you want to keep and remove the directory, or choose another --out",
+                        target.display(),
+                        shown(&present)
+                    )
+                })?;
+                // anything not listed, or listed but no longer a plain file, was put there
+                // since, and replacing the directory would lose it
+                let foreign: Vec<String> = present
+                    .iter()
+                    .filter(|n| *n != RUN_MARKER)
+                    .filter(|n| {
+                        !listed.contains(n)
+                            || !std::fs::symlink_metadata(target.join(n)).is_ok_and(|m| m.is_file())
+                    })
+                    .cloned()
+                    .collect();
+                if !foreign.is_empty() {
+                    anyhow::bail!(
+                        "--out {}: holds files the earlier sinsmodel run did not write ({}); move them or choose another --out (nothing is overwritten)",
+                        target.display(),
+                        shown(&foreign)
+                    );
                 }
             }
             let canon = target.canonicalize()?;
@@ -203,11 +296,19 @@ impl OutputDir {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| "out".into());
-        remove_stale(&parent, &format!(".{name}."));
-        let staging = sibling(target, "partial");
-        let _ = std::fs::remove_dir_all(&staging);
+        remove_stale(&parent, &name);
+        let staging = sibling(target, "staging");
+        if std::fs::symlink_metadata(&staging).is_ok() {
+            anyhow::bail!(
+                "--out {}: {} exists (this process's staging name); remove it",
+                target.display(),
+                staging.display()
+            );
+        }
         std::fs::create_dir(&staging)
             .with_context(|| format!("cannot create {}", staging.display()))?;
+        register(&staging);
+        write_text(&staging.join(STAGING_MARKER), STAGING_TEXT)?;
         Ok(OutputDir {
             staging,
             target: target.to_path_buf(),
@@ -227,14 +328,20 @@ impl OutputDir {
             .filter_map(|e| e.ok())
             .map(|e| e.file_name().to_string_lossy().into_owned())
             .collect();
+        names.retain(|n| n != STAGING_MARKER);
         names.sort();
         write_text(
             &self.staging.join(RUN_MARKER),
-            &format!("written by sinsmodel; its files:\n{}\n", names.join("\n")),
+            &format!("{RUN_MARKER_HEADER}\n{}\n", names.join("\n")),
         )?;
+        // (a kill between the two leaves a staging directory the sweep still recognises)
+        std::fs::remove_file(self.staging.join(STAGING_MARKER))
+            .with_context(|| format!("cannot finish {}", self.staging.display()))?;
         // two renames, each atomic: the earlier run moves aside whole, the new one moves in
         // whole; a kill between them leaves no target (never a mixed or half-deleted one), and
-        // the hidden leftovers are removed by the next run
+        // the hidden leftovers are removed by the next run. Under the registry's lock: a
+        // SIGINT or SIGTERM waits for both.
+        let mut list = unfinished();
         let old = sibling(&self.target, "old");
         if self.target.exists() {
             std::fs::rename(&self.target, &old)
@@ -248,6 +355,8 @@ impl OutputDir {
             )
         })?;
         self.committed = true;
+        unregister(&mut list, &self.staging);
+        drop(list);
         let _ = std::fs::remove_dir_all(&old);
         Ok(())
     }
@@ -257,11 +366,46 @@ impl Drop for OutputDir {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
+            unregister(&mut unfinished(), &self.staging);
         }
     }
 }
 
-/// `.NAME.KIND-PID` beside `target`: this process's hidden staging or set-aside directory.
+/// The files a run directory's [`RUN_MARKER`] lists, or why it proves nothing: missing, not a
+/// plain file, unreadable, not sinsmodel's header, or listing no file.
+pub fn run_listing(dir: &Path) -> std::result::Result<Vec<String>, String> {
+    let marker = dir.join(RUN_MARKER);
+    let meta = std::fs::symlink_metadata(&marker).map_err(|_| format!("it has no {RUN_MARKER}"))?;
+    if !meta.is_file() {
+        return Err(format!("its {RUN_MARKER} is not a plain file"));
+    }
+    if meta.len() > 1 << 20 {
+        return Err(format!(
+            "its {RUN_MARKER} is larger than any sinsmodel writes"
+        ));
+    }
+    let text = std::fs::read_to_string(&marker)
+        .map_err(|e| format!("its {RUN_MARKER} cannot be read as text: {e}"))?;
+    let mut lines = text.lines();
+    if lines.next() != Some(RUN_MARKER_HEADER) {
+        return Err(format!(
+            "its {RUN_MARKER} does not start with sinsmodel's line \"{RUN_MARKER_HEADER}\""
+        ));
+    }
+    let listed: Vec<String> = lines
+        .filter(|l| !l.is_empty())
+        .map(str::to_string)
+        .collect();
+    if listed.is_empty() {
+        return Err(format!(
+            "its {RUN_MARKER} lists no files, as an older release wrote it"
+        ));
+    }
+    Ok(listed)
+}
+
+/// `.NAME.sinsmodel-KIND-PID` beside `target`: this process's hidden staging or set-aside
+/// directory.
 fn sibling(target: &Path, kind: &str) -> PathBuf {
     let parent = match target.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -271,7 +415,7 @@ fn sibling(target: &Path, kind: &str) -> PathBuf {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
-    parent.join(format!(".{name}.{kind}-{}", std::process::id()))
+    parent.join(format!(".{name}.{TEMP_TAG}-{kind}-{}", std::process::id()))
 }
 
 /// True unless the process `pid` is known to be gone (Linux: no /proc/PID).
@@ -282,31 +426,73 @@ fn pid_alive(pid: u32) -> bool {
     Path::new(&format!("/proc/{pid}")).exists()
 }
 
-/// Removes leftovers of killed runs in `dir`: entries named `PREFIX…-PID` or `PREFIX…-PID-N`
-/// (temporaries, staging and set-aside directories) whose process is gone.
-fn remove_stale(dir: &Path, prefix: &str) {
+/// What a leftover name beside output `name` is, if it is exactly one of this crate's
+/// temporaries: (kind, pid).
+fn leftover_kind(entry: &str, name: &str) -> Option<(&'static str, u32)> {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    // NAME.sinsmodel-partial-PID-N, optionally .png (a plot's temporary)
+    if let Some(rest) = entry
+        .strip_prefix(name)
+        .and_then(|r| r.strip_prefix(&format!(".{TEMP_TAG}-partial-")))
+    {
+        let rest = rest.strip_suffix(".png").unwrap_or(rest);
+        let (pid, k) = rest.split_once('-')?;
+        if !(digits(pid) && digits(k)) {
+            return None;
+        }
+        return pid.parse().ok().map(|p| ("file", p));
+    }
+    // .NAME.sinsmodel-staging-PID or .NAME.sinsmodel-old-PID
+    let rest = entry
+        .strip_prefix('.')?
+        .strip_prefix(name)?
+        .strip_prefix(&format!(".{TEMP_TAG}-"))?;
+    for kind in ["staging", "old"] {
+        if let Some(pid) = rest.strip_prefix(kind).and_then(|r| r.strip_prefix('-')) {
+            if digits(pid) {
+                return pid.parse().ok().map(|p| (kind, p));
+            }
+        }
+    }
+    None
+}
+
+/// Removes leftovers of killed runs beside output `name` in `dir`: only entries whose name is
+/// exactly one of this crate's temporaries, whose process is gone, and whose content proves it
+/// (a plain file for a file's temporary; a directory holding the staging marker, or an earlier
+/// run's valid [`RUN_MARKER`], for a staging or set-aside directory). Anything else is left.
+fn remove_stale(dir: &Path, name: &str) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
     for e in entries.filter_map(|e| e.ok()) {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let Some(rest) = name.strip_prefix(prefix) else {
+        let entry = e.file_name().to_string_lossy().into_owned();
+        let Some((kind, pid)) = leftover_kind(&entry, name) else {
             continue;
         };
-        // KIND-PID or KIND-PID-N, KIND one of partial, old
-        let mut parts = rest.rsplit('-');
-        let (Some(a), Some(b)) = (parts.next(), parts.next()) else {
+        if pid == std::process::id() || pid_alive(pid) {
+            continue;
+        }
+        let p = e.path();
+        let Ok(meta) = std::fs::symlink_metadata(&p) else {
             continue;
         };
-        let kind_ok = |k: &str| k.ends_with("partial") || k.ends_with("old");
-        let pid = match (a.parse::<u32>(), b.parse::<u32>()) {
-            (Ok(_), Ok(pid)) if parts.next().is_some_and(kind_ok) => pid,
-            (Ok(pid), _) if kind_ok(b) => pid,
-            _ => continue,
+        let ours = match kind {
+            "file" => meta.is_file(),
+            "staging" => {
+                meta.is_dir()
+                    && (std::fs::read_to_string(p.join(STAGING_MARKER))
+                        .is_ok_and(|t| t == STAGING_TEXT)
+                        || run_listing(&p).is_ok())
+            }
+            _ => meta.is_dir() && run_listing(&p).is_ok(),
         };
-        if pid != std::process::id() && !pid_alive(pid) {
-            let p = e.path();
-            let _ = std::fs::remove_dir_all(&p).or_else(|_| std::fs::remove_file(&p));
+        if ours {
+            let _ = if meta.is_dir() {
+                std::fs::remove_dir_all(&p)
+            } else {
+                std::fs::remove_file(&p)
+            };
         }
     }
 }
@@ -324,10 +510,194 @@ fn refuse_mat_variable_name(option: &str, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// What proves that an existing single-file output is this command's earlier result, so that a
+/// run may replace it: anything else is refused without `--force`.
+#[derive(Debug, Clone, Copy)]
+pub enum Provenance {
+    /// A JSON object whose `written_by` is `sinsmodel COMMAND` (see [`with_written_by`]).
+    Json(&'static str),
+    /// A text file whose first line is the provenance header `# sinsmodel COMMAND …`.
+    Text(&'static str),
+    /// A PNG carrying the `Software` text chunk `sinsmodel` that every plot of this crate has.
+    Png,
+}
+
+/// `text` (pretty JSON of an object) with `"written_by": "sinsmodel COMMAND"` as its first
+/// field: how a JSON output proves it is this command's ([`Provenance::Json`]).
+pub fn with_written_by(text: &str, command: &str) -> String {
+    match text.strip_prefix('{') {
+        Some(rest) if rest.trim_start().starts_with('"') => {
+            format!("{{\n  \"written_by\": \"sinsmodel {command}\",{rest}")
+        }
+        Some(rest) => format!("{{\n  \"written_by\": \"sinsmodel {command}\"{rest}"),
+        None => text.to_string(),
+    }
+}
+
+impl Provenance {
+    /// Why the file at `path` is not provably this command's output (`None`: it is).
+    fn lacking(&self, path: &Path) -> Option<String> {
+        use std::io::Read;
+        match self {
+            Provenance::Json(cmd) => {
+                let mut text = String::new();
+                let read = std::fs::File::open(path)
+                    .and_then(|f| f.take(64 << 20).read_to_string(&mut text));
+                let v: Option<serde_json::Value> =
+                    read.ok().and_then(|_| serde_json::from_str(&text).ok());
+                let want = format!("sinsmodel {cmd}");
+                match v
+                    .as_ref()
+                    .and_then(|v| v.get("written_by"))
+                    .and_then(|w| w.as_str())
+                {
+                    Some(w) if w == want => None,
+                    Some(w) => Some(format!("its \"written_by\" is \"{w}\", not \"{want}\"")),
+                    None => Some(format!(
+                        "it is not a JSON object with \"written_by\": \"{want}\""
+                    )),
+                }
+            }
+            Provenance::Text(cmd) => {
+                let mut head = vec![0u8; 4096];
+                let n = std::fs::File::open(path)
+                    .and_then(|mut f| f.read(&mut head))
+                    .unwrap_or(0);
+                let first = String::from_utf8_lossy(&head[..n]);
+                let first = first.lines().next().unwrap_or("");
+                let want = format!("# sinsmodel {cmd}");
+                (first != want && !first.starts_with(&format!("{want} "))).then(|| {
+                    format!("its first line is not the header \"{want} …\" this command writes")
+                })
+            }
+            Provenance::Png => {
+                let bytes = std::fs::read(path).unwrap_or_default();
+                (png_text(&bytes, "Software").as_deref() != Some(PNG_SOFTWARE))
+                    .then(|| format!("it is not a PNG marked \"Software: {PNG_SOFTWARE}\""))
+            }
+        }
+    }
+}
+
+/// The `Software` text every plot of this crate carries.
+pub const PNG_SOFTWARE: &str = "sinsmodel";
+
+/// CRC-32 (ISO-HDLC, as PNG chunks use) of `data`.
+fn crc32(data: &[u8]) -> u32 {
+    let mut c = 0xffff_ffffu32;
+    for &b in data {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xedb8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+/// The PNG's chunks as (type, data) up to IEND, or `None` if it is no PNG.
+fn png_chunks(bytes: &[u8]) -> Option<Vec<([u8; 4], &[u8])>> {
+    let mut rest = bytes.strip_prefix(b"\x89PNG\r\n\x1a\n")?;
+    let mut out = Vec::new();
+    while rest.len() >= 12 {
+        let len = u32::from_be_bytes(rest[..4].try_into().ok()?) as usize;
+        let kind: [u8; 4] = rest[4..8].try_into().ok()?;
+        let data = rest.get(8..8 + len)?;
+        rest = rest.get(12 + len..)?;
+        out.push((kind, data));
+        if &kind == b"IEND" {
+            break;
+        }
+    }
+    Some(out)
+}
+
+/// The text of the PNG's `tEXt` chunk `keyword`, if it has one.
+pub fn png_text(bytes: &[u8], keyword: &str) -> Option<String> {
+    png_chunks(bytes)?
+        .into_iter()
+        .filter(|(k, _)| k == b"tEXt")
+        .find_map(|(_, d)| {
+            let z = d.iter().position(|&b| b == 0)?;
+            (&d[..z] == keyword.as_bytes())
+                .then(|| String::from_utf8_lossy(&d[z + 1..]).into_owned())
+        })
+}
+
+/// `bytes` (a PNG) with a `tEXt` chunk `keyword` = `text` after its header chunk; `None` if it
+/// is no PNG.
+pub fn png_with_text(bytes: &[u8], keyword: &str, text: &str) -> Option<Vec<u8>> {
+    let chunks = png_chunks(bytes)?;
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut push = |kind: &[u8], data: &[u8]| {
+        out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let start = out.len();
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+        let crc = crc32(&out[start..]);
+        out.extend_from_slice(&crc.to_be_bytes());
+    };
+    for (k, (kind, data)) in chunks.iter().enumerate() {
+        push(kind, data);
+        if k == 0 {
+            let mut t = keyword.as_bytes().to_vec();
+            t.push(0);
+            t.extend_from_slice(text.as_bytes());
+            push(b"tEXt", &t);
+        }
+    }
+    Some(out)
+}
+
 /// Refuses an output file `path` (named by `option` in the message) that is one of `inputs`
-/// (also through a link) or exists as something other than a regular file; call it before the
-/// computation.
-pub fn check_output_file(option: &str, path: &Path, inputs: &[&Path]) -> Result<()> {
+/// (also through a link) or exists as something other than a regular file; and, unless `force`,
+/// one that a sinsmodel run directory's [`RUN_MARKER`] lists (another run's result) or that is
+/// not provably this command's earlier output (`provenance`; an empty file holds nothing to
+/// lose). Call it before the computation.
+pub fn check_output_file(
+    option: &str,
+    path: &Path,
+    inputs: &[&Path],
+    provenance: Provenance,
+    force: bool,
+) -> Result<()> {
+    check_output_path(option, path, inputs)?;
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    if force {
+        return Ok(());
+    }
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if let (Ok(listed), Some(name)) = (run_listing(dir), path.file_name()) {
+        if listed.iter().any(|l| std::ffi::OsStr::new(l) == name) {
+            anyhow::bail!(
+                "{option} {}: is a result of the sinsmodel run in {} (its {RUN_MARKER} lists it); replacing it would change that run's outputs. Choose another path, or give --force to replace it",
+                path.display(),
+                dir.display()
+            );
+        }
+    }
+    if meta.len() > 0 {
+        if let Some(why) = provenance.lacking(path) {
+            anyhow::bail!(
+                "{option} {}: exists and is not provably an earlier output of this command ({why}); nothing is overwritten: choose another path, or give --force to replace it",
+                path.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuses an output file `path` (named by `option` in the message) that is one of `inputs`
+/// (also through a link) or exists as something other than a regular file.
+fn check_output_path(option: &str, path: &Path, inputs: &[&Path]) -> Result<()> {
     refuse_mat_variable_name(option, path)?;
     // writable before minutes of work: create the directory and a probe file in it
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
@@ -339,12 +709,17 @@ pub fn check_output_file(option: &str, path: &Path, inputs: &[&Path]) -> Result<
             )
         })?;
     }
-    let mut probe = path.as_os_str().to_owned();
-    probe.push(format!(".probe-{}", std::process::id()));
-    let probe = PathBuf::from(probe);
-    std::fs::File::create(&probe)
-        .with_context(|| format!("{option} {}: cannot write there", path.display()))?;
-    let _ = std::fs::remove_file(&probe);
+    // (a fresh name of this crate's temporary form, never truncating anything that exists)
+    let probe = temporary_beside(path, "");
+    let made = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe);
+    if made.is_ok() {
+        let _ = std::fs::remove_file(&probe);
+    }
+    forget_temporary(&probe);
+    made.with_context(|| format!("{option} {}: cannot write there", path.display()))?;
     if let Ok(m) = std::fs::metadata(path) {
         if !m.is_file() {
             anyhow::bail!(
@@ -364,4 +739,87 @@ pub fn check_output_file(option: &str, path: &Path, inputs: &[&Path]) -> Result<
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crc32_is_the_png_one() {
+        assert_eq!(crc32(b"123456789"), 0xcbf4_3926);
+        assert_eq!(crc32(b"IEND"), 0xae42_6082);
+    }
+
+    #[test]
+    fn a_png_gets_and_keeps_its_text() {
+        // the smallest PNG: signature, IHDR (1×1 grey), IDAT, IEND
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut chunk = |kind: &[u8], data: &[u8]| {
+            png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+            let mut body = kind.to_vec();
+            body.extend_from_slice(data);
+            png.extend_from_slice(&body);
+            png.extend_from_slice(&crc32(&body).to_be_bytes());
+        };
+        chunk(b"IHDR", &[0, 0, 0, 1, 0, 0, 0, 1, 8, 0, 0, 0, 0]);
+        chunk(b"IDAT", &[0x78, 0x9c, 0x63, 0x60, 0, 0, 0, 2, 0, 1]);
+        chunk(b"IEND", &[]);
+        assert_eq!(png_text(&png, "Software"), None);
+        let marked = png_with_text(&png, "Software", "sinsmodel").unwrap();
+        assert_eq!(png_text(&marked, "Software").as_deref(), Some("sinsmodel"));
+        // every chunk's CRC checks, and the text sits right after IHDR
+        let mut rest = &marked[8..];
+        while rest.len() >= 12 {
+            let len = u32::from_be_bytes(rest[..4].try_into().unwrap()) as usize;
+            let crc = u32::from_be_bytes(rest[8 + len..12 + len].try_into().unwrap());
+            assert_eq!(crc32(&rest[4..8 + len]), crc);
+            rest = &rest[12 + len..];
+        }
+        let chunks = png_chunks(&marked).unwrap();
+        assert_eq!(&chunks[1].0, b"tEXt");
+        assert_eq!(chunks.len(), 4);
+        assert_eq!(png_with_text(b"not a png", "Software", "x"), None);
+    }
+
+    #[test]
+    fn written_by_comes_first_in_a_json_object() {
+        let t = with_written_by("{\n  \"a\": 1\n}", "align");
+        let v: serde_json::Value = serde_json::from_str(&t).unwrap();
+        assert_eq!(v["written_by"], "sinsmodel align");
+        assert_eq!(v["a"], 1);
+        assert!(t.starts_with("{\n  \"written_by\""));
+        let v: serde_json::Value = serde_json::from_str(&with_written_by("{}", "x")).unwrap();
+        assert_eq!(v["written_by"], "sinsmodel x");
+    }
+
+    #[test]
+    fn only_exact_temporary_names_are_leftovers() {
+        assert_eq!(
+            leftover_kind("nav.txt.sinsmodel-partial-12-0", "nav.txt"),
+            Some(("file", 12))
+        );
+        assert_eq!(
+            leftover_kind("a_gyro.png.sinsmodel-partial-12-3.png", "a_gyro.png"),
+            Some(("file", 12))
+        );
+        assert_eq!(
+            leftover_kind(".o.sinsmodel-staging-7", "o"),
+            Some(("staging", 7))
+        );
+        assert_eq!(leftover_kind(".o.sinsmodel-old-7", "o"), Some(("old", 7)));
+        for user in [
+            "nav.txt.old-2024",
+            "nav.txt.partial-12-0",
+            "nav.txt.sinsmodel-partial-12",
+            "nav.txt.sinsmodel-partial-12-0.bak",
+            "nav.txt.sinsmodel-partial--0",
+            ".o.old-7",
+            ".o.sinsmodel-old-7x",
+            ".oo.sinsmodel-old-7",
+        ] {
+            let name = if user.contains("nav") { "nav.txt" } else { "o" };
+            assert_eq!(leftover_kind(user, name), None, "{user}");
+        }
+    }
 }

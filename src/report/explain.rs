@@ -37,6 +37,7 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         gain["misfit_unexplained"] = json!(u);
     }
     json!({
+        "written_by": "sinsmodel explain",
         "data": data,
         "model": e.model,
         "baseline": pass(&e.baseline),

@@ -49,7 +49,7 @@ pub fn line_plot(
     scale: Scale,
 ) -> Result<()> {
     register_font();
-    let tmp = path.with_extension("partial.png");
+    let tmp = crate::io::atomic_file::temporary_beside(path, ".png");
     {
         let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
         root.fill(&WHITE)
@@ -152,9 +152,7 @@ pub fn line_plot(
         root.present()
             .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
     }
-    std::fs::rename(&tmp, path)
-        .map_err(|e| anyhow!("cannot move {} into place: {e}", path.display()))?;
-    Ok(())
+    finish(&tmp, path)
 }
 
 /// One bar: label, value and an optional ± error.
@@ -177,7 +175,7 @@ pub fn bar_plot(
     threshold: Option<(f64, &str)>,
 ) -> Result<()> {
     register_font();
-    let tmp = path.with_extension("partial.png");
+    let tmp = crate::io::atomic_file::temporary_beside(path, ".png");
     {
         let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
         let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
@@ -266,7 +264,20 @@ pub fn bar_plot(
         }
         root.present().map_err(|e| err(&e))?;
     }
-    std::fs::rename(&tmp, path)
-        .map_err(|e| anyhow!("cannot move {} into place: {e}", path.display()))?;
-    Ok(())
+    finish(&tmp, path)
+}
+
+/// Moves the drawn temporary `tmp` to `path` (atomically), marked `Software: sinsmodel` so that
+/// a later run can tell its own plot from a user's file.
+fn finish(tmp: &Path, path: &Path) -> Result<()> {
+    use crate::io::atomic_file;
+    let bytes = std::fs::read(tmp);
+    let _ = std::fs::remove_file(tmp);
+    atomic_file::forget_temporary(tmp);
+    let bytes = bytes.map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
+    let marked = atomic_file::png_with_text(&bytes, "Software", atomic_file::PNG_SOFTWARE)
+        .ok_or_else(|| anyhow!("plot {}: the drawing is no PNG", path.display()))?;
+    let mut f = atomic_file::AtomicFile::create(path)?;
+    std::io::Write::write_all(f.writer(), &marked)?;
+    f.commit()
 }

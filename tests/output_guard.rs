@@ -1,0 +1,371 @@
+//! No output path removes or replaces a file the run cannot prove it wrote: run directories
+//! need a marker that lists their files, the sweep of killed runs' leftovers takes only this
+//! crate's temporaries, single-file outputs replace only their own command's earlier output
+//! (else `--force`), and a SIGINT/SIGTERM or a file-size limit leaves no half-written output.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+fn run(args: &[&str]) -> (bool, String) {
+    let (ok, _, err) = common::sinsmodel(args);
+    (ok, err)
+}
+
+const SCENARIO: &str = "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 20.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n";
+
+/// A simulated run in `d/o` (imu.txt, gnss.txt, truth.txt, scenario.toml and the marker).
+fn simulate(d: &Path) -> std::path::PathBuf {
+    let sc = d.join("s.toml");
+    std::fs::write(&sc, SCENARIO).unwrap();
+    let o = d.join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    o
+}
+
+fn simulate_into(d: &Path, o: &Path) -> (bool, String) {
+    run(&[
+        "simulate",
+        d.join("s.toml").to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ])
+}
+
+fn names(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A marker that lists no files (as older releases wrote it), an empty or foreign one, or a
+/// directory of that name proves nothing: the re-run is refused, the files named, nothing lost.
+#[test]
+fn a_run_directory_needs_a_marker_that_lists_its_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let marker = o.join(".sinsmodel-run");
+    let listing = std::fs::read_to_string(&marker).unwrap();
+    assert!(listing.starts_with("written by sinsmodel; its files:\n"));
+    // a re-run over its own complete output replaces it
+    let (ok, err) = simulate_into(d, &o);
+    assert!(ok, "{err}");
+    std::fs::write(o.join("notes.txt"), "my notes").unwrap();
+    for (what, bad, why) in [
+        (
+            "one line",
+            Some("written by sinsmodel\n"),
+            "does not start with",
+        ),
+        (
+            "header only",
+            Some("written by sinsmodel; its files:\n"),
+            "lists no files",
+        ),
+        ("empty", Some(""), "does not start with"),
+        ("garbage", Some("\u{0}\u{1}xyz"), "does not start with"),
+        ("a directory", None, "not a plain file"),
+    ] {
+        let _ = std::fs::remove_file(&marker);
+        let _ = std::fs::remove_dir(&marker);
+        match bad {
+            Some(text) => std::fs::write(&marker, text).unwrap(),
+            None => std::fs::create_dir(&marker).unwrap(),
+        }
+        let (ok, err) = simulate_into(d, &o);
+        assert!(
+            !ok && err.contains("cannot prove") && err.contains(why) && err.contains("notes.txt"),
+            "{what}: {err}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(o.join("notes.txt")).unwrap(),
+            "my notes",
+            "{what}"
+        );
+    }
+    // a valid marker with a file it does not list: refused, naming the file
+    let _ = std::fs::remove_dir(&marker);
+    std::fs::write(&marker, listing).unwrap();
+    let (ok, err) = simulate_into(d, &o);
+    assert!(!ok && err.contains("did not write (notes.txt)"), "{err}");
+    // a listed name that is now a directory is not the run's file either
+    std::fs::remove_file(o.join("notes.txt")).unwrap();
+    std::fs::remove_file(o.join("gnss.txt")).unwrap();
+    std::fs::create_dir(o.join("gnss.txt")).unwrap();
+    std::fs::write(o.join("gnss.txt/mine"), "x").unwrap();
+    let (ok, err) = simulate_into(d, &o);
+    assert!(!ok && err.contains("did not write (gnss.txt)"), "{err}");
+    assert!(o.join("gnss.txt/mine").exists());
+}
+
+/// The sweep before a run removes only this crate's temporaries of dead processes whose
+/// content proves them: users' `nav.txt.old-2024`, `.o.old-N` directories and old-style names
+/// are left alone.
+#[test]
+fn the_sweep_of_leftovers_never_takes_a_users_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    // pid 4194304 is above Linux's pid_max: never a live process
+    let theirs = [
+        "nav.txt.sinsmodel-partial-4194304-0",
+        ".o.sinsmodel-staging-4194304",
+        ".o.sinsmodel-old-4194304",
+    ];
+    std::fs::write(d.join(theirs[0]), "half").unwrap();
+    std::fs::create_dir(d.join(theirs[1])).unwrap();
+    std::fs::write(
+        d.join(theirs[1]).join(".sinsmodel-staging"),
+        "sinsmodel staging directory: removed when its run ends\n",
+    )
+    .unwrap();
+    std::fs::write(d.join(theirs[1]).join("imu.txt"), "half").unwrap();
+    std::fs::create_dir(d.join(theirs[2])).unwrap();
+    std::fs::copy(
+        o.join(".sinsmodel-run"),
+        d.join(theirs[2]).join(".sinsmodel-run"),
+    )
+    .unwrap();
+    let users = [
+        "nav.txt.old-2024",
+        "nav.txt.partial-4194304-0",
+        ".o.old-4194304",
+        ".o.partial-4194304",
+        // our form of name, but nothing inside proves it
+        ".o.sinsmodel-staging-4194305",
+        ".o.sinsmodel-old-4194305",
+        "nav.txt.sinsmodel-partial-4194304-x",
+    ];
+    for u in &users {
+        if u.starts_with('.') {
+            std::fs::create_dir(d.join(u)).unwrap();
+            std::fs::write(d.join(u).join("backup"), "keep").unwrap();
+        } else {
+            std::fs::write(d.join(u), "keep").unwrap();
+        }
+    }
+    let imu = o.join("imu.txt");
+    let (ok, err) = run(&[
+        "navigate",
+        "--imu",
+        imu.to_str().unwrap(),
+        "--lat",
+        "30",
+        "--lon",
+        "110",
+        "--att",
+        "0,0,0",
+        "--out",
+        d.join("nav.txt").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, err) = simulate_into(d, &o);
+    assert!(ok, "{err}");
+    let left = names(d);
+    for t in &theirs {
+        assert!(!left.contains(&t.to_string()), "{t} left: {left:?}");
+    }
+    for u in &users {
+        assert!(left.contains(&u.to_string()), "{u} removed: {left:?}");
+    }
+}
+
+/// Single-file outputs: another run's listed result or a file not provably this command's
+/// earlier output is refused (nothing changed); the command's own earlier output is replaced;
+/// --force replaces anything.
+#[test]
+fn single_file_outputs_replace_only_their_own_earlier_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let imu = o.join("imu.txt");
+    let imu = imu.to_str().unwrap();
+    let truth_before = std::fs::read(o.join("truth.txt")).unwrap();
+    let nav = |out: &Path, force: bool| {
+        let mut a = vec![
+            "navigate",
+            "--imu",
+            imu,
+            "--lat",
+            "30",
+            "--lon",
+            "110",
+            "--att",
+            "0,0,0",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if force {
+            a.push("--force");
+        }
+        run(&a)
+    };
+    // onto a simulation's truth.txt (listed in its marker)
+    let (ok, err) = nav(&o.join("truth.txt"), false);
+    assert!(
+        !ok && err.contains("is a result of the sinsmodel run in"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(o.join("truth.txt")).unwrap(), truth_before);
+    // onto a user's file; then its own earlier output; then --force
+    let mine = d.join("nav.txt");
+    std::fs::write(&mine, "my trajectory\n").unwrap();
+    let (ok, err) = nav(&mine, false);
+    assert!(
+        !ok && err.contains("not provably an earlier output"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my trajectory\n");
+    let (ok, err) = nav(&mine, true);
+    assert!(ok, "{err}");
+    let (ok, err) = nav(&mine, false);
+    assert!(ok, "its own earlier output: {err}");
+    // JSON outputs: a user's JSON, another command's JSON, an empty file, its own
+    let j = d.join("check.json");
+    std::fs::write(&j, "{\"mine\": 1}").unwrap();
+    for (cmd, extra) in [
+        ("imu-check", &[][..]),
+        ("align", &["--lat", "30"][..]),
+        ("allan", &[][..]),
+    ] {
+        let mut a = vec![cmd, "--imu", imu, "--json", j.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        let (ok, err) = run(&a);
+        assert!(
+            !ok && err.contains("not provably an earlier output"),
+            "{cmd}: {err}"
+        );
+        assert_eq!(std::fs::read_to_string(&j).unwrap(), "{\"mine\": 1}");
+    }
+    let ic = d.join("ic.json");
+    std::fs::write(&ic, "").unwrap();
+    let (ok, err) = run(&["imu-check", "--imu", imu, "--json", ic.to_str().unwrap()]);
+    assert!(ok, "an empty file holds nothing to lose: {err}");
+    let (ok, err) = run(&["imu-check", "--imu", imu, "--json", ic.to_str().unwrap()]);
+    assert!(ok, "its own earlier output: {err}");
+    let (ok, err) = run(&[
+        "align",
+        "--imu",
+        imu,
+        "--lat",
+        "30",
+        "--json",
+        ic.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("\"sinsmodel imu-check\", not \"sinsmodel align\""),
+        "{err}"
+    );
+    // plots: a user's PNG is refused, allan's own replaced
+    let prefix = d.join("a");
+    let a_json = d.join("a.json");
+    let allan = |force: bool| {
+        let mut a = vec![
+            "allan",
+            "--imu",
+            imu,
+            "--json",
+            a_json.to_str().unwrap(),
+            "--plot",
+            prefix.to_str().unwrap(),
+        ];
+        if force {
+            a.push("--force");
+        }
+        run(&a)
+    };
+    let (ok, err) = allan(false);
+    assert!(ok, "{err}");
+    let (ok, err) = allan(false);
+    assert!(ok, "its own plots: {err}");
+    std::fs::write(d.join("a_gyro.png"), b"\x89PNG\r\n\x1a\nmine").unwrap();
+    let (ok, err) = allan(false);
+    assert!(!ok && err.contains("not a PNG marked"), "{err}");
+    let (ok, err) = allan(true);
+    assert!(ok, "{err}");
+}
+
+/// SIGINT or SIGTERM during a run removes its staging directory at once (not at the next run),
+/// exits 128 + signal, and leaves the earlier run's directory whole.
+#[test]
+fn an_interrupted_run_leaves_no_staging_and_the_earlier_result_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let before = names(&o);
+    let ex = d.join("ex");
+    for (sig, code) in [(libc_sig::SIGINT, 130), (libc_sig::SIGTERM, 143)] {
+        // the embedded demo into the simulation's directory would be refused; into its own
+        let child = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
+            .args(["explain", "--out", ex.to_str().unwrap()])
+            .stderr(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // wait for the staging directory to appear
+        let t0 = std::time::Instant::now();
+        while !names(d)
+            .iter()
+            .any(|n| n.starts_with(".ex.sinsmodel-staging-"))
+        {
+            assert!(t0.elapsed().as_secs() < 60, "no staging directory appeared");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        Command::new("kill")
+            .args([format!("-{sig}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{err}");
+        assert!(err.contains("unfinished output"), "{err}");
+        let left: Vec<String> = names(d)
+            .into_iter()
+            .filter(|n| n.contains("sinsmodel-"))
+            .collect();
+        assert!(left.is_empty(), "left behind: {left:?}");
+        assert!(!ex.exists());
+    }
+    assert_eq!(names(&o), before);
+}
+
+/// Signal numbers (Linux and the BSDs agree on these two).
+mod libc_sig {
+    pub const SIGINT: i32 = 2;
+    pub const SIGTERM: i32 = 15;
+}
+
+/// Past a file-size limit (`ulimit -f`) a write fails with an error naming the file (no
+/// SIGXFSZ death, no message-less exit) and no temporary is left.
+#[test]
+fn a_file_size_limit_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let script = format!(
+        "ulimit -f 20; exec '{}' navigate --imu '{}' --lat 30 --lon 110 --att 0,0,0 --out-rate 100 --out '{}'",
+        env!("CARGO_BIN_EXE_sinsmodel"),
+        o.join("imu.txt").display(),
+        d.join("big.txt").display()
+    );
+    let out = Command::new("sh").args(["-c", &script]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cannot write") && err.contains("big.txt") && err.contains("too large"),
+        "{err}"
+    );
+    let left: Vec<String> = names(d).into_iter().filter(|n| n.contains("big")).collect();
+    assert!(left.is_empty(), "{left:?}");
+}
