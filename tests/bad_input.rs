@@ -487,3 +487,123 @@ fn a_scenario_that_would_take_hours_is_refused_with_its_estimate() {
     assert!(t.elapsed().as_secs() < 30, "refused before any work");
     assert!(!dir.path().join("o").exists());
 }
+
+/// A unit, scale or clock slip in the IMU file (accelerometers in g read as m/s², gyros in deg/s
+/// read as rad/s, a time in ms read as s) is refused by `filter`, `explain` and `navigate`
+/// before the run, with the likely cause named; `--force` runs anyway.
+#[test]
+fn imu_unit_and_clock_slips_are_refused_with_their_cause() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let o = d.join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(o.join("imu.txt")).unwrap();
+    let rewrite = |name: &str, f: &dyn Fn(&[f64]) -> Vec<f64>| {
+        let mut out = String::new();
+        for l in text.lines() {
+            if l.starts_with('#') {
+                out.push_str(l);
+            } else {
+                let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                let w = f(&v);
+                out.push_str(
+                    &w.iter()
+                        .map(|x| format!("{x:.15e}"))
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                );
+            }
+            out.push('\n');
+        }
+        let p = d.join(name);
+        std::fs::write(&p, out).unwrap();
+        p
+    };
+    let g = 9.80665;
+    let deg = 180.0 / std::f64::consts::PI;
+    let cases = [
+        (
+            rewrite("g.txt", &|v| {
+                vec![v[0], v[1], v[2], v[3], v[4] / g, v[5] / g, v[6] / g]
+            }),
+            "look like g read as m/s²",
+        ),
+        (
+            rewrite("ms.txt", &|v| {
+                vec![v[0] * 1000.0, v[1], v[2], v[3], v[4], v[5], v[6]]
+            }),
+            "time in ms read as s",
+        ),
+        (
+            rewrite("dps.txt", &|v| {
+                vec![v[0], v[1] * deg, v[2] * deg, v[3] * deg, v[4], v[5], v[6]]
+            }),
+            "deg/s read as rad/s",
+        ),
+    ];
+    let gnss = o.join("gnss.txt");
+    for (imu, cause) in &cases {
+        let imu_s = imu.to_str().unwrap();
+        let filter = |force: bool| {
+            let out = d.join("f");
+            let mut a = vec![
+                "filter",
+                "--model",
+                "P28",
+                "--imu",
+                imu_s,
+                "--aid",
+                gnss.to_str().unwrap(),
+                "--init",
+                "30,110,0,0,0,0",
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            if force {
+                a.push("--force");
+            }
+            run(&a)
+        };
+        let (ok, err) = filter(false);
+        assert!(
+            !ok && err.contains(cause) && err.contains("--imu"),
+            "{cause}: {err}"
+        );
+        let (ok, err) = run(&[
+            "explain",
+            "--model",
+            "P28",
+            "--imu",
+            imu_s,
+            "--aid",
+            gnss.to_str().unwrap(),
+            "--init",
+            "30,110,0,0,0,0",
+            "--out",
+            d.join("e").to_str().unwrap(),
+        ]);
+        assert!(!ok && err.contains(cause), "explain, {cause}: {err}");
+        let (ok, err) = navigate(imu, &d.join("nav.txt"));
+        assert!(!ok && err.contains(cause), "navigate, {cause}: {err}");
+        let (ok, err) = filter(true);
+        assert!(
+            ok && err.contains("(--force given)"),
+            "{cause}, --force: {err}"
+        );
+    }
+    // the data as written run without a word about units
+    let (ok, err) = navigate(&o.join("imu.txt"), &d.join("nav.txt"));
+    assert!(ok && !err.contains("warning"), "{err}");
+}

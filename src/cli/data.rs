@@ -907,6 +907,20 @@ impl DataArgs {
         let head = sinsmodel::io::imu::ImuData {
             samples: imu.head().to_vec(),
         };
+        // magnitudes before anything is run on them: a unit, scale or clock slip (deg/s as
+        // rad/s, g as m/s², ms as s) gives plausible-looking nonsense downstream
+        let slips = sinsmodel::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true)
+            .unit_problems;
+        if let Some(p) = slips.first() {
+            if args.force {
+                eprintln!("warning: --imu {}: {p} (--force given)", imu_path.display());
+            } else {
+                bail!(
+                    "--imu {}: {p} (in the first 10 s; `sinsmodel imu-check` shows what was read; --force runs anyway)",
+                    imu_path.display()
+                );
+            }
+        }
         if let Some(p) =
             sinsmodel::estimate::align::attitude_contradicts_gravity(&head, roll, pitch)
                 .filter(|_| !auto)

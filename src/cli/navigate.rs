@@ -106,8 +106,20 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     };
     let check =
         sinsmodel::estimate::imu_check::check(&head, Some(args.lat.to_radians()), 0.0, 10.0, true);
-    for p in &check.problems {
+    for p in check
+        .problems
+        .iter()
+        .filter(|p| !check.unit_problems.contains(p))
+    {
         eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
+    }
+    // a unit, scale or clock slip is refused: navigating on it gives hours of nonsense
+    if let Some(p) = check.unit_problems.first() {
+        if args.force {
+            eprintln!("warning: {p} (--force given)");
+        } else {
+            bail!("--imu: {p} (in the first 10 s; `sinsmodel imu-check` shows what was read; --force runs anyway)");
+        }
     }
     let d = std::f64::consts::PI / 180.0;
     if let Some(p) = sinsmodel::estimate::align::attitude_contradicts_gravity(

@@ -52,6 +52,10 @@ pub struct ImuCheck {
     pub tilt_deg: f64,
     /// What is wrong, each with what to check; empty when the log is plausible.
     pub problems: Vec<String>,
+    /// The subset of `problems` that only a unit, scale or clock slip explains (|f| far from
+    /// gravity, the mean rate 57.3× or over 1000× Earth rate at rest): `filter`, `explain` and
+    /// `navigate` refuse to start on them without `--force`.
+    pub unit_problems: Vec<String>,
     /// Remarks that are not errors.
     pub notes: Vec<String>,
 }
@@ -73,7 +77,15 @@ pub fn check(
     let gaps = intervals.iter().filter(|d| **d > 2.0 * median).count();
     intervals.sort_by(f64::total_cmp);
     let t_first = s.first().map(|x| x.t).unwrap_or(0.0);
-    let (w0, w1) = (t_first + skip_s, t_first + skip_s + window_s);
+    let w0 = t_first + skip_s;
+    // the window holds at least ten intervals (a clock read 1000× slow leaves one in 10 s)
+    let tenth = s
+        .iter()
+        .skip_while(|x| x.t <= w0)
+        .nth(10)
+        .map(|x| x.t)
+        .unwrap_or(f64::NEG_INFINITY);
+    let w1 = (w0 + window_s).max(tenth);
     // means with each sample's own interval (the first sample's interval is unknown: skipped)
     let (mut sdv, mut sdth, mut sdt) = (Vector3::zeros(), Vector3::zeros(), 0.0);
     let mut rates: Vec<Vector3<f64>> = Vec::new();
@@ -89,6 +101,7 @@ pub fn check(
         rates.push(b.dv / dt);
     }
     let mut problems = Vec::new();
+    let mut unit_problems = Vec::new();
     let mut notes = Vec::new();
     let g = earth::gravity(lat.unwrap_or(std::f64::consts::FRAC_PI_4), 0.0);
     let omega = earth::OMEGA;
@@ -128,12 +141,15 @@ pub fn check(
         // no vehicle averages 0.5 g or 2 g of specific force over seconds: a unit error shows
         // even while moving
         if !(0.5..2.0).contains(&gravity_ratio) {
-            problems.push(format!(
+            let p = format!(
                 "mean specific force |f| = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
-                 while moving too: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong",
+                 while moving too: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong{}",
                 crate::explain::sig3(f.norm()),
-                crate::explain::sig3(gravity_ratio)
-            ));
+                crate::explain::sig3(gravity_ratio),
+                unit_hint(g / f.norm())
+            );
+            problems.push(p.clone());
+            unit_problems.push(p);
         }
         notes.push(format!(
             "the window {w0:.1}–{w1:.1} s is not static (specific force varies by {spread:.2} m/s² RMS): \
@@ -141,52 +157,35 @@ pub fn check(
         ));
     } else {
         if (gravity_ratio - 1.0).abs() > 0.05 {
-            let k = g / f.norm();
-            let hint = [
-                (
-                    crate::io::units::STANDARD_GRAVITY,
-                    "the values look like g: accel_unit = \"g\" (or \"g*s\" for increments)",
-                ),
-                (
-                    crate::io::units::STANDARD_GRAVITY * 1e-3,
-                    "the values look like mg: accel_unit = \"mg\"",
-                ),
-                (
-                    1.0 / crate::io::units::STANDARD_GRAVITY,
-                    "the values look like m/s^2 described as g: accel_unit = \"m/s^2\"",
-                ),
-                (
-                    1e-3,
-                    "a factor 1000 off: the time unit ([time] unit) or mm/s vs m/s",
-                ),
-                (
-                    1e3,
-                    "a factor 1000 off: the time unit ([time] unit) or mm/s vs m/s",
-                ),
-            ]
-            .iter()
-            .find(|(r, _)| (k / r - 1.0).abs() < 0.05)
-            .map(|(_, h)| format!("; {h}"))
-            .unwrap_or_default();
-            problems.push(format!(
+            let p = format!(
                 "mean specific force |f| = {:.4} m/s² on a static stretch is {:.3}× local gravity ({g:.4} m/s²): \
-                 the accelerometer unit (or scale, or the clock) is wrong — check accel_unit and [time] unit{hint}",
+                 the accelerometer unit (or scale, or the clock) is wrong — check accel_unit and [time] unit{}",
                 f.norm(),
-                gravity_ratio
-            ));
+                gravity_ratio,
+                unit_hint(g / f.norm())
+            );
+            // beyond 20 % no calibration error explains it
+            if !(0.8..1.25).contains(&gravity_ratio) {
+                unit_problems.push(p.clone());
+            }
+            problems.push(p);
         }
         let r2d = 180.0 / std::f64::consts::PI;
         if (earth_rate_ratio / r2d - 1.0).abs() < 0.05 {
-            problems.push(format!(
+            let p = format!(
                 "mean angular rate on a static stretch is {earth_rate_ratio:.2}× Earth rate, within 5 % of 57.3 (degrees per radian): the gyro values look like deg/s read as rad/s — check gyro_unit"
-            ));
+            );
+            problems.push(p.clone());
+            unit_problems.push(p);
         } else if earth_rate_ratio > 1000.0 {
-            problems.push(format!(
+            let p = format!(
                 "mean angular rate {:.4} deg/s on a static stretch is {:.0}× Earth rate (even MEMS gyro \
                  biases stay below ~100×): check gyro_unit (deg/s read as rad/s gives 57.3×)",
                 w.norm() * deg,
                 earth_rate_ratio
-            ));
+            );
+            problems.push(p.clone());
+            unit_problems.push(p);
         } else if earth_rate_ratio < 0.2 {
             problems.push(format!(
                 "mean angular rate {:.3e} deg/h on a static stretch is {:.3}× Earth rate (15.04 deg/h), which \
@@ -259,6 +258,38 @@ pub fn check(
         heading_deg: heading,
         tilt_deg: tilt * deg,
         problems,
+        unit_problems,
         notes,
     }
+}
+
+/// The likely slip behind a specific force `k` times too small (`k` = gravity / |f|), when it
+/// is one of the usual factors.
+fn unit_hint(k: f64) -> String {
+    [
+        (
+            crate::io::units::STANDARD_GRAVITY,
+            "the values look like g read as m/s²: accel_unit = \"g\" (or \"g*s\" for increments)",
+        ),
+        (
+            crate::io::units::STANDARD_GRAVITY * 1e-3,
+            "the values look like mg: accel_unit = \"mg\"",
+        ),
+        (
+            1.0 / crate::io::units::STANDARD_GRAVITY,
+            "the values look like m/s^2 described as g: accel_unit = \"m/s^2\"",
+        ),
+        (
+            1e3,
+            "a factor 1000 off: time in ms read as s ([time] unit) divides the increments by a 1000× longer interval, or mm/s read as m/s",
+        ),
+        (
+            1e-3,
+            "a factor 1000 off: time in s read as ms ([time] unit), or m/s read as mm/s",
+        ),
+    ]
+    .iter()
+    .find(|(r, _)| k.is_finite() && (k / r - 1.0).abs() < 0.05)
+    .map(|(_, h)| format!("; {h}"))
+    .unwrap_or_default()
 }

@@ -19,6 +19,8 @@ use std::path::Path;
 pub const HEAD_SECONDS: f64 = 10.0;
 /// Most samples read ahead when a stream opens.
 pub const HEAD_MAX_SAMPLES: usize = 200_000;
+/// Fewest samples read ahead, whatever their span (a time in ms read as s makes 10 s hold one).
+pub const HEAD_MIN_SAMPLES: usize = 20;
 /// Largest angular rate any IMU measures [rad/s].
 pub const MAX_RATE: f64 = 100.0;
 /// Largest specific force any IMU measures [m/s²] (2000 g).
@@ -128,7 +130,8 @@ impl ImuStream {
             }
             let span = head.first().map(|f| s.t - f.0.t).unwrap_or(0.0);
             head.push((s, line));
-            if span >= HEAD_SECONDS {
+            // (and at least HEAD_MIN_SAMPLES: a clock read 1000× slow still shows its samples)
+            if span >= HEAD_SECONDS && head.len() >= HEAD_MIN_SAMPLES {
                 break;
             }
         }
