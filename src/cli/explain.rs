@@ -26,7 +26,8 @@ pub struct ExplainArgs {
     #[command(flatten)]
     data: DataArgs,
     /// Candidate terms: names and prefix groups (`kaq_*,kas_y,d_*`); default every spec term
-    /// the baseline lacks.
+    /// the baseline lacks. `!name` or `!prefix*` withholds (`!size_*,!tau_*`: every term but
+    /// those).
     #[arg(long)]
     candidates: Option<String>,
     /// Family-wise false-alarm level of the candidate tests (Holm-corrected), in (0, 0.5].
@@ -111,7 +112,13 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
                 .filter(|&&t| common::TERMS[t].sensor == Sensor::Gnss)
                 .map(|&t| common::TERMS[t].name)
                 .collect();
-            if args.candidates.is_some() && !gnss.is_empty() {
+            // (named by the user: a list of withholdings only starts from every term)
+            let named = args.candidates.as_deref().is_some_and(|c| {
+                c.split(',')
+                    .map(str::trim)
+                    .any(|i| !i.is_empty() && !i.starts_with('!'))
+            });
+            if named && !gnss.is_empty() {
                 bail!(
                     "--candidates: {} {} GNSS term{} (entering the fixes of a GNSS receiver); without --aid there is none",
                     gnss.join(", "),

@@ -107,11 +107,16 @@ pub struct ResidualStructure {
 
 impl PassStats {
     /// The channels whose innovations show structure (correlated in time or biased over a
-    /// segment); empty for a pass whose innovations look white and unbiased.
+    /// segment); empty for a pass whose innovations look white and unbiased. Channels whose
+    /// mean NIS lies below half its band's lower end are left out (their stated σ dominates).
     pub fn structure(&self) -> Vec<ResidualStructure> {
         let k = self.channels.len().max(1) as f64;
         self.channels
             .iter()
+            // innovations far below their stated σ (a noise-free static aid at a stated 1 m)
+            // are the filter's own smooth error: correlated by construction, no sign of a
+            // missing effect
+            .filter(|c| c.nis_mean >= 0.5 * c.nis_band[0])
             .filter_map(|c| {
                 let whiteness_p = c.whiteness_p.map(|p| (p * k).min(1.0));
                 let worst = c

@@ -359,19 +359,65 @@ impl Consistency {
         Some(match self.split.as_str() {
             "time" if g.len() == 2 => pair("the first and the second half of the data"),
             "speed" if g.len() == 2 => pair("the slower and the faster half of the updates"),
-            _ => format!(
-                "grouped by {}, the updates give {} {unit} (χ² {} on {} degrees of freedom): it does not hold across the data",
-                match self.split.as_str() {
-                    "motion" => "the last rotation's axis",
-                    other => other,
-                },
-                g.iter()
-                    .map(|x| format!("{} ± {} {}", sig3(x.estimate), sig3(x.sigma), x.group))
+            _ => {
+                // the words name the groups that carry information (σ within 100× the best
+                // group's) and, of many, the four farthest from the weighted mean; the JSON
+                // keeps every group
+                let best = g.iter().map(|x| x.sigma).fold(f64::INFINITY, f64::min);
+                let informative: Vec<&GroupEstimate> =
+                    g.iter().filter(|x| x.sigma <= 100.0 * best).collect();
+                let (sw, swe) = informative.iter().fold((0.0, 0.0), |(a, b), x| {
+                    let w = 1.0 / (x.sigma * x.sigma);
+                    (a + w, b + w * x.estimate)
+                });
+                let mean = swe / sw;
+                let mut shown: Vec<usize> = (0..informative.len()).collect();
+                if shown.len() > 5 {
+                    let off = |k: usize| {
+                        let x = informative[k];
+                        (x.estimate - mean).abs() / x.sigma
+                    };
+                    shown.sort_by(|&a, &b| off(b).total_cmp(&off(a)));
+                    shown.truncate(4);
+                    shown.sort_unstable();
+                }
+                let mut list = shown
+                    .iter()
+                    .map(|&k| {
+                        let x = informative[k];
+                        format!("{} ± {} {}", sig3(x.estimate), sig3(x.sigma), x.group)
+                    })
                     .collect::<Vec<_>>()
-                    .join(", "),
-                sig3(self.chi2),
-                self.dof
-            ),
+                    .join(", ");
+                if shown.len() < informative.len() {
+                    list.push_str(&format!(
+                        " (the {} farthest from their weighted mean {} of {} groups)",
+                        shown.len(),
+                        sig3(mean),
+                        informative.len()
+                    ));
+                }
+                if informative.len() < g.len() {
+                    list.push_str(&format!(
+                        "; {} group{} without information left out",
+                        g.len() - informative.len(),
+                        if g.len() - informative.len() == 1 {
+                            ""
+                        } else {
+                            "s"
+                        }
+                    ));
+                }
+                format!(
+                    "grouped by {}, the updates give {list} {unit} (χ² {} on {} degrees of freedom): it does not hold across the data",
+                    match self.split.as_str() {
+                        "motion" => "the last rotation's axis",
+                        other => other,
+                    },
+                    sig3(self.chi2),
+                    self.dof
+                )
+            }
         })
     }
 }

@@ -183,7 +183,22 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
                 .into(),
         );
     }
-    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+    let items: Vec<&str> = spec
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect();
+    // `!name` or `!prefix*` withholds: from the given terms, or from every term when only
+    // withholdings are given (`!size_*,!tau_*`)
+    let (withheld, given): (Vec<&str>, Vec<&str>) = items.iter().partition(|i| i.starts_with('!'));
+    if given.is_empty() {
+        out = (0..common::TERM_COUNT).filter(|&t| !in_base(t)).collect();
+    }
+    for item in given.iter().chain(&withheld) {
+        let (drop, item) = match item.strip_prefix('!') {
+            Some(rest) => (true, rest.trim()),
+            None => (false, *item),
+        };
         let matched: Vec<usize> = match item.strip_suffix('*') {
             Some(prefix) => (0..common::TERM_COUNT)
                 .filter(|&t| common::TERMS[t].name.starts_with(prefix))
@@ -198,11 +213,20 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
                 did_you_mean(item.trim_end_matches('*'))
             ));
         }
+        if drop {
+            out.retain(|t| !matched.contains(t));
+            continue;
+        }
         for t in matched {
             if !out.contains(&t) {
                 out.push(t);
             }
         }
+    }
+    if out.is_empty() {
+        return Err(format!(
+            "--candidates {spec}: withholds every candidate; nothing is left to test"
+        ));
     }
     Ok(out)
 }
@@ -711,9 +735,11 @@ fn select_and_retest(
             // the extended filter's prior must hold what the data say: a GLR estimate beyond
             // 2 prior σ widens it to 3 (|θ̂| + σ̂)
             let info_t = &common::TERMS[t];
+            // (never past the σ the term can physically have: its spec `limit`)
             if s.glr.abs() * info_t.display_to_si > 2.0 * prior_sigma(t, opts) {
+                let wide = 3.0 * (s.glr.abs() + s.glr_sigma) * info_t.display_to_si;
                 r.widened
-                    .push((t, 3.0 * (s.glr.abs() + s.glr_sigma) * info_t.display_to_si));
+                    .push((t, wide.min(info_t.limit).max(prior_sigma(t, opts))));
             }
             r.named.push(named);
             added.push(t);
@@ -928,6 +954,18 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
         .iter()
         .filter_map(|c| c.disagreement(&f.unit))
         .collect();
+    // a value the term cannot physically have is no property of the sensor
+    if let Some(info) = common::TERMS.iter().find(|t| t.name == f.term) {
+        if (f.estimate * info.display_to_si).abs() > info.limit {
+            why.push(format!(
+                "{} {} is beyond the {} {} the term can physically have (its `limit` in model-spec/terms.toml)",
+                sig3(f.estimate),
+                f.unit,
+                sig3(info.limit / info.display_to_si),
+                f.unit
+            ));
+        }
+    }
     let z = f.prior_sigmas;
     // the posterior prefers the fitted value to none only when the data's support (2Δℓ)
     // outweighs the prior's objection to a value at z prior σ (z²)
@@ -1186,6 +1224,25 @@ mod tests {
     }
 
     #[test]
+    fn candidates_can_be_withheld_by_name_or_family() {
+        let base = Model::parse("P28").unwrap();
+        let name =
+            |v: &[usize]| -> Vec<&str> { v.iter().map(|&t| common::TERMS[t].name).collect() };
+        let all = parse_candidates(None, &base).unwrap();
+        let no_size = parse_candidates(Some("!size_*"), &base).unwrap();
+        assert!(name(&no_size).iter().all(|n| !n.starts_with("size_")));
+        let sizes = name(&all).iter().filter(|n| n.starts_with("size_")).count();
+        assert!(sizes >= 9 && no_size.len() == all.len() - sizes);
+        let v = parse_candidates(Some("kaq_*, !kaq_x_xy ,d_x"), &base).unwrap();
+        assert!(name(&v).contains(&"d_x") && !name(&v).contains(&"kaq_x_xy"));
+        assert!(name(&v).contains(&"kaq_y_xy"));
+        let e = parse_candidates(Some("!nope_*"), &base).unwrap_err();
+        assert!(e.contains("unknown term `nope_*`"), "{e}");
+        let e = parse_candidates(Some("d_x,!d_*"), &base).unwrap_err();
+        assert!(e.contains("withholds every candidate"), "{e}");
+    }
+
+    #[test]
     fn structure_left_is_time_correlation_or_a_biased_segment() {
         let channel = |p: Option<f64>, bias: f64, count: usize| ChannelStats {
             channel: "vel_n".into(),
@@ -1236,5 +1293,9 @@ mod tests {
         };
         assert!(three(0.004).structure().is_empty());
         assert!(three(0.003).structure()[0].correlated);
+        // innovations far below their stated σ are the filter's smooth error: not structure
+        let mut quiet = channel(Some(1e-300), 0.0, 100);
+        quiet.nis_mean = 0.003;
+        assert!(pass(vec![quiet]).structure().is_empty());
     }
 }

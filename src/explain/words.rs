@@ -172,6 +172,7 @@ pub(super) fn finding_words(
     let group = info
         .group
         .trim_start_matches("accel ")
+        .trim_start_matches("accelerometer ")
         .trim_start_matches("gyro ");
     let bias = if info.sensor == Sensor::Accel {
         "bias"
@@ -363,13 +364,21 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             .collect::<Vec<_>>()
             .join(" ");
         let gain = sig3(e.baseline_priors_gain.unwrap_or(0.0));
+        // the check runs on the model explain recommends: the baseline plus its causes
+        let with = if e.findings.iter().any(|f| f.is_cause() && f.kind != "noise") {
+            "even with the findings added"
+        } else {
+            "with no term added"
+        };
         out.push(if e.baseline_priors_widened {
             format!(
-                "The baseline's priors are too tight for this sensor: even with the findings added, {values}. A baseline held to priors the data reject is biased and its bias would be explained, so explain ran again with {options}: the baseline's log-likelihood rises by 2Δℓ {gain}, and what follows is that run. Give them, or the --grade of your sensor, yourself."
+                "The baseline's priors are too tight for this sensor: {with}, {values}. A baseline held to priors the data reject is biased and its bias would be explained, so explain ran again with {options}: the baseline's log-likelihood rises by 2Δℓ {gain}, and what follows is that run. Give them, or the --grade of your sensor, yourself."
             )
         } else {
             format!(
-                "Even with the findings added, {values}; but widening those priors ({options}) does not raise the baseline's likelihood enough (2Δℓ {gain}): the data do not ask for them, and what follows keeps the priors as given. Such values usually pair with a term fitted beside them (see the stand-ins below)."
+                "{}{} {values}; but widening those priors ({options}) does not raise the baseline's likelihood enough (2Δℓ {gain}): the data do not ask for them, and what follows keeps the priors as given. Such values usually pair with a term fitted beside them (see the stand-ins below).",
+                with[..1].to_uppercase(),
+                &with[1..]
             )
         });
     }
