@@ -373,6 +373,10 @@ fn probe() {
     if let Ok(w) = std::env::var("WITHHOLD") {
         case = case.withholding(&w.split(',').collect::<Vec<_>>());
     }
+    // NOISE=1: a turntable case's aiding treated like a receiver's (noise levels tested)
+    if std::env::var("NOISE").is_ok() {
+        case.static_aid = false;
+    }
     let out = run_hidden_case(&case, &ExplainOptions::default()).expect("explain runs");
     eprintln!("{}", case.description);
     if std::env::var("SCEN").is_ok() {
@@ -405,6 +409,24 @@ fn probe() {
                 .map(|c| format!("{} χ² {:.1}/{}", c.split, c.chi2, c.dof))
                 .collect::<Vec<_>>()
         );
+    }
+    if std::env::var("SHOW_GROUPS").is_ok() {
+        for f in &e.findings {
+            for c in &f.consistency {
+                eprintln!(
+                    "  {} {}: χ² {:.1}/{} holds {} {:?}",
+                    f.term,
+                    c.split,
+                    c.chi2,
+                    c.dof,
+                    c.holds,
+                    c.groups
+                        .iter()
+                        .map(|g| format!("{} {:.3}±{:.3}", g.group, g.estimate, g.sigma))
+                        .collect::<Vec<_>>()
+                );
+            }
+        }
     }
     for (h, (x, s)) in case.hidden.iter().zip(&out.oracle_estimates) {
         eprintln!("  true {} {:.4e}, oracle {:.4e} ± {:.1e}", h.0, h.1, x, s);

@@ -57,7 +57,7 @@ fn a_run_directory_needs_a_marker_that_lists_its_files() {
     let o = simulate(d);
     let marker = o.join(".sinsmodel-run");
     let listing = std::fs::read_to_string(&marker).unwrap();
-    assert!(listing.starts_with("written by sinsmodel; its files:\n"));
+    assert!(listing.starts_with("written by sinsmodel simulate; its files:\n"));
     // a re-run over its own complete output replaces it
     let (ok, err) = simulate_into(d, &o);
     assert!(ok, "{err}");
@@ -368,4 +368,143 @@ fn a_file_size_limit_is_an_error_naming_the_file() {
     );
     let left: Vec<String> = names(d).into_iter().filter(|n| n.contains("big")).collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// A run killed between its two renames leaves the earlier result only in its set-aside
+/// directory: the next run into the same place restores it (even one that then fails) instead
+/// of sweeping it away; a set-aside directory holding anything unlisted is never swept.
+#[test]
+fn a_set_aside_earlier_run_is_restored_not_swept() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let before = names(&o);
+    // the state a SIGKILL between the renames leaves: no target, the earlier run aside
+    let aside = d.join(".o.sinsmodel-old-4194304");
+    std::fs::rename(&o, &aside).unwrap();
+    // a run that fails on its input still restores the earlier result first
+    let bad = d.join("bad.txt");
+    std::fs::write(&bad, "garbage\n").unwrap();
+    let (ok, _) = run(&[
+        "filter",
+        "--imu",
+        bad.to_str().unwrap(),
+        "--aid",
+        o.join("gnss.txt").to_str().unwrap(),
+        "--init",
+        "30,110,0,0,0,0",
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    let (ok, err) = simulate_into(d, &o);
+    assert!(ok, "{err}");
+    assert_eq!(names(&o), before);
+    assert!(!aside.exists());
+    // a set-aside directory with a file its marker does not list is the user's now: kept
+    std::fs::create_dir(&aside).unwrap();
+    std::fs::copy(o.join(".sinsmodel-run"), aside.join(".sinsmodel-run")).unwrap();
+    std::fs::write(aside.join("notes.txt"), "mine").unwrap();
+    let (ok, err) = simulate_into(d, &o);
+    assert!(ok, "{err}");
+    assert_eq!(
+        std::fs::read_to_string(aside.join("notes.txt")).unwrap(),
+        "mine"
+    );
+}
+
+/// A directory is replaced only by the command that wrote it, never through a symbolic link,
+/// and not when a file appeared in it while the run worked.
+#[test]
+fn a_run_directory_is_replaced_only_by_its_own_command_and_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let (ok, err) = run(&[
+        "explain",
+        "--demo-seconds",
+        "60",
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("holds the result of `sinsmodel simulate`, not of `explain`"),
+        "{err}"
+    );
+    assert!(o.join("imu.txt").exists());
+    let link = d.join("link");
+    std::os::unix::fs::symlink(&o, &link).unwrap();
+    let (ok, err) = simulate_into(d, &link);
+    assert!(!ok && err.contains("is a symbolic link"), "{err}");
+    // a file added during the run: the new result is not moved in, the file stays
+    let ex = d.join("ex");
+    let demo = |out: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
+            .args([
+                "explain",
+                "--demo-seconds",
+                "60",
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let out = demo(&ex).wait_with_output().unwrap();
+    assert!(out.status.success());
+    let child = demo(&ex);
+    let t0 = std::time::Instant::now();
+    while !names(d)
+        .iter()
+        .any(|n| n.starts_with(".ex.sinsmodel-staging-"))
+    {
+        assert!(t0.elapsed().as_secs() < 60, "no staging directory appeared");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    std::fs::write(ex.join("my_notes.txt"), "notes").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("changed while the run worked"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(ex.join("my_notes.txt")).unwrap(),
+        "notes"
+    );
+    assert!(!names(d).iter().any(|n| n.contains("sinsmodel-")));
+}
+
+/// What a reader opens beside the IMU file (a GNSS_IMU csv's `.tag`) is an input: no output
+/// replaces it, not even with --force.
+#[test]
+fn the_clock_file_beside_a_csv_is_an_input() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
+    if !src.join("imu_1934.csv").exists() {
+        eprintln!("skipped: ../shared/data/gnss-imu-drive is missing");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for f in ["imu_1934.csv", "imu_1934.csv.tag"] {
+        std::fs::copy(src.join(f), d.join(f)).unwrap();
+        let mut p = std::fs::metadata(d.join(f)).unwrap().permissions();
+        #[allow(clippy::permissions_set_readonly_false)]
+        p.set_readonly(false);
+        std::fs::set_permissions(d.join(f), p).unwrap();
+    }
+    let tag = d.join("imu_1934.csv.tag");
+    let before = std::fs::read(&tag).unwrap();
+    let (ok, err) = run(&[
+        "imu-check",
+        "--imu",
+        d.join("imu_1934.csv").to_str().unwrap(),
+        "--json",
+        tag.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(!ok && err.contains("is an input of this run"), "{err}");
+    assert_eq!(std::fs::read(&tag).unwrap(), before);
 }

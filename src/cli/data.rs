@@ -60,6 +60,8 @@ impl ImuSource {
         let mut v = vec![sinsmodel::io::readers::matlab::file_of(&self.imu)];
         v.extend(self.imu_format.clone());
         v.extend(sinsmodel::io::imu_format::beside(&self.imu));
+        // a GNSS_IMU csv's clock file is read beside it
+        v.push(self.imu.with_extension("csv.tag"));
         v
     }
 
@@ -442,6 +444,12 @@ impl DataArgs {
         .into_iter()
         .flatten()
         .map(|p| sinsmodel::io::readers::matlab::file_of(p))
+        .chain(self.imu.iter().flat_map(|i| {
+            // what is read beside the IMU file: its format description and a csv's clock file
+            let mut v: Vec<PathBuf> = sinsmodel::io::imu_format::beside(i).into_iter().collect();
+            v.push(i.with_extension("csv.tag"));
+            v
+        }))
         .collect()
     }
 
@@ -909,8 +917,20 @@ impl DataArgs {
         };
         // magnitudes before anything is run on them: a unit, scale or clock slip (deg/s as
         // rad/s, g as m/s², ms as s) gives plausible-looking nonsense downstream
-        let slips = sinsmodel::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true)
-            .unit_problems;
+        let check = sinsmodel::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true);
+        // a MEMS gyro's bias can reach what a unit slip gives: with --grade mems a warning
+        let mems = args.grade.as_deref() == Some("mems");
+        for p in check.gyro_unit_problems.iter().filter(|_| mems) {
+            eprintln!(
+                "warning: --imu {}: {p} (or a MEMS gyro's bias: --grade mems given)",
+                imu_path.display()
+            );
+        }
+        let slips: Vec<&String> = check
+            .unit_problems
+            .iter()
+            .chain(check.gyro_unit_problems.iter().filter(|_| !mems))
+            .collect();
         if let Some(p) = slips.first() {
             if args.force {
                 eprintln!("warning: --imu {}: {p} (--force given)", imu_path.display());

@@ -128,6 +128,12 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
             }
             cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
         }
+        if cands.is_empty() {
+            bail!(
+                "--candidates: no candidate is left to test (the baseline {} holds every term named, or only GNSS terms were named and there is no --aid)",
+                baseline.name
+            );
+        }
         let skipped = already_in_baseline(args.candidates.as_deref(), &baseline);
         // every option is checked before the (long) run
         args.data.check_prior_names(&baseline)?;
@@ -139,7 +145,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         opts.noise_levels = args.data.has_gnss();
         let inputs = args.data.input_paths();
         let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
-        let out = OutputDir::create(&args.out, &refs)?;
+        let out = OutputDir::create(&args.out, &refs, "explain")?;
         args.data.print_noise()?;
         let inputs = args.data.load_for_passes()?;
         let data = ExplainData {
@@ -237,7 +243,7 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let baseline = Model::parse(model_text)?;
     let cands = explain::parse_candidates(args.candidates.as_deref(), &baseline)
         .map_err(anyhow::Error::msg)?;
-    let out = OutputDir::create(&args.out, &[])?;
+    let out = OutputDir::create(&args.out, &[], "explain")?;
     let case = reproduce::explain_demo(seconds, seed);
     eprintln!(
         "demo: simulating {:.0} s of the paper's vibration case (6 g / 3 g at 90 Hz on N, E, D; 2 kHz) with d_x d_y d_z = 5e-5 s^2/m hidden; baseline {}",
@@ -327,6 +333,14 @@ fn finish(
     atomic_file::write_text(&out.file("report.html"), &html)?;
     out.commit()?;
     if let Some(j) = &args.json {
+        // checked again: the file may have been replaced while the run worked
+        atomic_file::check_output_file(
+            "--json",
+            j,
+            &[],
+            atomic_file::Provenance::Json("explain"),
+            args.data.force,
+        )?;
         atomic_file::write_text(j, &text)?;
     }
     for line in &e.summary {

@@ -104,7 +104,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         alpha: args.alpha,
         ..EvalSpec::default()
     };
-    let out = OutputDir::create(&args.out, &[])?;
+    let out = OutputDir::create(&args.out, &[], "explain-eval")?;
     let mut opts = explain_eval::default_options();
     opts.broken_selector = args.broken_selector;
     let mut pool = rayon::ThreadPoolBuilder::new();
@@ -199,7 +199,7 @@ fn merge(args: &EvalArgs) -> Result<()> {
     let spec = spec.context("--merge needs at least one directory")?;
     cases.sort_by_key(|c| c.index);
     let inputs: Vec<&Path> = args.merge.iter().map(|p| p.as_path()).collect();
-    let out = OutputDir::create(&args.out, &inputs)?;
+    let out = OutputDir::create(&args.out, &inputs, "explain-eval")?;
     write(&out, &spec, &cases, None)?;
     out.commit()?;
     for line in headline(&explain_eval::summarize(&spec, &cases)) {

@@ -40,7 +40,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     let mut cfg = args.data.config(&model, false)?;
     let inputs = args.data.input_paths();
     let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let out = OutputDir::create(&args.out, &refs)?;
+    let out = OutputDir::create(&args.out, &refs, "filter")?;
     args.data.print_noise()?;
     let mut inputs = args.data.open()?;
     if args.in_memory {

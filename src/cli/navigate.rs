@@ -110,6 +110,13 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         .problems
         .iter()
         .filter(|p| !check.unit_problems.contains(p))
+        .map(|p| {
+            if check.gyro_unit_problems.contains(p) {
+                format!("{p} (or an uncalibrated MEMS gyro's bias)")
+            } else {
+                p.clone()
+            }
+        })
     {
         eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
     }
@@ -201,6 +208,13 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         }
     }
     pb.finish_and_clear();
+    // checked again: the file may have been replaced while the run worked
+    args.src.check_output(
+        "--out",
+        &args.out,
+        sinsmodel::io::atomic_file::Provenance::Text("navigate"),
+        args.force,
+    )?;
     out.commit()?;
     eprintln!(
         "navigated {} samples ({:.1} s), wrote {} rows to {}",

@@ -58,7 +58,7 @@ fn model_error_series(run: &FilterRun, label: &str, comp: usize) -> Series {
 /// Runs the command.
 pub fn run(args: &ReproduceArgs) -> Result<()> {
     // one run's outputs, complete or none; a directory sinsmodel did not write is left alone
-    let dir = sinsmodel::io::atomic_file::OutputDir::create(&args.out, &[])?;
+    let dir = sinsmodel::io::atomic_file::OutputDir::create(&args.out, &[], "reproduce")?;
     if args.consistency {
         return consistency(args, dir);
     }

@@ -74,7 +74,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             EVALUATIONS_PER_S
         );
     }
-    let out = OutputDir::create(&args.out, &[args.scenario.as_path()])?;
+    let out = OutputDir::create(&args.out, &[args.scenario.as_path()], "simulate")?;
     let pb = progress::bar(1000, "simulate");
     let sim = simulate(&sc, |f| pb.set_position((f * 1000.0) as u64));
     pb.finish_and_clear();

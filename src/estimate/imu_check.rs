@@ -53,9 +53,12 @@ pub struct ImuCheck {
     /// What is wrong, each with what to check; empty when the log is plausible.
     pub problems: Vec<String>,
     /// The subset of `problems` that only a unit, scale or clock slip explains (|f| far from
-    /// gravity, the mean rate 57.3× or over 1000× Earth rate at rest): `filter`, `explain` and
-    /// `navigate` refuse to start on them without `--force`.
+    /// gravity): `filter`, `explain` and `navigate` refuse to start on them without `--force`.
     pub unit_problems: Vec<String>,
+    /// The gyro problems a unit slip likely explains (the mean rate at rest 57.3× or over 1000×
+    /// Earth rate), which an uncalibrated MEMS gyro's bias can also give: refused unless the
+    /// sensor is said to be MEMS grade.
+    pub gyro_unit_problems: Vec<String>,
     /// Remarks that are not errors.
     pub notes: Vec<String>,
 }
@@ -102,6 +105,7 @@ pub fn check(
     }
     let mut problems = Vec::new();
     let mut unit_problems = Vec::new();
+    let mut gyro_unit_problems = Vec::new();
     let mut notes = Vec::new();
     let g = earth::gravity(lat.unwrap_or(std::f64::consts::FRAC_PI_4), 0.0);
     let omega = earth::OMEGA;
@@ -176,7 +180,7 @@ pub fn check(
                 "mean angular rate on a static stretch is {earth_rate_ratio:.2}× Earth rate, within 5 % of 57.3 (degrees per radian): the gyro values look like deg/s read as rad/s — check gyro_unit"
             );
             problems.push(p.clone());
-            unit_problems.push(p);
+            gyro_unit_problems.push(p);
         } else if earth_rate_ratio > 1000.0 {
             let p = format!(
                 "mean angular rate {:.4} deg/s on a static stretch is {:.0}× Earth rate (even MEMS gyro \
@@ -185,7 +189,7 @@ pub fn check(
                 earth_rate_ratio
             );
             problems.push(p.clone());
-            unit_problems.push(p);
+            gyro_unit_problems.push(p);
         } else if earth_rate_ratio < 0.2 {
             problems.push(format!(
                 "mean angular rate {:.3e} deg/h on a static stretch is {:.3}× Earth rate (15.04 deg/h), which \
@@ -259,6 +263,7 @@ pub fn check(
         tilt_deg: tilt * deg,
         problems,
         unit_problems,
+        gyro_unit_problems,
         notes,
     }
 }

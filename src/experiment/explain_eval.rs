@@ -62,6 +62,9 @@ pub struct CaseResult {
     /// Noise levels explain named (noise findings: a claim about the data's noise, not a term).
     #[serde(default)]
     pub noise_named: Vec<String>,
+    /// Of those, the ones it labelled "not one level across the data" (stand-ins).
+    #[serde(default)]
+    pub noise_stand_ins: Vec<String>,
     /// The hidden term was named or is in a named class.
     pub detected: bool,
     /// A named term is neither the hidden one nor in a class with it (or anything in a null case).
@@ -153,6 +156,12 @@ pub fn run_case(
         .filter(|f| f.kind == "noise")
         .map(|f| f.term.clone())
         .collect();
+    let noise_stand_ins: Vec<String> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind == "noise" && f.stand_in.is_some())
+        .map(|f| f.term.clone())
+        .collect();
     let (mut detected, mut estimate, mut sigma) = (false, None, None);
     if let Some(t) = term {
         let name = common::TERMS[t].name;
@@ -186,6 +195,7 @@ pub fn run_case(
         lambda,
         named,
         noise_named,
+        noise_stand_ins,
         detected,
         wrong_term,
         estimate,

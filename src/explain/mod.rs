@@ -199,6 +199,11 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
             Some(rest) => (true, rest.trim()),
             None => (false, *item),
         };
+        if item.is_empty() {
+            return Err(
+                "--candidates: `!` needs a term or a family after it (`!size_*`, `!tau_x`)".into(),
+            );
+        }
         let matched: Vec<usize> = match item.strip_suffix('*') {
             Some(prefix) => (0..common::TERM_COUNT)
                 .filter(|&t| common::TERMS[t].name.starts_with(prefix))

@@ -239,21 +239,176 @@ pub(super) fn stage(
         .map(|f| f.two_delta_loglik)
         .sum();
     let (arw, vrw) = cfg.sensor_noise(&r.model);
-    let findings = fits
-        .iter()
-        .filter(|f| f.significant)
-        .map(|f| {
-            let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
-            noise_finding(
-                f,
-                arw,
-                vrw,
-                excess.map(|e| removed * w / e),
-                f.two_delta_loglik,
-            )
-        })
-        .collect();
+    // a noise level is a constant of the sensor or the receiver: fitted on parts of the data
+    // apart (while the body rotates or turns and otherwise; each half), it gives one scale
+    let groups = innovation_groups(ctx.data, &pass)?;
+    let mut findings = Vec::new();
+    for f in fits.iter().filter(|f| f.significant) {
+        let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
+        let mut nf = noise_finding(
+            f,
+            arw,
+            vrw,
+            excess.map(|e| removed * w / e),
+            f.two_delta_loglik,
+        );
+        nf.consistency = split_scales(ctx, &r.model, &cfg_noise, f, &pass, &groups)?;
+        let why: Vec<String> = nf
+            .consistency
+            .iter()
+            .filter_map(|c| c.disagreement("× stated"))
+            .collect();
+        if !why.is_empty() {
+            let why = why.join("; ");
+            // every group's scale on the same side of 1.5×: the stated value is off throughout,
+            // by an amount that changes
+            let failing = nf.consistency.iter().filter(|c| !c.holds);
+            let (lo, hi) = failing
+                .flat_map(|c| c.groups.iter().map(|g| g.estimate))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                    (a.min(x), b.max(x))
+                });
+            let tail = if lo > 1.5 {
+                format!("the stated value is too small in every group ({}× to {}×) but no single level fits: the noise changes with the motion, or something the candidates do not describe adds to it; a filter that must be consistent everywhere needs the larger", sig3(lo), sig3(hi))
+            } else if hi < 1.0 / 1.5 {
+                format!("the stated value is too large in every group ({}× to {}×) but no single level fits: the noise changes with the motion, or something the candidates do not describe takes part of it", sig3(lo), sig3(hi))
+            } else {
+                "a noise level of the sensor or receiver is one constant; a missing term, an aiding error or noise that changes with the motion fits this way; do not read it as the stated noise being wrong".to_string()
+            };
+            nf.words.push_str(&format!(
+                ". It is not one level across the data ({why}): {tail}"
+            ));
+            nf.stand_in = Some(why);
+        }
+        findings.push(nf);
+    }
     Ok((findings, Some(pass)))
+}
+
+/// Each innovation's group in the two splits of the noise levels: (0 at rest or moving
+/// straight, 1 while the body rotates or turns, to 2 s after), and (0 first half, 1 second
+/// half of the updates).
+fn innovation_groups(data: &ExplainData, pass: &Pass) -> anyhow::Result<Vec<[usize; 2]>> {
+    // rotating spans from the rate averaged over 0.1 s
+    let mut spans: Vec<(f64, f64)> = Vec::new();
+    let mut samples = data.imu.samples()?;
+    let (mut t0, mut acc) = (f64::NAN, nalgebra::Vector3::zeros());
+    let mut on = false;
+    while let Some(smp) = samples.next_sample()? {
+        if t0.is_nan() {
+            t0 = smp.t;
+            continue;
+        }
+        acc += smp.dtheta;
+        if smp.t - t0 >= 0.1 {
+            let rate = acc.norm() / (smp.t - t0);
+            if rate > super::signatures::ROTATING {
+                if !on {
+                    spans.push((t0, smp.t));
+                }
+                on = true;
+                if let Some(last) = spans.last_mut() {
+                    last.1 = smp.t;
+                }
+            } else if rate < 0.5 * super::signatures::ROTATING {
+                on = false;
+            }
+            t0 = smp.t;
+            acc = nalgebra::Vector3::zeros();
+        }
+    }
+    let inn = &pass.run.innovations;
+    let half = inn.len() / 2;
+    Ok(inn
+        .iter()
+        .enumerate()
+        .map(|(k, i)| {
+            let moving = spans.iter().any(|&(a, b)| i.t >= a && i.t <= b + 2.0);
+            [usize::from(moving), usize::from(k >= half)]
+        })
+        .collect())
+}
+
+/// Level `f`'s scale fitted on each group of each split apart: passes at half and twice the
+/// fitted scale beside `pass` (which has it), a parabola in log₂ s through each group's
+/// log-likelihood; σ from its curvature. Groups without curvature carry no information.
+fn split_scales(
+    ctx: &Context,
+    model: &Model,
+    cfg: &FilterConfig,
+    f: &LevelFit,
+    pass: &Pass,
+    groups: &[[usize; 2]],
+) -> anyhow::Result<Vec<super::Consistency>> {
+    let loglik_by_group = |p: &Pass| -> [[f64; 2]; 2] {
+        let mut l = [[0.0; 2]; 2];
+        for (i, g) in p.run.innovations.iter().zip(groups) {
+            let li = -0.5 * (i.nu * i.nu / i.s + (2.0 * std::f64::consts::PI * i.s).ln());
+            for (split, &k) in g.iter().enumerate() {
+                l[split][k] += li;
+            }
+        }
+        l
+    };
+    let mut at = Vec::new();
+    for u in [-1.0, 1.0] {
+        let mut c = cfg.clone();
+        f.level.apply(model, &mut c, 2f64.powf(u));
+        let p = run_pass(model, &[], ctx.data, &c, &mut |_| {})?;
+        if p.run.innovations.len() != groups.len() {
+            anyhow::bail!("the noise passes differ in their updates");
+        }
+        at.push(loglik_by_group(&p));
+    }
+    let mid = loglik_by_group(pass);
+    let mut out = Vec::new();
+    for (split, name, labels) in [
+        (
+            0,
+            "rotation",
+            ["at rest or moving straight", "while rotating or turning"],
+        ),
+        (1, "time", ["first half", "second half"]),
+    ] {
+        let est: Vec<(f64, f64)> = (0..2)
+            .map(|k| {
+                let (ym, y0, yp) = (at[0][split][k], mid[split][k], at[1][split][k]);
+                // ℓ(u) = a u² + b u + c through u = −1, 0, 1
+                let a = 0.5 * (yp + ym) - y0;
+                let b = 0.5 * (yp - ym);
+                if a >= 0.0 || groups.iter().all(|g| g[split] != k) {
+                    return (f64::NAN, f64::NAN);
+                }
+                // (beyond 8× of the passes the parabola is no guide: at least that far)
+                let u = (-b / (2.0 * a)).clamp(-3.0, 3.0);
+                let sigma_u = 1.0 / (-2.0 * a).sqrt();
+                // a group that cannot place the scale within a factor 4 says nothing
+                if sigma_u > 2.0 {
+                    return (f64::NAN, f64::NAN);
+                }
+                (f.scale.log2() + u, sigma_u)
+            })
+            .collect();
+        // tested in log₂ s (where the likelihood is near a parabola): the groups disagree when
+        // χ² p < 0.0027 and their scales differ by more than 1.5×
+        let mut c = super::Consistency::test(name, &|k| labels[k].to_string(), &est);
+        let spread = c
+            .groups
+            .iter()
+            .map(|g| g.estimate)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), u| {
+                (lo.min(u), hi.max(u))
+            });
+        c.holds = !(c.p_value < 0.0027 && spread.1 - spread.0 > 1.5f64.log2());
+        // said as scales of the stated value (σ by the delta method)
+        for g in &mut c.groups {
+            let scale = 2f64.powf(g.estimate);
+            g.sigma *= scale * std::f64::consts::LN_2;
+            g.estimate = scale;
+        }
+        out.push(c);
+    }
+    Ok(out)
 }
 
 /// The finding of a significant noise level: the level the data show in the user's unit, its

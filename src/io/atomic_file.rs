@@ -207,72 +207,35 @@ pub const RUN_MARKER: &str = ".sinsmodel-run";
 pub struct OutputDir {
     staging: PathBuf,
     target: PathBuf,
+    command: String,
     committed: bool,
 }
 
 impl OutputDir {
-    /// Checks `target` can be replaced and that no `inputs` lie inside it, then creates the
-    /// staging directory.
-    pub fn create(target: &Path, inputs: &[&Path]) -> Result<OutputDir> {
+    /// Checks `target` can be replaced by a run of `command` (`simulate`, `explain`, …) and that
+    /// no `inputs` lie inside it, then creates the staging directory. An earlier run that a
+    /// killed replacement left set aside (and no target) is restored first.
+    pub fn create(target: &Path, inputs: &[&Path], command: &str) -> Result<OutputDir> {
         refuse_mat_variable_name("--out", target)?;
+        if std::fs::symlink_metadata(target).is_ok_and(|m| m.file_type().is_symlink()) {
+            anyhow::bail!(
+                "--out {}: is a symbolic link; give the directory it points to (a run replaces the directory itself, not what a link points at)",
+                target.display()
+            );
+        }
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".into());
+        if !target.exists() {
+            restore_set_aside(&parent, &name, target);
+        }
         if target.exists() {
-            if !target.is_dir() {
-                anyhow::bail!("--out {}: exists and is not a directory", target.display());
-            }
-            let mut present: Vec<String> = std::fs::read_dir(target)
-                .with_context(|| format!("cannot read {}", target.display()))?
-                .filter_map(|e| e.ok())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .collect();
-            present.sort();
-            if !present.is_empty() {
-                let shown = |names: &[String]| {
-                    let mut s = names
-                        .iter()
-                        .take(20)
-                        .cloned()
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    if names.len() > 20 {
-                        s.push_str(&format!(" and {} more", names.len() - 20));
-                    }
-                    s
-                };
-                if !present.iter().any(|n| n == RUN_MARKER) {
-                    anyhow::bail!(
-                        "--out {}: the directory exists and was not written by sinsmodel (it holds {}); choose another (nothing is overwritten)",
-                        target.display(),
-                        shown(&present)
-                    );
-                }
-                // the marker must list the run's files: an empty, unreadable or foreign marker
-                // (or one of an older release, which listed none) proves nothing
-                let listed = run_listing(target).map_err(|why| {
-                    anyhow::anyhow!(
-                        "--out {}: cannot prove the directory holds only an earlier sinsmodel run's files ({why}); it holds {}. Nothing is overwritten: move what you want to keep and remove the directory, or choose another --out",
-                        target.display(),
-                        shown(&present)
-                    )
-                })?;
-                // anything not listed, or listed but no longer a plain file, was put there
-                // since, and replacing the directory would lose it
-                let foreign: Vec<String> = present
-                    .iter()
-                    .filter(|n| *n != RUN_MARKER)
-                    .filter(|n| {
-                        !listed.contains(n)
-                            || !std::fs::symlink_metadata(target.join(n)).is_ok_and(|m| m.is_file())
-                    })
-                    .cloned()
-                    .collect();
-                if !foreign.is_empty() {
-                    anyhow::bail!(
-                        "--out {}: holds files the earlier sinsmodel run did not write ({}); move them or choose another --out (nothing is overwritten)",
-                        target.display(),
-                        shown(&foreign)
-                    );
-                }
-            }
+            check_replaceable(target, command)?;
             let canon = target.canonicalize()?;
             for inp in inputs {
                 if let Ok(c) = inp.canonicalize() {
@@ -286,16 +249,8 @@ impl OutputDir {
                 }
             }
         }
-        let parent = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
         std::fs::create_dir_all(&parent)
             .with_context(|| format!("cannot create {}", parent.display()))?;
-        let name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "out".into());
         remove_stale(&parent, &name);
         let staging = sibling(target, "staging");
         if std::fs::symlink_metadata(&staging).is_ok() {
@@ -305,13 +260,20 @@ impl OutputDir {
                 staging.display()
             );
         }
-        std::fs::create_dir(&staging)
-            .with_context(|| format!("cannot create {}", staging.display()))?;
+        // registered first: a signal at any moment from here removes it
         register(&staging);
-        write_text(&staging.join(STAGING_MARKER), STAGING_TEXT)?;
+        let made = std::fs::create_dir(&staging)
+            .with_context(|| format!("cannot create {}", staging.display()))
+            .and_then(|_| write_text(&staging.join(STAGING_MARKER), STAGING_TEXT));
+        if let Err(e) = made {
+            let _ = std::fs::remove_dir_all(&staging);
+            unregister(&mut unfinished(), &staging);
+            return Err(e);
+        }
         Ok(OutputDir {
             staging,
             target: target.to_path_buf(),
+            command: command.to_string(),
             committed: false,
         })
     }
@@ -332,7 +294,7 @@ impl OutputDir {
         names.sort();
         write_text(
             &self.staging.join(RUN_MARKER),
-            &format!("{RUN_MARKER_HEADER}\n{}\n", names.join("\n")),
+            &format!("{}\n{}\n", marker_header(&self.command), names.join("\n")),
         )?;
         // (a kill between the two leaves a staging directory the sweep still recognises)
         std::fs::remove_file(self.staging.join(STAGING_MARKER))
@@ -342,6 +304,13 @@ impl OutputDir {
         // the hidden leftovers are removed by the next run. Under the registry's lock: a
         // SIGINT or SIGTERM waits for both.
         let mut list = unfinished();
+        // what the start checked may have changed while the run worked (a file added, the
+        // directory replaced): checked again, and nothing moves in if it is not replaceable
+        if self.target.exists() {
+            check_replaceable(&self.target, &self.command).context(
+                "the output directory changed while the run worked; the new result is not moved in",
+            )?;
+        }
         let old = sibling(&self.target, "old");
         if self.target.exists() {
             std::fs::rename(&self.target, &old)
@@ -356,8 +325,9 @@ impl OutputDir {
         })?;
         self.committed = true;
         unregister(&mut list, &self.staging);
-        drop(list);
+        // (still under the lock: a signal waits, so no half-deleted set-aside run is left)
         let _ = std::fs::remove_dir_all(&old);
+        drop(list);
         Ok(())
     }
 }
@@ -367,6 +337,138 @@ impl Drop for OutputDir {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
             unregister(&mut unfinished(), &self.staging);
+        }
+    }
+}
+
+/// The first line of a run's marker: `written by sinsmodel COMMAND; its files:`.
+fn marker_header(command: &str) -> String {
+    format!("written by sinsmodel {command}; its files:")
+}
+
+/// Refuses to replace the existing directory `target` unless it provably holds only a
+/// sinsmodel run's files: a valid marker listing them, of `command` (or of a release that did
+/// not record the command), and nothing else beside them.
+fn check_replaceable(target: &Path, command: &str) -> Result<()> {
+    if !target.is_dir() {
+        anyhow::bail!("--out {}: exists and is not a directory", target.display());
+    }
+    let mut present: Vec<String> = std::fs::read_dir(target)
+        .with_context(|| format!("cannot read {}", target.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    present.sort();
+    if present.is_empty() {
+        return Ok(());
+    }
+    let shown = |names: &[String]| {
+        let mut s = names
+            .iter()
+            .take(20)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join(", ");
+        if names.len() > 20 {
+            s.push_str(&format!(" and {} more", names.len() - 20));
+        }
+        s
+    };
+    if !present.iter().any(|n| n == RUN_MARKER) {
+        anyhow::bail!(
+            "--out {}: the directory exists and was not written by sinsmodel (it holds {}); choose another (nothing is overwritten)",
+            target.display(),
+            shown(&present)
+        );
+    }
+    // the marker must list the run's files: an empty, unreadable or foreign marker (or one of
+    // an older release, which listed none) proves nothing
+    let listed = run_listing(target).map_err(|why| {
+        anyhow::anyhow!(
+            "--out {}: cannot prove the directory holds only an earlier sinsmodel run's files ({why}); it holds {}. Nothing is overwritten: move what you want to keep and remove the directory, or choose another --out",
+            target.display(),
+            shown(&present)
+        )
+    })?;
+    if let Some(other) = run_command(target).filter(|c| c != command) {
+        anyhow::bail!(
+            "--out {}: holds the result of `sinsmodel {other}`, not of `{command}`; choose another --out (nothing is overwritten)",
+            target.display()
+        );
+    }
+    // anything not listed, or listed but no longer a plain file, was put there since, and
+    // replacing the directory would lose it
+    let foreign: Vec<String> = present
+        .iter()
+        .filter(|n| *n != RUN_MARKER)
+        .filter(|n| {
+            !listed.contains(n)
+                || !std::fs::symlink_metadata(target.join(n)).is_ok_and(|m| m.is_file())
+        })
+        .cloned()
+        .collect();
+    if !foreign.is_empty() {
+        anyhow::bail!(
+            "--out {}: holds files the earlier sinsmodel run did not write ({}); move them or choose another --out (nothing is overwritten)",
+            target.display(),
+            shown(&foreign)
+        );
+    }
+    Ok(())
+}
+
+/// The command a run directory's marker names (`None` for a release that did not record it,
+/// or no valid marker).
+fn run_command(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join(RUN_MARKER)).ok()?;
+    let first = text.lines().next()?;
+    let cmd = first
+        .strip_prefix("written by sinsmodel ")?
+        .strip_suffix("; its files:")?;
+    Some(cmd.to_string())
+}
+
+/// True when `dir` holds a valid run marker and nothing but the files it lists.
+fn fully_listed(dir: &Path) -> bool {
+    let Ok(listed) = run_listing(dir) else {
+        return false;
+    };
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.filter_map(|e| e.ok()).all(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n == RUN_MARKER || (listed.contains(&n) && e.file_type().is_ok_and(|t| t.is_file()))
+        })
+    })
+}
+
+/// With no `target`, moves back the earlier run a killed replacement left set aside
+/// (`.NAME.sinsmodel-old-PID` of a process that is gone, holding only its listed files).
+fn restore_set_aside(parent: &Path, name: &str, target: &Path) {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    let mut found: Vec<(std::time::SystemTime, PathBuf)> = entries
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let entry = e.file_name().to_string_lossy().into_owned();
+            match leftover_kind(&entry, name) {
+                Some(("old", pid)) if pid != std::process::id() && !pid_alive(pid) => {
+                    let p = e.path();
+                    let t = e.metadata().and_then(|m| m.modified()).ok()?;
+                    (fully_listed(&p) && !e.file_type().ok()?.is_symlink()).then_some((t, p))
+                }
+                _ => None,
+            }
+        })
+        .collect();
+    found.sort();
+    if let Some((_, p)) = found.pop() {
+        if std::fs::rename(&p, target).is_ok() {
+            eprintln!(
+                "note: restored {} from {} (a run was killed while replacing it)",
+                target.display(),
+                p.display()
+            );
         }
     }
 }
@@ -387,7 +489,15 @@ pub fn run_listing(dir: &Path) -> std::result::Result<Vec<String>, String> {
     let text = std::fs::read_to_string(&marker)
         .map_err(|e| format!("its {RUN_MARKER} cannot be read as text: {e}"))?;
     let mut lines = text.lines();
-    if lines.next() != Some(RUN_MARKER_HEADER) {
+    let first = lines.next().unwrap_or("");
+    let ours = first == RUN_MARKER_HEADER
+        || first
+            .strip_prefix("written by sinsmodel ")
+            .and_then(|r| r.strip_suffix("; its files:"))
+            .is_some_and(|c| {
+                !c.is_empty() && c.bytes().all(|b| b.is_ascii_lowercase() || b == b'-')
+            });
+    if !ours {
         return Err(format!(
             "its {RUN_MARKER} does not start with sinsmodel's line \"{RUN_MARKER_HEADER}\""
         ));
@@ -485,7 +595,7 @@ fn remove_stale(dir: &Path, name: &str) {
                         .is_ok_and(|t| t == STAGING_TEXT)
                         || run_listing(&p).is_ok())
             }
-            _ => meta.is_dir() && run_listing(&p).is_ok(),
+            _ => meta.is_dir() && fully_listed(&p),
         };
         if ours {
             let _ = if meta.is_dir() {
