@@ -39,6 +39,29 @@ fn simulate_into(d: &Path, o: &Path) -> (bool, String) {
     ])
 }
 
+/// `navigate` on `imu` into `out` from a level start at 30° N 110° E.
+fn navigate(imu: &str, out: &Path, force: bool) -> (bool, String) {
+    let mut a = vec![
+        "navigate", "--imu", imu, "--lat", "30", "--lon", "110", "--att", "0,0,0", "--out",
+    ];
+    let out = out.to_str().unwrap();
+    a.push(out);
+    if force {
+        a.push("--force");
+    }
+    run(&a)
+}
+
+/// Waits (up to a minute) until a staging directory for output `name` appears in `d`.
+fn wait_for_staging(d: &Path, name: &str) {
+    let t0 = std::time::Instant::now();
+    let prefix = format!(".{name}.sinsmodel-staging-");
+    while !names(d).iter().any(|n| n.starts_with(&prefix)) {
+        assert!(t0.elapsed().as_secs() < 60, "no staging directory appeared");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
 fn names(d: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(d)
         .unwrap()
@@ -156,19 +179,7 @@ fn the_sweep_of_leftovers_never_takes_a_users_file() {
         }
     }
     let imu = o.join("imu.txt");
-    let (ok, err) = run(&[
-        "navigate",
-        "--imu",
-        imu.to_str().unwrap(),
-        "--lat",
-        "30",
-        "--lon",
-        "110",
-        "--att",
-        "0,0,0",
-        "--out",
-        d.join("nav.txt").to_str().unwrap(),
-    ]);
+    let (ok, err) = navigate(imu.to_str().unwrap(), &d.join("nav.txt"), false);
     assert!(ok, "{err}");
     let (ok, err) = simulate_into(d, &o);
     assert!(ok, "{err}");
@@ -192,25 +203,7 @@ fn single_file_outputs_replace_only_their_own_earlier_output() {
     let imu = o.join("imu.txt");
     let imu = imu.to_str().unwrap();
     let truth_before = std::fs::read(o.join("truth.txt")).unwrap();
-    let nav = |out: &Path, force: bool| {
-        let mut a = vec![
-            "navigate",
-            "--imu",
-            imu,
-            "--lat",
-            "30",
-            "--lon",
-            "110",
-            "--att",
-            "0,0,0",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        if force {
-            a.push("--force");
-        }
-        run(&a)
-    };
+    let nav = |out: &Path, force: bool| navigate(imu, out, force);
     // onto a simulation's truth.txt (listed in its marker)
     let (ok, err) = nav(&o.join("truth.txt"), false);
     assert!(
@@ -314,14 +307,7 @@ fn an_interrupted_run_leaves_no_staging_and_the_earlier_result_whole() {
             .spawn()
             .unwrap();
         // wait for the staging directory to appear
-        let t0 = std::time::Instant::now();
-        while !names(d)
-            .iter()
-            .any(|n| n.starts_with(".ex.sinsmodel-staging-"))
-        {
-            assert!(t0.elapsed().as_secs() < 60, "no staging directory appeared");
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
+        wait_for_staging(d, "ex");
         Command::new("kill")
             .args([format!("-{sig}"), child.id().to_string()])
             .status()
@@ -455,14 +441,7 @@ fn a_run_directory_is_replaced_only_by_its_own_command_and_as_it_was() {
     let out = demo(&ex).wait_with_output().unwrap();
     assert!(out.status.success());
     let child = demo(&ex);
-    let t0 = std::time::Instant::now();
-    while !names(d)
-        .iter()
-        .any(|n| n.starts_with(".ex.sinsmodel-staging-"))
-    {
-        assert!(t0.elapsed().as_secs() < 60, "no staging directory appeared");
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
+    wait_for_staging(d, "ex");
     std::fs::write(ex.join("my_notes.txt"), "notes").unwrap();
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
@@ -507,4 +486,30 @@ fn the_clock_file_beside_a_csv_is_an_input() {
     ]);
     assert!(!ok && err.contains("is an input of this run"), "{err}");
     assert_eq!(std::fs::read(&tag).unwrap(), before);
+}
+
+/// A file of a run directory edited since the run wrote it (another size or modification time
+/// than its marker records) is not replaced.
+#[test]
+fn a_hand_edited_result_is_not_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let marker = std::fs::read_to_string(o.join(".sinsmodel-run")).unwrap();
+    assert!(
+        marker.lines().nth(1).unwrap().split('\t').count() == 3,
+        "{marker}"
+    );
+    let mut text = std::fs::read_to_string(o.join("scenario.toml")).unwrap();
+    text.push_str("# my note\n");
+    std::fs::write(o.join("scenario.toml"), &text).unwrap();
+    let (ok, err) = simulate_into(d, &o);
+    assert!(
+        !ok && err.contains("scenario.toml changed since the earlier sinsmodel run"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(o.join("scenario.toml")).unwrap(),
+        text
+    );
 }

@@ -84,13 +84,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
                 );
             }
         }
-        atomic_file::check_output_file(
-            "--json",
-            j,
-            &[],
-            atomic_file::Provenance::Json("explain"),
-            args.data.force,
-        )?;
+        check_json(j, args.data.force)?;
     }
     if args.data.any_given() {
         if args.demo_seconds.is_some() || args.demo_seed.is_some() {
@@ -202,6 +196,17 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 /// Candidates the user named that the baseline already has (skipped, with a note).
+/// Refuses a `--json` file that is not provably an earlier explain output (unless `force`).
+fn check_json(j: &Path, force: bool) -> Result<()> {
+    atomic_file::check_output_file(
+        "--json",
+        j,
+        &[],
+        atomic_file::Provenance::Json("explain"),
+        force,
+    )
+}
+
 fn already_in_baseline(spec: Option<&str>, baseline: &Model) -> Vec<String> {
     let Some(spec) = spec else {
         return Vec::new();
@@ -334,13 +339,7 @@ fn finish(
     out.commit()?;
     if let Some(j) = &args.json {
         // checked again: the file may have been replaced while the run worked
-        atomic_file::check_output_file(
-            "--json",
-            j,
-            &[],
-            atomic_file::Provenance::Json("explain"),
-            args.data.force,
-        )?;
+        check_json(j, args.data.force)?;
         atomic_file::write_text(j, &text)?;
     }
     for line in &e.summary {

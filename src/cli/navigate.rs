@@ -87,12 +87,15 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             args.out_rate
         );
     }
-    args.src.check_output(
-        "--out",
-        &args.out,
-        sinsmodel::io::atomic_file::Provenance::Text("navigate"),
-        args.force,
-    )?;
+    let check_out = || {
+        args.src.check_output(
+            "--out",
+            &args.out,
+            sinsmodel::io::atomic_file::Provenance::Text("navigate"),
+            args.force,
+        )
+    };
+    check_out()?;
     // streamed: memory does not grow with the file; the output is written as it goes and
     // appears only when complete
     let mut data = args.src.open()?;
@@ -209,12 +212,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     }
     pb.finish_and_clear();
     // checked again: the file may have been replaced while the run worked
-    args.src.check_output(
-        "--out",
-        &args.out,
-        sinsmodel::io::atomic_file::Provenance::Text("navigate"),
-        args.force,
-    )?;
+    check_out()?;
     out.commit()?;
     eprintln!(
         "navigated {} samples ({:.1} s), wrote {} rows to {}",

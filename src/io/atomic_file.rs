@@ -223,14 +223,7 @@ impl OutputDir {
                 target.display()
             );
         }
-        let parent = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "out".into());
+        let (parent, name) = parent_and_name(target);
         if !target.exists() {
             restore_set_aside(&parent, &name, target);
         }
@@ -292,9 +285,17 @@ impl OutputDir {
             .collect();
         names.retain(|n| n != STAGING_MARKER);
         names.sort();
+        // each file with its size and modification time: a file edited since is not the run's
+        let lines: Vec<String> = names
+            .iter()
+            .map(|n| match stamp(&self.staging.join(n)) {
+                Some((len, ns)) => format!("{n}\t{len}\t{ns}"),
+                None => n.clone(),
+            })
+            .collect();
         write_text(
             &self.staging.join(RUN_MARKER),
-            &format!("{}\n{}\n", marker_header(&self.command), names.join("\n")),
+            &format!("{}\n{}\n", marker_header(&self.command), lines.join("\n")),
         )?;
         // (a kill between the two leaves a staging directory the sweep still recognises)
         std::fs::remove_file(self.staging.join(STAGING_MARKER))
@@ -414,6 +415,15 @@ fn check_replaceable(target: &Path, command: &str) -> Result<()> {
             shown(&foreign)
         );
     }
+    let edited = edited_since(target);
+    if !edited.is_empty() {
+        anyhow::bail!(
+            "--out {}: {} changed since the earlier sinsmodel run wrote {} (size or modification time); copy what you want to keep elsewhere or choose another --out (nothing is overwritten)",
+            target.display(),
+            shown(&edited),
+            if edited.len() == 1 { "it" } else { "them" }
+        );
+    }
     Ok(())
 }
 
@@ -426,6 +436,32 @@ fn run_command(dir: &Path) -> Option<String> {
         .strip_prefix("written by sinsmodel ")?
         .strip_suffix("; its files:")?;
     Some(cmd.to_string())
+}
+
+/// A file's size [bytes] and modification time [ns since the epoch], as the marker records them.
+fn stamp(p: &Path) -> Option<(u64, u128)> {
+    let m = std::fs::symlink_metadata(p).ok()?;
+    let t = m
+        .modified()
+        .ok()?
+        .duration_since(std::time::UNIX_EPOCH)
+        .ok()?;
+    Some((m.len(), t.as_nanos()))
+}
+
+/// The files of run directory `dir` whose size or modification time differ from what its
+/// marker recorded (edited since the run wrote them).
+fn edited_since(dir: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join(RUN_MARKER)).unwrap_or_default();
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let mut f = l.split('\t');
+            let (name, len, ns) = (f.next()?, f.next()?, f.next()?);
+            let recorded = (len.parse::<u64>().ok()?, ns.parse::<u128>().ok()?);
+            (stamp(&dir.join(name)) != Some(recorded)).then(|| name.to_string())
+        })
+        .collect()
 }
 
 /// True when `dir` holds a valid run marker and nothing but the files it lists.
@@ -504,7 +540,7 @@ pub fn run_listing(dir: &Path) -> std::result::Result<Vec<String>, String> {
     }
     let listed: Vec<String> = lines
         .filter(|l| !l.is_empty())
-        .map(str::to_string)
+        .map(|l| l.split('\t').next().unwrap_or(l).to_string())
         .collect();
     if listed.is_empty() {
         return Err(format!(
@@ -517,6 +553,12 @@ pub fn run_listing(dir: &Path) -> std::result::Result<Vec<String>, String> {
 /// `.NAME.sinsmodel-KIND-PID` beside `target`: this process's hidden staging or set-aside
 /// directory.
 fn sibling(target: &Path, kind: &str) -> PathBuf {
+    let (parent, name) = parent_and_name(target);
+    parent.join(format!(".{name}.{TEMP_TAG}-{kind}-{}", std::process::id()))
+}
+
+/// The directory `target` is in (`.` for a bare name) and its name.
+fn parent_and_name(target: &Path) -> (PathBuf, String) {
     let parent = match target.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -525,7 +567,7 @@ fn sibling(target: &Path, kind: &str) -> PathBuf {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
-    parent.join(format!(".{name}.{TEMP_TAG}-{kind}-{}", std::process::id()))
+    (parent, name)
 }
 
 /// True unless the process `pid` is known to be gone (Linux: no /proc/PID).
