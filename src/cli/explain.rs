@@ -148,6 +148,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
                 format: inputs.imu_format.as_deref(),
                 clock_offset: inputs.clock_offset,
                 skip_through: inputs.start.t + 1e-9,
+                identity: Some(sinsmodel::explain::FileIdentity::of(&inputs.imu)?),
             },
             aid: &inputs.aid,
             truth: inputs.truth.as_deref(),

@@ -133,7 +133,40 @@ pub enum ImuInput<'a> {
         /// Samples at or before this time [s] are skipped (a run that starts later than the
         /// file, `--init auto`).
         skip_through: f64,
+        /// The file as it was when the run began: every pass checks it still is.
+        identity: Option<FileIdentity>,
     },
+}
+
+/// What identifies a file's content cheaply: size, modification time and a hash of its first
+/// 64 KiB.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileIdentity {
+    len: u64,
+    modified: Option<std::time::SystemTime>,
+    head_hash: u64,
+}
+
+impl FileIdentity {
+    /// The identity of the file at `path` now.
+    pub fn of(path: &std::path::Path) -> anyhow::Result<FileIdentity> {
+        use std::io::Read;
+        let meta = std::fs::metadata(path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+        let mut head = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(64 << 10).read_to_end(&mut head))
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+        // FNV-1a
+        let head_hash = head.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+            (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+        });
+        Ok(FileIdentity {
+            len: meta.len(),
+            modified: meta.modified().ok(),
+            head_hash,
+        })
+    }
 }
 
 impl ImuInput<'_> {
@@ -146,7 +179,18 @@ impl ImuInput<'_> {
                 format,
                 clock_offset,
                 skip_through,
+                identity,
             } => {
+                // explain reads the file once per pass: a file replaced meanwhile would give a
+                // report built from two data sets
+                if let Some(id) = identity {
+                    if FileIdentity::of(path)? != id {
+                        anyhow::bail!(
+                            "--imu {}: the file changed while explain was running (its size, modification time or first 64 KiB differ from when the run began); a report from two data sets would be wrong: run again on a file that stays put",
+                            path.display()
+                        );
+                    }
+                }
                 let mut s =
                     crate::io::imu_stream::ImuStream::open_with(path, format, clock_offset)?.0;
                 s.skip_through(skip_through)?;
@@ -1226,6 +1270,33 @@ mod tests {
         assert!((e - 4.59).abs() < 1e-12);
         // with 10 innovations a mean NIS of 1.5 is within the band
         assert_eq!(baseline_excess(&pass(1.5, 10)), None);
+    }
+
+    #[test]
+    fn a_file_replaced_between_passes_is_refused() {
+        let dir = std::env::temp_dir().join(format!("sinsmodel-identity-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("imu.txt");
+        let rows = |n: usize| -> String {
+            let mut s = String::from("# t dth dv\n");
+            for k in 1..=n {
+                s.push_str(&format!("{:.2} 0 0 0 0 0 -0.098\n", k as f64 * 0.01));
+            }
+            s
+        };
+        std::fs::write(&p, rows(50)).unwrap();
+        let input = ImuInput::File {
+            path: &p,
+            format: None,
+            clock_offset: None,
+            skip_through: 0.0,
+            identity: Some(FileIdentity::of(&p).unwrap()),
+        };
+        assert!(input.samples().is_ok());
+        std::fs::write(&p, rows(60)).unwrap();
+        let e = input.samples().err().unwrap().to_string();
+        assert!(e.contains("changed while explain was running"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
