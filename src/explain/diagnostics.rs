@@ -198,10 +198,12 @@ pub(super) fn segments(level: &[(f64, f64)], t_start: f64, t_end: f64) -> Vec<(f
 
 /// Total log-likelihood of a run's innovations, Σ −½(ν²/S + ln 2πS).
 pub fn innovation_loglik(run: &FilterRun) -> f64 {
-    run.innovations
-        .iter()
-        .map(|i| -0.5 * (i.nu * i.nu / i.s + (2.0 * std::f64::consts::PI * i.s).ln()))
-        .sum()
+    run.innovations.iter().map(loglik_of).sum()
+}
+
+/// One scalar innovation's log-likelihood −½(ν²/S + ln 2πS).
+pub(super) fn loglik_of(i: &crate::estimate::filter::Innovation) -> f64 {
+    -0.5 * (i.nu * i.nu / i.s + (2.0 * std::f64::consts::PI * i.s).ln())
 }
 
 pub(super) fn pass_stats(

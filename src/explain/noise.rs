@@ -343,7 +343,7 @@ fn split_scales(
     let loglik_by_group = |p: &Pass| -> [[f64; 2]; 2] {
         let mut l = [[0.0; 2]; 2];
         for (i, g) in p.run.innovations.iter().zip(groups) {
-            let li = -0.5 * (i.nu * i.nu / i.s + (2.0 * std::f64::consts::PI * i.s).ln());
+            let li = super::diagnostics::loglik_of(i);
             for (split, &k) in g.iter().enumerate() {
                 l[split][k] += li;
             }
