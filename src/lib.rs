@@ -6,6 +6,8 @@
 //!
 //! - [`model`]: the compiled error models (catalogue, generated kernels, run-time composition,
 //!   covariance propagation, Jacobians at a point).
+//! - [`data`]: the data a run reads, opened by the library (options, aiding plan, outages,
+//!   initial state, the filter set-up the options give).
 //! - [`nav`]: Earth model, attitude, the linearisation point, the strapdown navigator.
 //! - [`sim`]: scenarios, trajectories, the IMU simulator with error injection, seeded RNG.
 //! - [`estimate`]: the error-state Kalman filter, alignment, Allan deviation, mounting.
@@ -18,6 +20,7 @@
 //! - [`report`]: rendering: explain's words and Markdown, plots and progress bars.
 //! - [`fuzzing`]: fuzz target bodies, shared by cargo-fuzz and the stable corpus test.
 
+pub mod data;
 pub mod estimate;
 pub mod experiment;
 pub mod explain;

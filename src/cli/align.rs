@@ -67,7 +67,7 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         args.src
             .check_output("--json", j, Provenance::Json("align"), args.force)?;
     }
-    let data = args.src.read()?;
+    let data = args.src.read(&mut super::data::note)?;
     let d = std::f64::consts::PI / 180.0;
     let a = align::align(
         &data,

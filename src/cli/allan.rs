@@ -74,7 +74,7 @@ pub fn run(args: &AllanArgs) -> Result<()> {
                 .check_output("--plot", &png, Provenance::Png, args.force)?;
         }
     }
-    let data = args.src.read()?;
+    let data = args.src.read(&mut super::data::note)?;
     let dt = data.interval();
     if !(args.skip.is_finite() && args.skip >= 0.0) {
         anyhow::bail!("--skip {}: expected seconds >= 0", args.skip);

@@ -140,8 +140,8 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         let inputs = args.data.input_paths();
         let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
         let out = OutputDir::create(&args.out, &refs, "explain")?;
-        args.data.print_noise()?;
-        let inputs = args.data.load_for_passes()?;
+        super::data::print_noise(&args.data)?;
+        let inputs = args.data.load_for_passes(&mut super::data::note)?;
         let data = ExplainData {
             imu: sinsmodel::explain::ImuInput::File {
                 path: &inputs.imu,
@@ -156,7 +156,7 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
         };
         let config_for = |m: &Model| {
             let mut c = args.data.config(m, true)?;
-            super::data::apply_opened(&mut c, m, inputs.init_sigma, inputs.step_s);
+            sinsmodel::data::apply_opened(&mut c, m, inputs.init_sigma, inputs.step_s);
             Ok(c)
         };
         let mut e = run_explain(&baseline, &cands, &data, &config_for, &opts)?;

@@ -3,7 +3,7 @@
 use super::data::DataArgs;
 use anyhow::Result;
 use clap::Args;
-use sinsmodel::estimate::filter;
+use sinsmodel::estimate::{filter, metrics};
 use sinsmodel::io::atomic_file::{AtomicFile, OutputDir};
 use sinsmodel::model::Model;
 use sinsmodel::report::progress;
@@ -41,78 +41,16 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     let inputs = args.data.input_paths();
     let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     let out = OutputDir::create(&args.out, &refs, "filter")?;
-    args.data.print_noise()?;
-    let mut inputs = args.data.open()?;
+    super::data::print_noise(&args.data)?;
+    let mut inputs = args.data.open(&mut super::data::note)?;
     if args.in_memory {
         inputs.imu = inputs.imu.into_memory()?;
     }
     let start = inputs.start;
-    super::data::apply_opened(&mut cfg, &model, inputs.init_sigma, inputs.step_s);
+    sinsmodel::data::apply_opened(&mut cfg, &model, inputs.init_sigma, inputs.step_s);
     let provenance = super::command_line();
-    let arcsec = 180.0 / std::f64::consts::PI * 3600.0;
-
-    let mut states = AtomicFile::create(&out.file("states.txt"))?;
-    let w = states.writer();
-    writeln!(w, "# {provenance}")?;
-    writeln!(
-        w,
-        "# model {} ({} states), mode {}; estimate and 1-sigma of every state, SI units (rad, m/s, rad/s, m/s^2, 1, s^2/m …)",
-        model.name,
-        model.n(),
-        cfg.mode.word()
-    )?;
-    write!(w, "# t")?;
-    for (i, n) in model.names.iter().enumerate() {
-        write!(w, " {n}[{}]", model.unit(i))?;
-    }
-    for n in &model.names {
-        write!(w, " sigma_{n}")?;
-    }
-    writeln!(w)?;
     let with_truth = inputs.truth.is_some();
-    let mut model_error = match with_truth {
-        true => {
-            let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
-            let w = f.writer();
-            writeln!(w, "# {provenance}")?;
-            writeln!(
-                w,
-                "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
-            )?;
-            Some(f)
-        }
-        false => None,
-    };
-    // what the summary needs of each epoch: t and the model error e = φ̂ − φ (north, east)
-    let mut errors: Vec<(f64, Option<[f64; 2]>)> = Vec::new();
-    let mut on_record = |r: &filter::Record| -> Result<()> {
-        let w = states.writer();
-        write!(w, "{:.4}", r.t)?;
-        for v in r.x.iter().chain(&r.sigma) {
-            write!(w, " {v:.6e}")?;
-        }
-        writeln!(w)?;
-        let mut e_ne = None;
-        if let (Some(f), Some(p)) = (model_error.as_mut(), r.phi_true) {
-            let e = r.phi_est - p;
-            e_ne = Some([e.x, e.y]);
-            writeln!(
-                f.writer(),
-                "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
-                r.t,
-                p.x * arcsec,
-                p.y * arcsec,
-                p.z * arcsec,
-                r.phi_est.x * arcsec,
-                r.phi_est.y * arcsec,
-                r.phi_est.z * arcsec,
-                e.x * arcsec,
-                e.y * arcsec
-            )?;
-        }
-        errors.push((r.t, e_ne));
-        Ok(())
-    };
+    let mut files = EpochFiles::create(&out, &model, &cfg, &provenance, with_truth)?;
     if let Some(r) = args.nav_rate {
         if !(r.is_finite() && r > 0.0 && r <= 1e5) {
             anyhow::bail!("--nav-rate {r}: expected a rate in (0, 1e5] Hz");
@@ -139,7 +77,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         |f| pb.set_position((f * 1000.0) as u64),
         &mut |_| {},
         &mut nav,
-        &mut on_record,
+        &mut |r| files.record(r),
         false,
     )?;
     drop(epochs);
@@ -147,41 +85,11 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     run.check().map_err(anyhow::Error::msg)?;
     if let Some(tr) = inputs.truth.take() {
         tr.finish()?;
-        let covered = errors.iter().filter(|e| e.1.is_some()).count();
-        if covered == 0 && !errors.is_empty() {
-            anyhow::bail!(
-                "--truth: the truth file has no row at any of the {} update epochs ({:.3} .. {:.3} s): is it on the IMU's and the aiding's clock?",
-                errors.len(),
-                errors[0].0,
-                errors[errors.len() - 1].0
-            );
-        }
-        if covered < errors.len() {
-            eprintln!(
-                "warning: the truth file has a row at only {covered} of the {} update epochs: model_error.txt and the model-error RMS cover those only",
-                errors.len()
-            );
-        }
+        check_truth_coverage(&files.errors)?;
     }
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
-    super::data::check_inside(errors.len(), inputs.aid.len(), start.t, t_last)?;
-    states.commit()?;
-
-    let mut f = AtomicFile::create(&out.file("innovations.txt"))?;
-    let w = f.writer();
-    writeln!(w, "# {provenance}")?;
-    writeln!(w, "# t measurement component nu S (SI; nu = z - H x)")?;
-    for i in &run.innovations {
-        writeln!(
-            w,
-            "{:.4} {} {} {:.6e} {:.6e}",
-            i.t, i.meas, i.component, i.nu, i.s
-        )?;
-    }
-    f.commit()?;
-    if let Some(f) = model_error {
-        f.commit()?;
-    }
+    sinsmodel::data::check_inside(files.errors.len(), inputs.aid.len(), start.t, t_last)?;
+    let errors = files.commit(&out, &run, &provenance)?;
     let nav_rows = nav.rows;
     if nav_rows == 0 {
         anyhow::bail!(
@@ -191,7 +99,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         );
     }
     nav.finish(&out.file("nav.png"))?;
-    let outage_rows = outage_drifts(&inputs.outages, &run, t_first, t_last)?;
+    let outage_rows = metrics::outage_drifts(&inputs.outages, &run, t_first, t_last)?;
     if !outage_rows.is_empty() {
         sinsmodel::io::atomic_file::write_text(
             &out.file("outages.json"),
@@ -203,70 +111,26 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         )?;
     }
     out.commit()?;
+    let filtered_from = if inputs.skipped_samples > 0 {
+        start.t
+    } else {
+        t_first
+    };
     eprintln!(
         "filtered {} samples ({:.1} s) with {} ({} states, {} loop): {} scalar updates",
         inputs.imu.count() - inputs.skipped_samples,
-        t_last
-            - if inputs.skipped_samples > 0 {
-                start.t
-            } else {
-                t_first
-            },
+        t_last - filtered_from,
         model.name,
         model.n(),
         cfg.mode.word(),
         run.innovations.len(),
     );
     eprint!("{}", nis_table(&run));
-    if !outage_rows.is_empty() {
-        eprintln!("GNSS outages: drift at the first fix after each (the filter's solution against that fix)");
-        eprintln!(
-            "  {:>10} {:>9} {:>10} {:>9} {:>9} {:>10}",
-            "start[s]", "length[s]", "fix at[s]", "north[m]", "east[m]", "horiz.[m]"
-        );
-        for r in &outage_rows {
-            eprintln!(
-                "  {:>10.1} {:>9.1} {:>10.1} {:>9.2} {:>9.2} {:>10.2}",
-                r.start_s - t_first,
-                r.end_s - r.start_s,
-                r.fix_t_s - t_first,
-                r.drift_n_m,
-                r.drift_e_m,
-                r.drift_horizontal_m
-            );
-        }
+    eprint!("{}", outage_table(&outage_rows, t_first));
+    if with_truth {
+        eprint!("{}", model_error_line(&errors));
     }
-    if let (Some(first), Some(last), true) = (errors.first(), errors.last(), with_truth) {
-        let mid = 0.5 * (first.0 + last.0);
-        let all = errors.iter().filter(|e| e.0 >= mid).count();
-        let half: Vec<[f64; 2]> = errors
-            .iter()
-            .filter(|e| e.0 >= mid)
-            .filter_map(|e| e.1)
-            .collect();
-        if half.is_empty() {
-            eprintln!(
-                "model error: no update epoch of the second half ({mid:.0}–{:.0} s) has a truth row: no RMS",
-                last.0
-            );
-        } else {
-            let rms = |c: usize| {
-                (half.iter().map(|e| e[c] * e[c]).sum::<f64>() / half.len() as f64).sqrt() * arcsec
-            };
-            eprintln!(
-                "model error e = phi_hat - phi (truth), RMS over the second half ({mid:.0}–{:.0} s{}): north {:.2} arcsec, east {:.2} arcsec",
-                last.0,
-                if half.len() < all {
-                    format!(", the {} of {all} update epochs with a truth row", half.len())
-                } else {
-                    String::new()
-                },
-                rms(0),
-                rms(1)
-            );
-        }
-    }
-    let mut files = vec![
+    let mut names = vec![
         "states.txt",
         "innovations.txt",
         "nav.txt",
@@ -274,69 +138,208 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         "nav_sigma.png",
     ];
     if with_truth {
-        files.push("model_error.txt");
+        names.push("model_error.txt");
     }
     if !inputs.outages.is_empty() {
-        files.push("outages.json");
+        names.push("outages.json");
     }
     eprintln!(
         "wrote {} in {} (nav.txt: {nav_rows} rows)",
-        files.join(", "),
+        names.join(", "),
         args.out.display()
     );
     Ok(())
 }
 
-/// The drift at the end of one GNSS outage.
-#[derive(Debug, Clone, serde::Serialize)]
-struct OutageDrift {
-    /// START of `--outage START,DURATION`: seconds from the first IMU sample.
-    start_from_first_sample_s: f64,
-    /// DURATION [s].
-    duration_s: f64,
-    /// The window on the data's clock [s].
-    start_s: f64,
-    end_s: f64,
-    /// Time of the first aiding fix after the outage [s].
-    fix_t_s: f64,
-    drift_n_m: f64,
-    drift_e_m: f64,
-    drift_horizontal_m: f64,
+/// The files written as the epochs come: states.txt, and model_error.txt with truth; and what
+/// the summary needs of each epoch: t [s] and the model error e = φ̂ − φ (north, east) [rad].
+struct EpochFiles {
+    /// states.txt.
+    states: AtomicFile,
+    /// model_error.txt, with truth.
+    model_error: Option<AtomicFile>,
+    /// t [s] and e north, east [rad] (None where the truth has no row) of every epoch.
+    errors: Vec<(f64, Option<[f64; 2]>)>,
 }
 
-/// For each outage, the pos_ne innovation (computed − fix, before the update) at the first
-/// fix after it: the drift of the filter's solution over the outage.
-fn outage_drifts(
-    outages: &[super::data::Outage],
-    run: &filter::FilterRun,
-    t_first: f64,
-    t_last: f64,
-) -> Result<Vec<OutageDrift>> {
-    let mut out = Vec::new();
-    for o in outages {
-        let after = |c: usize| {
-            run.innovations
-                .iter()
-                .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
+impl EpochFiles {
+    /// Creates the files in `out` with their headers.
+    fn create(
+        out: &OutputDir,
+        model: &Model,
+        cfg: &filter::FilterConfig,
+        provenance: &str,
+        with_truth: bool,
+    ) -> Result<EpochFiles> {
+        let mut states = AtomicFile::create(&out.file("states.txt"))?;
+        let w = states.writer();
+        writeln!(w, "# {provenance}")?;
+        writeln!(
+            w,
+            "# model {} ({} states), mode {}; estimate and 1-sigma of every state, SI units (rad, m/s, rad/s, m/s^2, 1, s^2/m …)",
+            model.name,
+            model.n(),
+            cfg.mode.word()
+        )?;
+        write!(w, "# t")?;
+        for (i, n) in model.names.iter().enumerate() {
+            write!(w, " {n}[{}]", model.unit(i))?;
+        }
+        for n in &model.names {
+            write!(w, " sigma_{n}")?;
+        }
+        writeln!(w)?;
+        let model_error = match with_truth {
+            true => {
+                let mut f = AtomicFile::create(&out.file("model_error.txt"))?;
+                let w = f.writer();
+                writeln!(w, "# {provenance}")?;
+                writeln!(
+                    w,
+                    "# t phi_true_n phi_true_e phi_true_d phi_est_n phi_est_e phi_est_d e_n e_e [arcsec]"
+                )?;
+                Some(f)
+            }
+            false => None,
         };
-        let (Some(n), Some(e)) = (after(0), after(1)) else {
-            anyhow::bail!(
-                "--outage ending at {:.1} s: no position fix after it inside the data (which end at {t_last:.1} s): nothing to measure the drift against",
-                o.end_s
-            );
-        };
-        out.push(OutageDrift {
-            start_from_first_sample_s: o.start_s - t_first,
-            duration_s: o.end_s - o.start_s,
-            start_s: o.start_s,
-            end_s: o.end_s,
-            fix_t_s: n.t,
-            drift_n_m: n.nu,
-            drift_e_m: e.nu,
-            drift_horizontal_m: n.nu.hypot(e.nu),
-        });
+        Ok(EpochFiles {
+            states,
+            model_error,
+            errors: Vec::new(),
+        })
     }
-    Ok(out)
+
+    /// Writes one epoch's record.
+    fn record(&mut self, r: &filter::Record) -> Result<()> {
+        let arcsec = metrics::ARCSEC_PER_RAD;
+        let w = self.states.writer();
+        write!(w, "{:.4}", r.t)?;
+        for v in r.x.iter().chain(&r.sigma) {
+            write!(w, " {v:.6e}")?;
+        }
+        writeln!(w)?;
+        let mut e_ne = None;
+        if let (Some(f), Some(p)) = (self.model_error.as_mut(), r.phi_true) {
+            let e = r.phi_est - p;
+            e_ne = Some([e.x, e.y]);
+            writeln!(
+                f.writer(),
+                "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
+                r.t,
+                p.x * arcsec,
+                p.y * arcsec,
+                p.z * arcsec,
+                r.phi_est.x * arcsec,
+                r.phi_est.y * arcsec,
+                r.phi_est.z * arcsec,
+                e.x * arcsec,
+                e.y * arcsec
+            )?;
+        }
+        self.errors.push((r.t, e_ne));
+        Ok(())
+    }
+
+    /// Commits states.txt, innovations.txt (written now from `run`) and model_error.txt;
+    /// returns the epochs' model errors.
+    fn commit(
+        self,
+        out: &OutputDir,
+        run: &filter::FilterRun,
+        provenance: &str,
+    ) -> Result<Vec<(f64, Option<[f64; 2]>)>> {
+        self.states.commit()?;
+        let mut f = AtomicFile::create(&out.file("innovations.txt"))?;
+        let w = f.writer();
+        writeln!(w, "# {provenance}")?;
+        writeln!(w, "# t measurement component nu S (SI; nu = z - H x)")?;
+        for i in &run.innovations {
+            writeln!(
+                w,
+                "{:.4} {} {} {:.6e} {:.6e}",
+                i.t, i.meas, i.component, i.nu, i.s
+            )?;
+        }
+        f.commit()?;
+        if let Some(f) = self.model_error {
+            f.commit()?;
+        }
+        Ok(self.errors)
+    }
+}
+
+/// The truth must have a row at the update epochs: none is an error (another clock?), some
+/// missing a warning.
+fn check_truth_coverage(errors: &[(f64, Option<[f64; 2]>)]) -> Result<()> {
+    let covered = errors.iter().filter(|e| e.1.is_some()).count();
+    if covered == 0 && !errors.is_empty() {
+        anyhow::bail!(
+            "--truth: the truth file has no row at any of the {} update epochs ({:.3} .. {:.3} s): is it on the IMU's and the aiding's clock?",
+            errors.len(),
+            errors[0].0,
+            errors[errors.len() - 1].0
+        );
+    }
+    if covered < errors.len() {
+        eprintln!(
+            "warning: the truth file has a row at only {covered} of the {} update epochs: model_error.txt and the model-error RMS cover those only",
+            errors.len()
+        );
+    }
+    Ok(())
+}
+
+/// The table of the drift at the end of each GNSS outage (empty without outages); times from
+/// `t_first`, the first IMU sample [s].
+fn outage_table(rows: &[metrics::OutageDrift], t_first: f64) -> String {
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "GNSS outages: drift at the first fix after each (the filter's solution against that fix)\n",
+    );
+    s.push_str(&format!(
+        "  {:>10} {:>9} {:>10} {:>9} {:>9} {:>10}\n",
+        "start[s]", "length[s]", "fix at[s]", "north[m]", "east[m]", "horiz.[m]"
+    ));
+    for r in rows {
+        s.push_str(&format!(
+            "  {:>10.1} {:>9.1} {:>10.1} {:>9.2} {:>9.2} {:>10.2}\n",
+            r.start_s - t_first,
+            r.end_s - r.start_s,
+            r.fix_t_s - t_first,
+            r.drift_n_m,
+            r.drift_e_m,
+            r.drift_horizontal_m
+        ));
+    }
+    s
+}
+
+/// The model error RMS over the second half of the update epochs, in words (empty without
+/// epochs).
+fn model_error_line(errors: &[(f64, Option<[f64; 2]>)]) -> String {
+    let Some(h) = metrics::second_half_rms(errors) else {
+        return String::new();
+    };
+    match h.rms_arcsec {
+        None => format!(
+            "model error: no update epoch of the second half ({:.0}–{:.0} s) has a truth row: no RMS\n",
+            h.mid, h.last
+        ),
+        Some(rms) => format!(
+            "model error e = phi_hat - phi (truth), RMS over the second half ({:.0}–{:.0} s{}): north {:.2} arcsec, east {:.2} arcsec\n",
+            h.mid,
+            h.last,
+            if h.with_truth < h.epochs {
+                format!(", the {} of {} update epochs with a truth row", h.with_truth, h.epochs)
+            } else {
+                String::new()
+            },
+            rms[0],
+            rms[1]
+        ),
+    }
 }
 
 /// The mean NIS of every channel against its 95 % band, with a word on each.

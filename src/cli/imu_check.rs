@@ -50,7 +50,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         args.src
             .check_output("--json", j, Provenance::Json("imu-check"), args.force)?;
     }
-    let data = args.src.read()?;
+    let data = args.src.read(&mut super::data::note)?;
     let c = imu_check::check(
         &data,
         args.lat.map(f64::to_radians),

@@ -98,7 +98,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     check_out()?;
     // streamed: memory does not grow with the file; the output is written as it goes and
     // appears only when complete
-    let mut data = args.src.open()?;
+    let mut data = args.src.open(&mut super::data::note)?;
     if args.in_memory {
         data = data.into_memory()?;
     }

@@ -7,4 +7,5 @@ pub mod allan;
 pub mod filter;
 pub mod imu_check;
 pub mod init;
+pub mod metrics;
 pub mod stats;

@@ -63,7 +63,7 @@ use words::{finding_words, regressor_in_natural_units, summary};
 /// Standard gravity [m/s²] for expressing regressors in g.
 pub(crate) const G0: f64 = 9.806_65;
 /// Arcseconds per radian.
-pub(crate) const ARCSEC: f64 = 180.0 / std::f64::consts::PI * 3600.0;
+pub(crate) use crate::estimate::metrics::ARCSEC_PER_RAD as ARCSEC;
 
 /// Settings of a run of explain.
 #[derive(Debug, Clone)]

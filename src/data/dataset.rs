@@ -1,0 +1,263 @@
+//! A data set opened for a run: the IMU stream, the aiding plan, truth, the outages and the
+//! start, everything checked that can be before the run ([`DataOptions::open`]); and the same
+//! loaded once for a command that passes over the data several times ([`DataOptions::load_for_passes`]).
+
+use super::aid::{AidPlan, Outage};
+use super::DataOptions;
+use crate::estimate::filter::AidingEpoch;
+use crate::io::imu_stream::ImuStream;
+use crate::io::truth::{self, TruthRow};
+use crate::nav::earth;
+use crate::nav::strapdown::NavState;
+use anyhow::{bail, Result};
+use std::path::PathBuf;
+
+/// Default filter step [s].
+pub const DEFAULT_STEP_S: f64 = 0.01;
+
+/// The data options opened for one streamed pass.
+pub struct Dataset {
+    /// IMU samples, validated as they are read.
+    pub imu: ImuStream,
+    /// Aiding epochs after the start.
+    pub aid: AidPlan,
+    /// Truth, read as the run advances.
+    pub truth: Option<truth::TruthReader>,
+    /// Initial navigation state.
+    pub start: NavState,
+    /// GNSS outages (aiding dropped inside).
+    pub outages: Vec<Outage>,
+    /// With `--init auto`: 1-σ of the found tilt and heading [rad], for the attitude priors.
+    pub init_sigma: Option<(f64, f64)>,
+    /// IMU samples read before the start (`--init auto` at a later sample) and not filtered.
+    pub skipped_samples: u64,
+    /// The filter step [s]: `--step`, or the default raised to the IMU's interval.
+    pub step_s: f64,
+}
+
+/// What the data options load for a command that passes over the data more than once: the IMU
+/// file (read again on every pass), aiding epochs, truth, the initial state.
+pub struct PassInputs {
+    /// The IMU file.
+    pub imu: PathBuf,
+    /// Its format description, when given.
+    pub imu_format: Option<PathBuf>,
+    /// `--clock-offset` [s], when given.
+    pub clock_offset: Option<f64>,
+    /// Aiding epochs after the start.
+    pub aid: Vec<AidingEpoch>,
+    /// Truth rows, when given.
+    pub truth: Option<Vec<TruthRow>>,
+    /// Initial navigation state.
+    pub start: NavState,
+    /// With `--init auto`: 1-σ of the found tilt and heading [rad].
+    pub init_sigma: Option<(f64, f64)>,
+    /// The filter step [s].
+    pub step_s: f64,
+}
+
+/// At least 10 aiding epochs must have fallen inside the IMU data (t0, t_last]: `used` of
+/// `total` (0: a static plan) did.
+pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<()> {
+    if used < 10 {
+        bail!(
+            "only {used}{} aiding epochs fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (the filter works on innovations)",
+            if total > 0 { format!(" of {total}") } else { String::new() }
+        );
+    }
+    Ok(())
+}
+
+/// Horizontal distance [m] between two positions (lat, lon in rad) on the WGS-84 ellipsoid at
+/// the first one's latitude and height `h` [m] (a local flat approximation: enough to tell the
+/// same place from another town).
+fn horizontal_distance_m(lat: f64, lon: f64, h: f64, lat2: f64, lon2: f64) -> f64 {
+    let dn = (lat2 - lat) * (earth::radius_meridian(lat) + h);
+    let de = (lon2 - lon) * (earth::radius_transverse(lat) + h) * lat.cos();
+    dn.hypot(de)
+}
+
+impl DataOptions {
+    /// Opens the IMU, aiding and truth files for one streamed pass and builds the initial
+    /// state; everything that can be checked before the run is (the aiding epochs that fall
+    /// inside the IMU data are counted after it: [`check_inside`]). `note` hears what is read
+    /// and what `--init auto` found, and the warnings.
+    pub fn open(&self, note: &mut dyn FnMut(&str)) -> Result<Dataset> {
+        let step = self.step_given()?;
+        let imu_path = self.imu_path()?;
+        let mut imu = super::options::open_imu(
+            imu_path,
+            self.imu_format.as_deref(),
+            self.clock_offset,
+            note,
+        )?;
+        let plan = self.aid_plan(imu.first_t())?;
+        let mut truth_reader = match &self.truth {
+            Some(p) => Some(truth::TruthReader::open(p)?),
+            None => None,
+        };
+        let step_s = match step {
+            Some(s) if s < 0.999 * imu.interval() => bail!(
+                "--step {s} s is shorter than the IMU's median sample interval ({:.6} s); give --step {:.6} or more",
+                imu.interval(),
+                imu.interval()
+            ),
+            Some(s) => s,
+            None => DEFAULT_STEP_S.max(imu.interval()),
+        };
+        let outages = self.outages(imu.first_t())?;
+        let start = self.start(&mut imu, &plan, &outages, truth_reader.as_mut(), note)?;
+        let t0 = start.state.t;
+        if let Some(o) = outages.iter().find(|o| o.end_s <= t0 + 1e-9) {
+            bail!(
+                "--outage: the window {:.3} .. {:.3} s ends before the run starts ({t0:.3} s{}): there is no drift to measure",
+                o.start_s,
+                o.end_s,
+                if self.init_auto() { ", where --init auto found its start" } else { "" }
+            );
+        }
+        self.check_head(&imu, &start.state, note)?;
+        check_plan_at_start(&plan, &start.state)?;
+        Ok(Dataset {
+            imu,
+            aid: plan.after(t0),
+            truth: truth_reader,
+            start: start.state,
+            outages,
+            init_sigma: start.sigma,
+            skipped_samples: start.skipped,
+            step_s,
+        })
+    }
+
+    /// Checks the first seconds of the IMU against the start: magnitudes before anything is run
+    /// on them (a unit, scale or clock slip — deg/s as rad/s, g as m/s², ms as s — gives
+    /// plausible-looking nonsense downstream), and the start's roll and pitch against gravity.
+    fn check_head(
+        &self,
+        imu: &ImuStream,
+        start: &NavState,
+        note: &mut dyn FnMut(&str),
+    ) -> Result<()> {
+        let imu_path = self.imu_path()?;
+        let e = start.euler();
+        let (roll, pitch) = (e.x, e.y);
+        let head = crate::io::imu::ImuData {
+            samples: imu.head().to_vec(),
+        };
+        let check = crate::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true);
+        // a MEMS gyro's bias can reach what a unit slip gives: with --grade mems a warning
+        let mems = self.grade.as_deref() == Some("mems");
+        for p in check.gyro_unit_problems.iter().filter(|_| mems) {
+            note(&format!(
+                "warning: --imu {}: {p} (or a MEMS gyro's bias: --grade mems given)",
+                imu_path.display()
+            ));
+        }
+        let slips: Vec<&String> = check
+            .unit_problems
+            .iter()
+            .chain(check.gyro_unit_problems.iter().filter(|_| !mems))
+            .collect();
+        if let Some(p) = slips.first() {
+            if self.force {
+                note(&format!(
+                    "warning: --imu {}: {p} (--force given)",
+                    imu_path.display()
+                ));
+            } else {
+                bail!(
+                    "--imu {}: {p} (in the first 10 s; `sinsmodel imu-check` shows what was read; --force runs anyway)",
+                    imu_path.display()
+                );
+            }
+        }
+        if let Some(p) = crate::estimate::align::attitude_contradicts_gravity(&head, roll, pitch)
+            .filter(|_| !self.init_auto())
+        {
+            if self.force {
+                note(&format!("warning: {p} (--force given)"));
+            } else {
+                bail!("{}{p}", if self.init.is_some() { "--init: " } else { "" });
+            }
+        }
+        Ok(())
+    }
+
+    /// For a command that passes over the IMU file more than once (explain): reads the file
+    /// through once (every sample validated, its end found; memory does not grow with it), then
+    /// the aiding epochs inside it, the truth and the initial state. Each pass reads the file
+    /// again ([`crate::explain::ImuInput::File`]).
+    pub fn load_for_passes(&self, note: &mut dyn FnMut(&str)) -> Result<PassInputs> {
+        let mut opened = self.open(note)?;
+        while opened.imu.next()?.is_some() {}
+        let t_last = opened.imu.last_t();
+        let truth = match &self.truth {
+            Some(p) => Some(truth::read(p)?),
+            None => None,
+        };
+        let start = opened.start;
+        let aid: Vec<AidingEpoch> = opened
+            .aid
+            .epochs_outside(&opened.outages)
+            .take_while(|e| e.t <= t_last + 1e-9)
+            .collect();
+        check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
+        Ok(PassInputs {
+            init_sigma: opened.init_sigma,
+            step_s: opened.step_s,
+            imu: self.imu_path()?.to_path_buf(),
+            imu_format: self.imu_format.clone(),
+            clock_offset: self.clock_offset,
+            aid,
+            truth,
+            start,
+        })
+    }
+}
+
+/// The aiding must go on after the start (at least 10 epochs) and begin where the start is
+/// (within 20 km of it).
+fn check_plan_at_start(plan: &AidPlan, start: &NavState) -> Result<()> {
+    let t0 = start.t;
+    let far = |lat: f64, lon: f64| {
+        let d = horizontal_distance_m(start.lat, start.lon, start.h, lat, lon);
+        (d > 20_000.0).then_some(d)
+    };
+    match plan {
+        AidPlan::Fixes(fixes, _, _) => {
+            let after = fixes.iter().filter(|f| f.0.t > t0).count();
+            if after < 10 {
+                bail!(
+                    "only {after} of {} aiding epochs come after the IMU start ({t0:.3} s); at least 10 are needed (the filter works on innovations)",
+                    fixes.len()
+                );
+            }
+            // the initial position and the first aiding fix must describe the same place
+            if let Some(f) = fixes.iter().map(|f| &f.0).find(|f| f.t > t0) {
+                if let Some(dist) = far(f.lat, f.lon) {
+                    bail!(
+                        "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
+                        dist / 1000.0,
+                        f.t
+                    );
+                }
+            }
+        }
+        AidPlan::Static { fix, .. } => {
+            if let Some(dist) = far(fix.lat, fix.lon) {
+                bail!(
+                    "the initial position is {:.1} km from the first aiding fix (--static-aid): check --init / --static-aid",
+                    dist / 1000.0
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The distance the start check uses, for the module's tests.
+#[cfg(test)]
+pub(crate) fn tests_distance(lat: f64, lon: f64, h: f64, lat2: f64, lon2: f64) -> f64 {
+    horizontal_distance_m(lat, lon, h, lat2, lon2)
+}

@@ -1,0 +1,248 @@
+//! The data options of the commands that read data, as a library value: the IMU file and how
+//! to read it ([`ImuSource`]), and everything `filter` and `explain` share ([`DataOptions`]:
+//! IMU, aiding, truth, initial state, priors, noise, mode, step, ZUPT, outages, known GNSS
+//! values). With the `cli` feature they are also the command line's options, so a field's doc
+//! comment is its `--help` text.
+
+use crate::io::imu::ImuData;
+use crate::io::imu_stream::ImuStream;
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+/// The files read beside an IMU file: its format description and a GNSS_IMU csv's clock file.
+fn read_beside(imu: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = crate::io::imu_format::beside(imu).into_iter().collect();
+    v.push(imu.with_extension("csv.tag"));
+    v
+}
+
+/// The IMU file and how to read it: the options of `navigate`, `align`, `allan`, `imu-check`.
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(Clone, Debug)]
+pub struct ImuSource {
+    /// IMU file (text, PSINS .imu, FILE.mat:VARIABLE of PSINS [wm vm t], GNSS_IMU .csv, or any
+    /// layout --imu-format describes).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub imu: PathBuf,
+    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
+    /// IMU file if there is one, else chosen by the file's extension.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub imu_format: Option<PathBuf>,
+    /// GPST − IMU clock [s] for a GNSS_IMU .csv without its .tag file (0 keeps the IMU clock).
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
+    pub clock_offset: Option<f64>,
+}
+
+impl ImuSource {
+    /// Reads the IMU file; `note` hears which format was used.
+    pub fn read(&self, note: &mut dyn FnMut(&str)) -> Result<ImuData> {
+        self.open(note)?.collect()
+    }
+
+    /// Opens the IMU file as a stream of validated samples; `note` hears which format was used.
+    pub fn open(&self, note: &mut dyn FnMut(&str)) -> Result<ImuStream> {
+        open_imu(
+            &self.imu,
+            self.imu_format.as_deref(),
+            self.clock_offset,
+            note,
+        )
+    }
+
+    /// The input files (so outputs never land on them).
+    pub fn paths(&self) -> Vec<PathBuf> {
+        let mut v = vec![crate::io::readers::matlab::file_of(&self.imu)];
+        v.extend(self.imu_format.clone());
+        v.extend(read_beside(&self.imu));
+        v
+    }
+
+    /// Refuses an output file that is one of the inputs or not a regular file, and (unless
+    /// `force`) one that is another run's result or not provably this command's earlier output.
+    pub fn check_output(
+        &self,
+        option: &str,
+        path: &Path,
+        provenance: crate::io::atomic_file::Provenance,
+        force: bool,
+    ) -> Result<()> {
+        let inputs = self.paths();
+        let refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+        crate::io::atomic_file::check_output_file(option, path, &refs, provenance, force)
+    }
+}
+
+/// Opens an IMU file as a stream of validated samples; `note` hears "reading FILE as …".
+pub fn open_imu(
+    imu: &Path,
+    format: Option<&Path>,
+    clock_offset: Option<f64>,
+    note: &mut dyn FnMut(&str),
+) -> Result<ImuStream> {
+    let (stream, how) = ImuStream::open_with(imu, format, clock_offset)?;
+    note(&crate::io::lines::printable_message(&format!(
+        "reading {} {how}",
+        imu.display()
+    )));
+    Ok(stream)
+}
+
+/// The data options of `filter` and `explain`.
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+#[derive(Clone, Debug)]
+pub struct DataOptions {
+    /// IMU file (text, PSINS .imu, FILE.mat:VARIABLE of PSINS [wm vm t], GNSS_IMU .csv, or any
+    /// layout --imu-format describes).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub imu: Option<PathBuf>,
+    /// IMU format description (TOML, docs/formats.md); default: FILE.format.toml beside the
+    /// IMU file if there is one, else chosen by the file's extension.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub imu_format: Option<PathBuf>,
+    /// GPST − IMU clock [s] for a GNSS_IMU .csv without its .tag file (0 keeps the IMU clock).
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
+    pub clock_offset: Option<f64>,
+    /// Position aiding file (t lat lon h sigma_n sigma_e sigma_d), or an RTKLIB `.pos` solution.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub aid: Option<PathBuf>,
+    /// Which parts of the aiding file to use: pos, vel or pos,vel (default: all the file has; an
+    /// RTKLIB .pos with vn ve vu, or an 11-column aiding file, has velocities).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub aid_use: Option<String>,
+    /// A static vehicle at a known position: lat,lon [deg],h [m]; position updates (σ 0.1 m) and
+    /// zero-velocity updates (σ from --zupt, default 0.01 m/s) at 1 Hz instead of --aid.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_delimiter = ',', allow_hyphen_values = true)
+    )]
+    pub static_aid: Option<Vec<f64>>,
+    /// Prior 1-σ of a state, NAME=QUANTITY with units (repeatable); a trailing `*` matches a
+    /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub prior: Vec<String>,
+    /// Sensor white noise instead of the spec defaults: a `sinsmodel allan --json` file (mean
+    /// ARW of the gyros, VRW of the accelerometers), or inline with units:
+    /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub noise: Option<PathBuf>,
+    /// Truth file (t lat lon h vn ve vd roll pitch yaw), or a PSINS reference FILE.mat:avp: adds
+    /// the true φ and the model error.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub truth: Option<PathBuf>,
+    /// Initial lat,lon [deg],h [m],roll,pitch,yaw [deg][,vn,ve,vd m/s], or `auto`: level from
+    /// the first seconds at rest, heading by gyrocompassing (when the grade allows) or from the
+    /// GNSS course of the drive-off, or from the course at a moving start (docs/real-data.md);
+    /// default: the first truth row.
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
+    pub init: Option<String>,
+    /// With `--init auto`: the GNSS speed [m/s] above which the course gives the heading
+    /// [default: 3].
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub init_speed: Option<f64>,
+    /// open (errors estimated only) or closed (fed back).
+    #[cfg_attr(feature = "cli", arg(long, default_value = "open"))]
+    pub mode: String,
+    /// Filter step [s] [default: 0.01, or the IMU's median interval when that is longer].
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub step: Option<f64>,
+    /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub zupt: Option<f64>,
+    /// Run even when the initial roll and pitch contradict the measured gravity direction; with
+    /// explain, also replace a --json file that is not provably an earlier explain output.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub force: bool,
+    /// Sensor grade the priors and noise assume: navigation (the spec's defaults), tactical or
+    /// mems; --prior and --noise override single values.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub grade: Option<String>,
+    /// A GNSS outage: START,DURATION [s], START counted from the first IMU sample; the aiding
+    /// epochs inside are dropped and the drift at its end is reported (repeatable).
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
+    pub outage: Vec<String>,
+    /// Known IMU–GNSS time offset with its unit (`92 ms`, `0.092 s`): a fix stamped t is the
+    /// trajectory at t + OFFSET (the spec term dt_gnss), applied in the residuals; needs --aid.
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
+    pub gnss_delay: Option<String>,
+    /// Known GNSS antenna lever arm, IMU to antenna in the body frame (FRD): X,Y,Z [m] (the spec
+    /// terms lever_x lever_y lever_z), applied in the residuals; needs --aid.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_delimiter = ',', allow_hyphen_values = true)
+    )]
+    pub lever_arm: Option<Vec<String>>,
+}
+
+impl DataOptions {
+    /// True when any data option was given (explain runs its embedded demo when none is).
+    pub fn any_given(&self) -> bool {
+        self.imu.is_some()
+            || self.imu_format.is_some()
+            || self.clock_offset.is_some()
+            || self.aid.is_some()
+            || self.aid_use.is_some()
+            || self.static_aid.is_some()
+            || !self.prior.is_empty()
+            || self.noise.is_some()
+            || self.truth.is_some()
+            || self.init.is_some()
+            || self.zupt.is_some()
+            || self.force
+            || self.grade.is_some()
+            || !self.outage.is_empty()
+            || self.gnss_delay.is_some()
+            || self.lever_arm.is_some()
+    }
+
+    /// True when the aiding comes from a GNSS file (`--aid`): GNSS terms (time offset, lever
+    /// arm) mean something only then.
+    pub fn has_gnss(&self) -> bool {
+        self.aid.is_some()
+    }
+
+    /// The input files named by the options (so outputs never land on them).
+    pub fn input_paths(&self) -> Vec<PathBuf> {
+        [
+            &self.imu,
+            &self.imu_format,
+            &self.aid,
+            &self.noise,
+            &self.truth,
+        ]
+        .into_iter()
+        .flatten()
+        .map(|p| crate::io::readers::matlab::file_of(p))
+        .chain(self.imu.iter().flat_map(|i| read_beside(i)))
+        .collect()
+    }
+
+    /// A description of the data for reports.
+    pub fn describe(&self) -> String {
+        let mut s = String::new();
+        if let Some(p) = &self.imu {
+            s.push_str(&format!("IMU {}", p.display()));
+        }
+        if let Some(p) = &self.aid {
+            s.push_str(&format!(", aiding {}", p.display()));
+        }
+        if let Some(v) = &self.static_aid {
+            s.push_str(&format!(", static at {v:?}"));
+        }
+        if let Some(p) = &self.truth {
+            s.push_str(&format!(", truth {}", p.display()));
+        }
+        if let Some(d) = &self.gnss_delay {
+            s.push_str(&format!(", known GNSS delay {d}"));
+        }
+        if let Some(l) = &self.lever_arm {
+            s.push_str(&format!(", known lever arm {} (m, FRD)", l.join(",")));
+        }
+        s
+    }
+
+    /// The IMU file, which every run on data needs.
+    pub fn imu_path(&self) -> Result<&Path> {
+        use anyhow::Context;
+        self.imu.as_deref().context("--imu FILE is required")
+    }
+}

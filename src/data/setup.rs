@@ -1,0 +1,371 @@
+//! The filter set-up the data options give: grade priors and noise, `--prior` by pattern,
+//! `--noise`, mode, step, the known GNSS values, explain's term priors.
+
+use super::dataset::DEFAULT_STEP_S;
+use super::DataOptions;
+use crate::estimate::filter::{FilterConfig, Mode};
+use crate::model::catalog::GradeInfo;
+use crate::model::generated::common;
+use crate::model::priors::{self, StatePattern};
+use crate::model::Model;
+use crate::nav::strapdown::Vertical;
+use anyhow::{bail, Context, Result};
+
+/// The grade `--grade` names (None for navigation, the spec's defaults): `model-spec/grades.toml`.
+pub(crate) fn grade_table(grade: Option<&str>) -> Result<Option<&'static GradeInfo>> {
+    priors::grade(grade).map_err(|_| {
+        anyhow::anyhow!(
+            "--grade `{}`: expected {}",
+            crate::io::lines::shown(grade.unwrap_or_default()),
+            priors::grade_names()
+        )
+    })
+}
+
+/// What opening the data decides for the filter set-up: the step [s] (the default raised to the
+/// IMU's interval), and the attitude priors raised to what `--init auto` found — tilt 1-σ for
+/// phi_n and phi_e, heading 1-σ for phi_d [rad] (a prior already wider is kept).
+pub fn apply_opened(
+    cfg: &mut FilterConfig,
+    model: &Model,
+    init_sigma: Option<(f64, f64)>,
+    step_s: f64,
+) {
+    cfg.step_s = step_s;
+    let Some((tilt, yaw)) = init_sigma else {
+        return;
+    };
+    for (i, name) in model.names.iter().enumerate() {
+        let s = match *name {
+            "phi_n" | "phi_e" => tilt,
+            "phi_d" => yaw,
+            _ => continue,
+        };
+        cfg.prior_sigma[i] = cfg.prior_sigma[i].max(s);
+    }
+}
+
+impl DataOptions {
+    /// The known GNSS term values of `--gnss-delay` and `--lever-arm`: (term index, SI), each
+    /// checked for syntax and physics.
+    pub fn known_gnss(&self) -> Result<Vec<(usize, f64)>> {
+        let term = |name: &str, option: &str| -> Result<usize> {
+            common::TERMS
+                .iter()
+                .position(|t| t.name == name)
+                .with_context(|| {
+                    format!("{option}: the spec has no term `{name}` (model-spec/terms.toml)")
+                })
+        };
+        let mut out = Vec::new();
+        if let Some(text) = &self.gnss_delay {
+            let dt = crate::io::units::parse_quantity_as(text, "s").with_context(|| {
+                format!("--gnss-delay `{text}`: expected a time with its unit, e.g. `92 ms` or `0.092 s`")
+            })?;
+            if !dt.is_finite() || dt.abs() > 1.0 {
+                bail!(
+                    "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second difference belongs in --clock-offset)"
+                );
+            }
+            if dt != 0.0 && dt.abs() < 1e-3 {
+                bail!(
+                    "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
+                    dt * 1e3
+                );
+            }
+            out.push((term("dt_gnss", "--gnss-delay")?, dt));
+        }
+        if let Some(l) = &self.lever_arm {
+            if l.len() != 3 {
+                bail!(
+                    "--lever-arm: expected X,Y,Z in metres (body frame, FRD), got {} values",
+                    l.len()
+                );
+            }
+            for (k, (item, axis)) in l.iter().zip(["x", "y", "z"]).enumerate() {
+                // bare numbers are metres; a unit may be given (`34 cm`)
+                let item = item.trim();
+                let v = match item.parse::<f64>() {
+                    Ok(v) => v,
+                    Err(_) => crate::io::units::parse_quantity_as(item, "m").with_context(|| {
+                        format!("--lever-arm: {axis} = `{item}`: expected metres (`0.3`) or a length with its unit (`30 cm`)")
+                    })?,
+                };
+                if !v.is_finite() {
+                    bail!("--lever-arm: {axis} = `{item}` is not a number");
+                }
+                if v.abs() > 10.0 {
+                    bail!(
+                        "--lever-arm: {axis} = {v} m is beyond ±10 m; a vehicle's IMU-to-antenna arm is metres at most (mm read as m?)"
+                    );
+                }
+                out.push((
+                    term(["lever_x", "lever_y", "lever_z"][k], "--lever-arm")?,
+                    v,
+                ));
+            }
+        }
+        if !out.is_empty() && !self.has_gnss() {
+            bail!("--gnss-delay and --lever-arm describe a GNSS receiver: they need --aid (a GNSS file)");
+        }
+        Ok(out)
+    }
+
+    /// What the run assumes of the sensor, one line each: the grade the priors assume, the known
+    /// GNSS values applied, the noise `--noise` gives (said once per run).
+    pub fn noise_lines(&self) -> Result<Vec<String>> {
+        let mut lines = Vec::new();
+        match grade_table(self.grade.as_deref())? {
+            None => lines.push(format!(
+                "priors and noise: {} (the spec's defaults, a navigation-grade laser-gyro INS); --grade tactical|mems for other sensors{}",
+                if self.grade.is_some() { "--grade navigation" } else { "navigation grade" },
+                if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
+            )),
+            Some(g) => lines.push(format!(
+                "priors and noise: --grade {} (ARW {}, VRW {}; the priors of model-spec/grades.toml){}",
+                g.name,
+                g.gyro_arw_text,
+                g.accel_vrw_text,
+                if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
+            )),
+        }
+        for (t, v) in self.known_gnss()? {
+            let info = &common::TERMS[t];
+            lines.push(format!(
+                "known GNSS value applied in the residuals: {} = {} {} ({}); a {} state in the model estimates what is left on top of it",
+                info.name,
+                v / info.display_to_si,
+                info.display,
+                info.doc,
+                info.name
+            ));
+        }
+        if let Some(path) = &self.noise {
+            let (arw, vrw) = noise_from_allan(path)?;
+            // rad/√s → deg/√h: × 180/π × 60; m/s/√s → µg/√Hz: ÷ g × 1e6
+            lines.push(format!(
+                "noise from {} (used{}): ARW {:.3e} rad/sqrt(s) = {:.3} deg/sqrt(h), VRW {:.3e} m/s/sqrt(s) = {:.0} ug/sqrt(Hz)",
+                path.display(),
+                if self.grade.is_some() { " instead of the grade's" } else { "" },
+                arw,
+                arw.to_degrees() * 60.0,
+                vrw,
+                vrw / crate::io::units::STANDARD_GRAVITY * 1e6
+            ));
+        }
+        Ok(lines)
+    }
+
+    /// The `--prior` options that name spec terms (names or prefixes): (term index, σ in SI),
+    /// for explain's candidates (the sensor class of the data).
+    pub fn term_priors(&self) -> Result<Vec<(usize, f64)>> {
+        use crate::model::generated::common;
+        let mut out: Vec<(usize, f64)> = Vec::new();
+        if let Some(g) = grade_table(self.grade.as_deref())? {
+            out.extend(g.term_sigma.iter().copied().enumerate());
+        }
+        for spec in &self.prior {
+            let (name, value) = spec
+                .split_once('=')
+                .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
+            let (name, value) = (name.trim(), value.trim());
+            let pattern = StatePattern::new(name);
+            for (t, info) in common::TERMS.iter().enumerate() {
+                if pattern.matches(info.name) {
+                    let si = crate::io::units::parse_quantity_as(value, info.unit)
+                        .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+                    if !(si.is_finite() && si > 0.0) {
+                        bail!("--prior `{spec}`: a prior σ must be positive and finite");
+                    }
+                    if let Some(why) = info.beyond_limit(si) {
+                        bail!("--prior `{spec}`: {}: {why}", info.name);
+                    }
+                    out.retain(|x| x.0 != t);
+                    out.push((t, si));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Every `--prior` must name a state of `model` or a spec term (explain's candidates).
+    pub fn check_prior_names(&self, model: &Model) -> Result<()> {
+        use crate::model::generated::common;
+        for spec in &self.prior {
+            let name = spec.split_once('=').map(|x| x.0.trim()).unwrap_or(spec);
+            let hit = |n: &str| match name.strip_suffix('*') {
+                Some(prefix) => n.starts_with(prefix),
+                None => n == name,
+            };
+            if !model.names.iter().any(|n| hit(n)) && !common::TERMS.iter().any(|t| hit(t.name)) {
+                bail!(
+                    "--prior `{spec}`: no state `{name}` in {} and no spec term of that name{}",
+                    model.name,
+                    crate::model::did_you_mean(name.trim_end_matches('*'))
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// `--step` when given, checked: in (0, 10] s.
+    pub(crate) fn step_given(&self) -> Result<Option<f64>> {
+        match self.step {
+            Some(s) if !(s.is_finite() && s > 0.0 && s <= 10.0) => {
+                bail!("--step {s}: expected a filter step in (0, 10] s")
+            }
+            s => Ok(s),
+        }
+    }
+
+    /// The filter configuration for `model`: mode, step, vertical channel, `--prior` and
+    /// `--noise`. With `lenient_priors`, a `--prior` naming no state of this model is skipped
+    /// (explain applies the same priors to the baseline and to extended models).
+    pub fn config(&self, model: &Model, lenient_priors: bool) -> Result<FilterConfig> {
+        let args = self;
+        let mut cfg = FilterConfig::new(model);
+        if let Some(g) = grade_table(args.grade.as_deref())? {
+            priors::apply_grade(model, g, &mut cfg.prior_sigma);
+            cfg = cfg.with_sensor_noise(model, g.gyro_arw, g.accel_vrw);
+        }
+        cfg.mode = match args.mode.as_str() {
+            "open" => Mode::OpenLoop,
+            "closed" => Mode::ClosedLoop,
+            m => bail!("--mode `{m}`: expected open or closed"),
+        };
+        cfg.step_s = args.step_given()?.unwrap_or(DEFAULT_STEP_S);
+        cfg.known_gnss = args.known_gnss()?;
+        if !args.has_gnss() {
+            if let Some(t) = model.states.iter().find_map(|s| match *s {
+                crate::model::catalog::StateRef::Term(k)
+                    if common::TERMS[k].sensor == crate::model::catalog::Sensor::Gnss =>
+                {
+                    Some(common::TERMS[k].name)
+                }
+                _ => None,
+            }) {
+                bail!("--model {}: {t} is a GNSS term (it enters the fixes of a GNSS receiver); without --aid there is none", model.name);
+            }
+        }
+        if !model.vertical {
+            cfg.vertical = Vertical::Fixed;
+        }
+        for spec in &args.prior {
+            let (name, value) = spec
+                .split_once('=')
+                .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
+            let (name, value) = (name.trim(), value.trim());
+            let pattern = StatePattern::new(name);
+            let matches: Vec<usize> = (0..model.n())
+                .filter(|&i| pattern.matches(model.names[i]))
+                .collect();
+            if matches.is_empty() && !lenient_priors {
+                bail!(
+                    "--prior `{spec}`: no state `{name}` in model {}",
+                    model.name
+                );
+            }
+            for i in matches {
+                let si = crate::io::units::parse_quantity_as(value, model.unit(i))
+                    .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+                if !(si.is_finite() && si > 0.0) {
+                    bail!("--prior `{spec}`: a prior σ must be positive and finite");
+                }
+                if let crate::model::catalog::StateRef::Term(t) = model.states[i] {
+                    let info = &crate::model::generated::common::TERMS[t];
+                    if let Some(why) = info.beyond_limit(si) {
+                        bail!("--prior `{spec}`: {}: {why}", info.name);
+                    }
+                }
+                cfg.prior_sigma[i] = si;
+            }
+        }
+        if let Some(path) = &args.noise {
+            let (arw, vrw) = noise_from_allan(path)?;
+            cfg = cfg.with_sensor_noise(model, arw, vrw);
+        }
+        Ok(cfg)
+    }
+}
+
+/// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from `--noise`: inline
+/// `arw=Q, vrw=Q` with units, or an `allan --json` file (the mean over the three axes).
+pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
+    let text = path.to_string_lossy();
+    if text.contains('=') && !path.exists() {
+        return noise_inline(&text);
+    }
+    let text = crate::io::lines::read_small_text(path, "--noise")
+        .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "--noise {}: not valid JSON (expected the output of `sinsmodel allan --json`)",
+            path.display()
+        )
+    })?;
+    let white = |names: [&str; 3]| -> Result<f64> {
+        let mut s = 0.0;
+        for n in names {
+            let field = &v["fit"][n]["white"];
+            let w = field.as_f64().with_context(|| {
+                format!(
+                    "--noise {}: fit.{n}.white {} (expected a number: the output of `sinsmodel allan --json`)",
+                    path.display(),
+                    if field.is_null() { "is missing or null (the fit was not determined)".to_string() } else { format!("is {field}, not a number") }
+                )
+            })?;
+            let (min, max) = noise_range(n.starts_with("gyro"));
+            if !(w.is_finite() && w >= min && w <= max) {
+                bail!(
+                    "--noise {}: fit.{n}.white = {w} is not a plausible noise density ({min:e} ≤ w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
+                    path.display()
+                );
+            }
+            s += w * w;
+        }
+        Ok((s / 3.0).sqrt())
+    };
+    Ok((
+        white(["gyro_x", "gyro_y", "gyro_z"])?,
+        white(["accel_x", "accel_y", "accel_z"])?,
+    ))
+}
+
+/// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's.
+fn noise_inline(text: &str) -> Result<(f64, f64)> {
+    let (mut arw, mut vrw) = (None, None);
+    for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (k, v) = part
+            .split_once('=')
+            .with_context(|| format!("--noise `{part}`: expected arw=QUANTITY or vrw=QUANTITY"))?;
+        let (slot, unit, (min, max)) = match k.trim() {
+            "arw" => (&mut arw, "rad/sqrt(s)", noise_range(true)),
+            "vrw" => (&mut vrw, "m/s/sqrt(s)", noise_range(false)),
+            other => bail!("--noise: unknown key `{other}` (arw, vrw)"),
+        };
+        let q = crate::io::units::parse_quantity_as(v, unit)
+            .map_err(|e| anyhow::anyhow!("--noise {}: {}", k.trim(), e.0))?;
+        if !(q.is_finite() && q >= min && q <= max) {
+            bail!(
+                "--noise {}: {} is not a plausible noise density ({min:e} ..= {max} {unit})",
+                k.trim(),
+                v.trim()
+            );
+        }
+        *slot = Some(q);
+    }
+    match (arw, vrw) {
+        (Some(a), Some(v)) => Ok((a, v)),
+        _ => bail!("--noise `{text}`: give both arw and vrw, e.g. 'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'"),
+    }
+}
+
+/// Plausible white-noise densities (SI): gyro ARW 1e-9 ..= 1 rad/√s (the best ring-laser gyros
+/// are near 3e-7), accelerometer VRW 1e-7 ..= 100 m/s/√s (0.01 µg/√Hz upward).
+fn noise_range(gyro: bool) -> (f64, f64) {
+    if gyro {
+        (1e-9, 1.0)
+    } else {
+        (1e-7, 100.0)
+    }
+}

@@ -1,0 +1,188 @@
+//! What a filter run measures, computed once: the model error e = φ̂ − φ against truth (RMS in
+//! arcsec), the mean NIS per innovation channel against its band, the drift at the end of each
+//! GNSS outage; and the unit constant they share.
+
+use super::filter::FilterRun;
+use crate::data::Outage;
+use anyhow::{bail, Result};
+
+/// Arcseconds per radian.
+pub const ARCSEC_PER_RAD: f64 = 180.0 / std::f64::consts::PI * 3600.0;
+
+/// Root-mean-square of the model error e = φ̂ − φ (north, east) over records with t in [t0, t1],
+/// in arcseconds (the paper's metric, DESIGN §5).
+pub fn model_error_rms_arcsec(run: &FilterRun, t0: f64, t1: f64) -> Option<[f64; 2]> {
+    let mut sum = [0.0; 2];
+    let mut k = 0usize;
+    for r in run.records.iter().filter(|r| r.t >= t0 && r.t <= t1) {
+        let pt = r.phi_true?;
+        for c in 0..2 {
+            sum[c] += (r.phi_est[c] - pt[c]).powi(2);
+        }
+        k += 1;
+    }
+    if k == 0 {
+        return None;
+    }
+    let arcsec = ARCSEC_PER_RAD;
+    Some([
+        (sum[0] / k as f64).sqrt() * arcsec,
+        (sum[1] / k as f64).sqrt() * arcsec,
+    ])
+}
+
+/// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.
+pub fn channel_name(meas: &str, component: usize) -> String {
+    match meas.strip_suffix("_ne") {
+        Some(prefix) => format!("{prefix}_{}", ["n", "e"].get(component).unwrap_or(&"?")),
+        None => meas.to_string(),
+    }
+}
+
+/// Mean normalised innovation squared (NIS) of one scalar channel against what a consistent
+/// filter gives (1, with the 95 % band of the mean of `count` χ²₁ values).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ChannelNis {
+    /// `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.
+    pub channel: String,
+    /// Number of scalar innovations.
+    pub count: usize,
+    /// Mean of ν²/S (dimensionless; 1 expected).
+    pub mean: f64,
+    /// 95 % band of the mean for a consistent filter with this count.
+    pub band: [f64; 2],
+}
+
+impl ChannelNis {
+    /// One word on the channel: `consistent`, `too large` (the model misses something or the
+    /// noise is too small) or `too small` (noise or priors pessimistic).
+    pub fn verdict(&self) -> &'static str {
+        if self.mean > self.band[1] {
+            "too large"
+        } else if self.mean < self.band[0] {
+            "too small"
+        } else {
+            "consistent"
+        }
+    }
+}
+
+/// Mean NIS per channel, in the order the channels first appear.
+pub fn nis_by_channel(run: &FilterRun) -> Vec<ChannelNis> {
+    let mut out: Vec<(String, f64, usize)> = Vec::new();
+    for i in &run.innovations {
+        let name = channel_name(i.meas, i.component);
+        let v = i.nu * i.nu / i.s;
+        match out.iter_mut().find(|c| c.0 == name) {
+            Some(c) => {
+                c.1 += v;
+                c.2 += 1;
+            }
+            None => out.push((name, v, 1)),
+        }
+    }
+    out.into_iter()
+        .map(|(channel, sum, count)| ChannelNis {
+            channel,
+            count,
+            mean: sum / count as f64,
+            band: crate::estimate::stats::mean_chi2_band(1.0, count, 1.96),
+        })
+        .collect()
+}
+
+/// The model error RMS over the second half of the update epochs, from each epoch's time [s]
+/// and its north and east model error [rad] (None where the truth has no row).
+#[derive(Debug, Clone, Copy)]
+pub struct SecondHalfRms {
+    /// Start of the second half [s]: midway between the first and the last epoch.
+    pub mid: f64,
+    /// The last epoch [s].
+    pub last: f64,
+    /// Epochs of the second half.
+    pub epochs: usize,
+    /// Of those, the ones with a truth row.
+    pub with_truth: usize,
+    /// RMS north, east [arcsec] (None when no epoch of the second half has a truth row).
+    pub rms_arcsec: Option<[f64; 2]>,
+}
+
+/// [`SecondHalfRms`] of the epochs `errors` (time [s], north and east model error [rad]); None
+/// without epochs.
+pub fn second_half_rms(errors: &[(f64, Option<[f64; 2]>)]) -> Option<SecondHalfRms> {
+    let (first, last) = (errors.first()?, errors.last()?);
+    let mid = 0.5 * (first.0 + last.0);
+    let epochs = errors.iter().filter(|e| e.0 >= mid).count();
+    let half: Vec<[f64; 2]> = errors
+        .iter()
+        .filter(|e| e.0 >= mid)
+        .filter_map(|e| e.1)
+        .collect();
+    let rms = |c: usize| {
+        (half.iter().map(|e| e[c] * e[c]).sum::<f64>() / half.len() as f64).sqrt() * ARCSEC_PER_RAD
+    };
+    Some(SecondHalfRms {
+        mid,
+        last: last.0,
+        epochs,
+        with_truth: half.len(),
+        rms_arcsec: (!half.is_empty()).then(|| [rms(0), rms(1)]),
+    })
+}
+
+/// The drift at the end of one GNSS outage.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct OutageDrift {
+    /// START of `--outage START,DURATION`: seconds from the first IMU sample.
+    pub start_from_first_sample_s: f64,
+    /// DURATION [s].
+    pub duration_s: f64,
+    /// Start of the window on the data's clock [s].
+    pub start_s: f64,
+    /// End of the window on the data's clock [s].
+    pub end_s: f64,
+    /// Time of the first aiding fix after the outage [s].
+    pub fix_t_s: f64,
+    /// North drift [m].
+    pub drift_n_m: f64,
+    /// East drift [m].
+    pub drift_e_m: f64,
+    /// Horizontal drift [m].
+    pub drift_horizontal_m: f64,
+}
+
+/// For each outage, the pos_ne innovation (computed − fix, before the update) at the first
+/// fix after it: the drift of the filter's solution over the outage. `t_first`, `t_last`: the
+/// first and last IMU sample [s].
+pub fn outage_drifts(
+    outages: &[Outage],
+    run: &FilterRun,
+    t_first: f64,
+    t_last: f64,
+) -> Result<Vec<OutageDrift>> {
+    let mut out = Vec::new();
+    for o in outages {
+        let after = |c: usize| {
+            run.innovations
+                .iter()
+                .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
+        };
+        let (Some(n), Some(e)) = (after(0), after(1)) else {
+            bail!(
+                "--outage ending at {:.1} s: no position fix after it inside the data (which end at {t_last:.1} s): nothing to measure the drift against",
+                o.end_s
+            );
+        };
+        out.push(OutageDrift {
+            start_from_first_sample_s: o.start_s - t_first,
+            duration_s: o.end_s - o.start_s,
+            start_s: o.start_s,
+            end_s: o.end_s,
+            fix_t_s: n.t,
+            drift_n_m: n.nu,
+            drift_e_m: e.nu,
+            drift_horizontal_m: n.nu.hypot(e.nu),
+        });
+    }
+    Ok(out)
+}
