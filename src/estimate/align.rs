@@ -232,12 +232,46 @@ pub fn align(
             "the IMU interval is {dt} s: alignment needs data at 1 Hz or faster (10 s windows of samples)"
         );
     }
-    // at rest by absolute evidence (10 s windows of 1-s means) and not disturbed relative to
-    // the other windows; the longest run of such windows is used
-    let g_local = crate::nav::earth::gravity(lat.unwrap_or(45f64.to_radians()), h);
-    let (w10, disturbed) = disturbed_windows(data, 10.0);
-    let evidence = rest_evidence(data, w10, g_local);
-    let rest: Vec<bool> = evidence.iter().map(|e| e.at_rest()).collect();
+    let (q0, used) = samples_at_rest(data, dt, lat, h, seconds)?;
+    let (c, windows, lat_sigma) = coarse_on_quiet(&used, dt);
+    let lat_used = lat.unwrap_or(c.lat);
+    let north = north_seen(&c, lat, lat_used, gyro_bias_sigma);
+    let (bias_sigma, no_heading) = (north.bias_sigma, north.no_heading);
+    let fine = fine_align(used, dt, &c, lat_used, lon, h, bias_sigma)?;
+    let (e, eps) = (fine.euler, fine.eps_deg_h);
+    let deg = 180.0 / std::f64::consts::PI;
+    let deg_h = 180.0 / std::f64::consts::PI * 3600.0;
+    Ok(Alignment {
+        roll_deg: e.x * deg,
+        pitch_deg: e.y * deg,
+        heading_deg: (!no_heading).then(|| (e.z * deg).rem_euclid(360.0)),
+        heading_sigma_deg: (!no_heading).then_some(fine.heading_sigma * deg),
+        heading_note: north.note,
+        gyro_bias_sigma_used_deg_h: bias_sigma * deg_h,
+        lat_deg: (lat.is_some() || !no_heading).then_some(lat_used * deg),
+        // the bias tilts the measured Earth rate by up to σ_b / Ω
+        lat_sigma_deg: if lat.is_some() {
+            Some(0.0)
+        } else {
+            (!no_heading).then(|| lat_sigma.hypot(bias_sigma / crate::nav::earth::OMEGA) * deg)
+        },
+        // from the sample times (a jittered clock makes q0·dt wrong), rounded to the microsecond
+        skipped_s: ((data.samples[q0].t - data.samples[0].t) * 1e6).round() / 1e6,
+        heading_windows_deg: if no_heading {
+            Vec::new()
+        } else {
+            windows
+                .iter()
+                .map(|x| (x.euler.z * deg).rem_euclid(360.0))
+                .collect()
+        },
+        coarse_lat_deg: (!no_heading).then_some(c.lat * deg),
+        gyro_bias_deg_h: [eps[0], eps[1], eps[2]],
+    })
+}
+
+/// The first and end window index of the longest run of `true` in `rest` ((0, 0) when none).
+fn longest_run(rest: &[bool]) -> (usize, usize) {
     let (mut best, mut run_start) = ((0usize, 0usize), None);
     for (k, r) in rest.iter().chain(std::iter::once(&false)).enumerate() {
         match (r, run_start) {
@@ -251,6 +285,27 @@ pub fn align(
             _ => {}
         }
     }
+    best
+}
+
+/// The samples to align on (sample period `dt` [s]): the longest stretch at rest (10 s windows at
+/// rest by absolute evidence, gravity at latitude `lat` [rad] or 45° and height `h` [m]), less a
+/// disturbed start, at most `seconds` [s] of it; with the index of its first sample. At least
+/// 60 s are needed.
+fn samples_at_rest(
+    data: &ImuData,
+    dt: f64,
+    lat: Option<f64>,
+    h: f64,
+    seconds: Option<f64>,
+) -> anyhow::Result<(usize, Vec<ImuSample>)> {
+    // at rest by absolute evidence (10 s windows of 1-s means) and not disturbed relative to
+    // the other windows; the longest run of such windows is used
+    let g_local = crate::nav::earth::gravity(lat.unwrap_or(45f64.to_radians()), h);
+    let (w10, disturbed) = disturbed_windows(data, 10.0);
+    let evidence = rest_evidence(data, w10, g_local);
+    let rest: Vec<bool> = evidence.iter().map(|e| e.at_rest()).collect();
+    let best = longest_run(&rest);
     // from the sample times: on a jittered clock a window of w10 samples is not 10 s
     let rest_s = if best.1 > best.0 {
         let (a, b) = (best.0 * w10, (best.1 * w10).min(data.samples.len()) - 1);
@@ -300,9 +355,15 @@ pub fn align(
     if used.len() < (60.0 / dt) as usize {
         anyhow::bail!("fewer than 60 s of data at rest to align on (--seconds)");
     }
+    Ok((q0, used))
+}
+
+/// Coarse alignment of `used` (sample period `dt` [s]) on its quiet 10 s windows, the coarse
+/// alignments of its 60 s windows, and the 1-σ of the latitude from their scatter [rad].
+fn coarse_on_quiet(used: &[ImuSample], dt: f64) -> (Coarse, Vec<Coarse>, f64) {
     // coarse alignment on the quiet windows only (later disturbances excluded from the means)
     let used_data = ImuData {
-        samples: used.clone(),
+        samples: used.to_vec(),
     };
     let (w10, flags) = disturbed_windows(&used_data, 10.0);
     let quiet: Vec<ImuSample> = used
@@ -328,8 +389,22 @@ pub fn align(
         / (k - 1.0).max(1.0))
     .sqrt()
         / k.sqrt();
-    let lat_used = lat.unwrap_or(c.lat);
+    (c, windows, lat_sigma)
+}
 
+/// What the gyros can say about north.
+struct North {
+    /// Gyro-bias 1-σ for the fine alignment [rad/s]: the prior, widened to the bias seen.
+    bias_sigma: f64,
+    /// The bias hides the Earth rate: no heading (its σ would exceed 20°).
+    no_heading: bool,
+    /// Why there is no heading, or what widened the bias σ.
+    note: Option<String>,
+}
+
+/// What the gyros can say about north at latitude `lat_used` [rad] (`lat`: given) from the
+/// coarse alignment `c`, against the gyro-bias prior `gyro_bias_sigma` [rad/s].
+fn north_seen(c: &Coarse, lat: Option<f64>, lat_used: f64, gyro_bias_sigma: f64) -> North {
     // what the gyros can say about north: the horizontal Earth rate against the gyro bias. At
     // rest |ω̄| = |Ω + b|: above 2 Ω the bias is at least |ω̄| − Ω (≥ Ω) and the prior is
     // widened to it (the heading σ must include the bias the data show); between 0.5 and 2 Ω a
@@ -371,7 +446,35 @@ pub fn align(
             if lat.is_some() { " at this latitude" } else { "; its horizontal part is smaller" }
         ));
     }
+    North {
+        bias_sigma,
+        no_heading,
+        note: heading_note,
+    }
+}
 
+/// What the fine alignment gives.
+struct Fine {
+    /// Roll, pitch, heading [rad].
+    euler: Vector3<f64>,
+    /// 1-σ of the heading (phi_d) at the last update [rad].
+    heading_sigma: f64,
+    /// Estimated gyro biases [deg/h].
+    eps_deg_h: Vec<f64>,
+}
+
+/// Fine alignment of `used` (sample period `dt` [s]) from the coarse one `c`: P13, closed
+/// loop, zero velocity and known position (latitude `lat_used` [rad], longitude `lon` [rad],
+/// height `h` [m]) at 1 Hz, gyro-bias prior `bias_sigma` [rad/s].
+fn fine_align(
+    used: Vec<ImuSample>,
+    dt: f64,
+    c: &Coarse,
+    lat_used: f64,
+    lon: f64,
+    h: f64,
+    bias_sigma: f64,
+) -> anyhow::Result<Fine> {
     // fine alignment: P13, closed loop, zero velocity and known position at 1 Hz
     let model = Model::parse("P13")?;
     let mut cfg = FilterConfig::new(&model);
@@ -420,31 +523,9 @@ pub fn align(
         .iter()
         .map(|n| last.x[model.index_of(n).expect("P13 eps")] * deg * 3600.0)
         .collect();
-    Ok(Alignment {
-        roll_deg: e.x * deg,
-        pitch_deg: e.y * deg,
-        heading_deg: (!no_heading).then(|| (e.z * deg).rem_euclid(360.0)),
-        heading_sigma_deg: (!no_heading).then(|| last.sigma[i_phid] * deg),
-        heading_note,
-        gyro_bias_sigma_used_deg_h: bias_sigma * deg_h,
-        lat_deg: (lat.is_some() || !no_heading).then_some(lat_used * deg),
-        // the bias tilts the measured Earth rate by up to σ_b / Ω
-        lat_sigma_deg: if lat.is_some() {
-            Some(0.0)
-        } else {
-            (!no_heading).then(|| lat_sigma.hypot(bias_sigma / crate::nav::earth::OMEGA) * deg)
-        },
-        // from the sample times (a jittered clock makes q0·dt wrong), rounded to the microsecond
-        skipped_s: ((data.samples[q0].t - data.samples[0].t) * 1e6).round() / 1e6,
-        heading_windows_deg: if no_heading {
-            Vec::new()
-        } else {
-            windows
-                .iter()
-                .map(|x| (x.euler.z * deg).rem_euclid(360.0))
-                .collect()
-        },
-        coarse_lat_deg: (!no_heading).then_some(c.lat * deg),
-        gyro_bias_deg_h: [eps[0], eps[1], eps[2]],
+    Ok(Fine {
+        euler: e,
+        heading_sigma: last.sigma[i_phid],
+        eps_deg_h: eps,
     })
 }

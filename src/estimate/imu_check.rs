@@ -80,68 +80,166 @@ pub fn check(
     let gaps = intervals.iter().filter(|d| **d > 2.0 * median).count();
     intervals.sort_by(f64::total_cmp);
     let t_first = s.first().map(|x| x.t).unwrap_or(0.0);
-    let w0 = t_first + skip_s;
-    // the window holds at least ten intervals (a clock read 1000× slow leaves one in 10 s)
-    let tenth = s
-        .iter()
-        .skip_while(|x| x.t <= w0)
-        .nth(10)
-        .map(|x| x.t)
-        .unwrap_or(f64::NEG_INFINITY);
-    let w1 = (w0 + window_s).max(tenth);
-    // means with each sample's own interval (the first sample's interval is unknown: skipped)
-    let (mut sdv, mut sdth, mut sdt) = (Vector3::zeros(), Vector3::zeros(), 0.0);
-    let mut rates: Vec<Vector3<f64>> = Vec::new();
-    for w in s.windows(2) {
-        let (a, b) = (&w[0], &w[1]);
-        if b.t <= w0 || b.t > w1 {
-            continue;
-        }
-        let dt = b.t - a.t;
-        sdv += b.dv;
-        sdth += b.dtheta;
-        sdt += dt;
-        rates.push(b.dv / dt);
-    }
-    let mut problems = Vec::new();
-    let mut unit_problems = Vec::new();
-    let mut gyro_unit_problems = Vec::new();
-    let mut notes = Vec::new();
-    let g = earth::gravity(lat.unwrap_or(std::f64::consts::FRAC_PI_4), 0.0);
-    let omega = earth::OMEGA;
-    let (f, w) = if sdt > 0.0 {
-        (sdv / sdt, sdth / sdt)
-    } else {
-        (Vector3::zeros(), Vector3::zeros())
-    };
-    let spread = if rates.is_empty() {
-        f64::NAN
-    } else {
-        (rates.iter().map(|r| (r - f).norm_squared()).sum::<f64>() / rates.len() as f64).sqrt()
-    };
-    let is_static = rates.len() >= 10 && spread < 0.5;
-    let gravity_ratio = f.norm() / g;
-    let earth_rate_ratio = w.norm() / omega;
-    let roll = (-f.y).atan2(-f.z);
-    let pitch = f.x.atan2(f.y.hypot(f.z));
-    let tilt = if f.norm() > 0.0 {
-        (-f.z / f.norm()).clamp(-1.0, 1.0).acos()
-    } else {
-        f64::NAN
-    };
+    let m = Seen::of(imu, lat, t_first + skip_s, window_s);
+    let (w0, w1, f, w) = (m.w0, m.w1, m.f, m.w);
+    let mut out = Said::default();
     let deg = 180.0 / std::f64::consts::PI;
     let mut heading = None;
 
-    if rates.len() < 10 {
-        problems.push(format!(
+    if m.count < 10 {
+        out.problems.push(format!(
             "only {} samples between {:.3} s and {:.3} s: give --skip and --seconds inside the data ({:.3} .. {:.3} s)",
-            rates.len(),
+            m.count,
             w0,
             w1,
             t_first,
             s.last().map(|x| x.t).unwrap_or(0.0)
         ));
-    } else if !is_static {
+    } else if !m.is_static {
+        out.moving(&m);
+    } else {
+        heading = out.at_rest(&m, tilted_ok);
+    }
+    out.clock(jitter, median, &intervals, gaps);
+    ImuCheck {
+        samples: s.len(),
+        duration_s: imu.duration(),
+        rate_hz: 1.0 / median,
+        interval_min_s: intervals.first().copied().unwrap_or(0.0),
+        interval_max_s: intervals.last().copied().unwrap_or(0.0),
+        jitter_rms_s: jitter,
+        gaps,
+        window_s: [w0, w1],
+        f_spread_mps2: m.spread,
+        is_static: m.is_static,
+        f_mean_mps2: [f.x, f.y, f.z],
+        w_mean_radps: [w.x, w.y, w.z],
+        gravity_ratio: m.gravity_ratio,
+        gravity_mps2: m.g,
+        earth_rate_ratio: m.earth_rate_ratio,
+        roll_deg: m.roll * deg,
+        pitch_deg: m.pitch * deg,
+        heading_deg: heading,
+        tilt_deg: m.tilt * deg,
+        problems: out.problems,
+        unit_problems: out.unit_problems,
+        gyro_unit_problems: out.gyro_unit_problems,
+        notes: out.notes,
+    }
+}
+
+/// What the check window's samples show: their means, against gravity and Earth rate, and the
+/// attitude that follows.
+struct Seen {
+    /// Start of the window [s].
+    w0: f64,
+    /// End of the window [s].
+    w1: f64,
+    /// Samples in the window (each with its own interval).
+    count: usize,
+    /// Mean specific force, FRD [m/s²].
+    f: Vector3<f64>,
+    /// Mean angular rate, FRD [rad/s].
+    w: Vector3<f64>,
+    /// RMS of the specific force about its mean [m/s²].
+    spread: f64,
+    /// At least ten samples and a spread below 0.5 m/s².
+    is_static: bool,
+    /// Local normal gravity [m/s²].
+    g: f64,
+    /// |mean f| / local gravity.
+    gravity_ratio: f64,
+    /// |mean ω| / Earth rate.
+    earth_rate_ratio: f64,
+    /// Roll from the mean specific force [rad].
+    roll: f64,
+    /// Pitch from the mean specific force [rad].
+    pitch: f64,
+    /// Angle between the mean specific force and the body's up axis [rad].
+    tilt: f64,
+}
+
+impl Seen {
+    /// The samples of `imu` from `w0` [s] over `window_s` [s] (at least ten intervals), with
+    /// gravity at latitude `lat` [rad] (45° when None).
+    fn of(imu: &ImuData, lat: Option<f64>, w0: f64, window_s: f64) -> Seen {
+        let s = &imu.samples;
+        // the window holds at least ten intervals (a clock read 1000× slow leaves one in 10 s)
+        let tenth = s
+            .iter()
+            .skip_while(|x| x.t <= w0)
+            .nth(10)
+            .map(|x| x.t)
+            .unwrap_or(f64::NEG_INFINITY);
+        let w1 = (w0 + window_s).max(tenth);
+        // means with each sample's own interval (the first sample's interval is unknown: skipped)
+        let (mut sdv, mut sdth, mut sdt) = (Vector3::zeros(), Vector3::zeros(), 0.0);
+        let mut rates: Vec<Vector3<f64>> = Vec::new();
+        for w in s.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            if b.t <= w0 || b.t > w1 {
+                continue;
+            }
+            let dt = b.t - a.t;
+            sdv += b.dv;
+            sdth += b.dtheta;
+            sdt += dt;
+            rates.push(b.dv / dt);
+        }
+        let g = earth::gravity(lat.unwrap_or(std::f64::consts::FRAC_PI_4), 0.0);
+        let omega = earth::OMEGA;
+        let (f, w) = if sdt > 0.0 {
+            (sdv / sdt, sdth / sdt)
+        } else {
+            (Vector3::zeros(), Vector3::zeros())
+        };
+        let spread = if rates.is_empty() {
+            f64::NAN
+        } else {
+            (rates.iter().map(|r| (r - f).norm_squared()).sum::<f64>() / rates.len() as f64).sqrt()
+        };
+        let tilt = if f.norm() > 0.0 {
+            (-f.z / f.norm()).clamp(-1.0, 1.0).acos()
+        } else {
+            f64::NAN
+        };
+        Seen {
+            w0,
+            w1,
+            count: rates.len(),
+            f,
+            w,
+            spread,
+            is_static: rates.len() >= 10 && spread < 0.5,
+            g,
+            gravity_ratio: f.norm() / g,
+            earth_rate_ratio: w.norm() / omega,
+            roll: (-f.y).atan2(-f.z),
+            pitch: f.x.atan2(f.y.hypot(f.z)),
+            tilt,
+        }
+    }
+}
+
+/// What the check says: problems (and those a unit slip explains), and notes.
+#[derive(Default)]
+struct Said {
+    /// What is wrong.
+    problems: Vec<String>,
+    /// The problems only a unit, scale or clock slip explains.
+    unit_problems: Vec<String>,
+    /// The gyro problems a unit slip likely explains.
+    gyro_unit_problems: Vec<String>,
+    /// Remarks that are not errors.
+    notes: Vec<String>,
+}
+
+impl Said {
+    /// On a window that is not static: only a specific force far from gravity (0.5 to 2 g) says
+    /// something.
+    fn moving(&mut self, m: &Seen) {
+        let (w0, w1, f, g, gravity_ratio, spread) =
+            (m.w0, m.w1, m.f, m.g, m.gravity_ratio, m.spread);
         // no vehicle averages 0.5 g or 2 g of specific force over seconds: a unit error shows
         // even while moving
         if !(0.5..2.0).contains(&gravity_ratio) {
@@ -152,14 +250,20 @@ pub fn check(
                 crate::explain::sig3(gravity_ratio),
                 unit_hint(g / f.norm())
             );
-            problems.push(p.clone());
-            unit_problems.push(p);
+            self.problems.push(p.clone());
+            self.unit_problems.push(p);
         }
-        notes.push(format!(
+        self.notes.push(format!(
             "the window {w0:.1}–{w1:.1} s is not static (specific force varies by {spread:.2} m/s² RMS): \
              the gravity, Earth-rate and attitude checks need a static stretch (--skip, --seconds)"
         ));
-    } else {
+    }
+
+    /// On a static window: the specific force against gravity, the rate against Earth rate, the
+    /// tilt (unless `tilted_ok`); returns the gyrocompass heading [deg] when the gyros resolve
+    /// Earth rate.
+    fn at_rest(&mut self, m: &Seen, tilted_ok: bool) -> Option<f64> {
+        let (f, g, gravity_ratio) = (m.f, m.g, m.gravity_ratio);
         if (gravity_ratio - 1.0).abs() > 0.05 {
             let p = format!(
                 "mean specific force |f| = {:.4} m/s² on a static stretch is {:.3}× local gravity ({g:.4} m/s²): \
@@ -170,36 +274,15 @@ pub fn check(
             );
             // beyond 20 % no calibration error explains it
             if !(0.8..1.25).contains(&gravity_ratio) {
-                unit_problems.push(p.clone());
+                self.unit_problems.push(p.clone());
             }
-            problems.push(p);
+            self.problems.push(p);
         }
-        let r2d = 180.0 / std::f64::consts::PI;
-        if (earth_rate_ratio / r2d - 1.0).abs() < 0.05 {
-            let p = format!(
-                "mean angular rate on a static stretch is {earth_rate_ratio:.2}× Earth rate, within 5 % of 57.3 (degrees per radian): the gyro values look like deg/s read as rad/s — check gyro_unit"
-            );
-            problems.push(p.clone());
-            gyro_unit_problems.push(p);
-        } else if earth_rate_ratio > 1000.0 {
-            let p = format!(
-                "mean angular rate {:.4} deg/s on a static stretch is {:.0}× Earth rate (even MEMS gyro \
-                 biases stay below ~100×): check gyro_unit (deg/s read as rad/s gives 57.3×)",
-                w.norm() * deg,
-                earth_rate_ratio
-            );
-            problems.push(p.clone());
-            gyro_unit_problems.push(p);
-        } else if earth_rate_ratio < 0.2 {
-            problems.push(format!(
-                "mean angular rate {:.3e} deg/h on a static stretch is {:.3}× Earth rate (15.04 deg/h), which \
-                 any gyro at rest measures: check gyro_unit (rad/s read as deg/s gives 1/57.3)",
-                w.norm() * deg * 3600.0,
-                earth_rate_ratio
-            ));
-        }
+        self.earth_rate(m);
+        let deg = 180.0 / std::f64::consts::PI;
+        let (roll, pitch, tilt) = (m.roll, m.pitch, m.tilt);
         if tilt * deg > 45.0 && !tilted_ok {
-            problems.push(format!(
+            self.problems.push(format!(
                 "the static specific force points {:.1}° away from the body's up axis (roll {:.1}°, pitch {:.1}°): \
                  if the vehicle stands level, [axes] is wrong (a flipped z gives roll 180°, swapped x and z \
                  pitch ±90°); --tilted accepts a tilted mounting",
@@ -208,63 +291,76 @@ pub fn check(
                 pitch * deg
             ));
         }
+        let earth_rate_ratio = m.earth_rate_ratio;
         if (0.5..2.0).contains(&earth_rate_ratio) {
             // level the mean rate with roll and pitch; its horizontal part points north
             let c = crate::nav::attitude::dcm_from_euler(roll, pitch, 0.0);
-            let wl = c * w;
+            let wl = c * m.w;
             let h = (-wl.y).atan2(wl.x).to_degrees().rem_euclid(360.0);
             // no "-0.0" and no "360.0" for north
-            heading = Some(if h.abs() < 1e-9 || h > 360.0 - 1e-9 {
+            Some(if h.abs() < 1e-9 || h > 360.0 - 1e-9 {
                 0.0
             } else {
                 h
-            });
+            })
         } else {
-            notes.push(format!(
+            self.notes.push(format!(
                 "heading cannot be found from these gyros: |ω| is {earth_rate_ratio:.1}× Earth rate, so the \
                  gyro bias hides the Earth-rate direction; use --init or a GNSS course"
             ));
+            None
         }
     }
-    if jitter > 0.01 * median {
-        notes.push(format!(
-            "the clock jitters: intervals {:.6}–{:.6} s, RMS {:.2e} s about the median {median:.6} s \
-             (each sample's own interval is used)",
-            intervals.first().copied().unwrap_or(0.0),
-            intervals.last().copied().unwrap_or(0.0),
-            jitter
-        ));
+
+    /// On a static window: the mean angular rate against Earth rate (57.3×, over 1000×, under
+    /// 0.2× point at gyro_unit).
+    fn earth_rate(&mut self, m: &Seen) {
+        let (w, earth_rate_ratio) = (m.w, m.earth_rate_ratio);
+        let deg = 180.0 / std::f64::consts::PI;
+        let r2d = 180.0 / std::f64::consts::PI;
+        if (earth_rate_ratio / r2d - 1.0).abs() < 0.05 {
+            let p = format!(
+                "mean angular rate on a static stretch is {earth_rate_ratio:.2}× Earth rate, within 5 % of 57.3 (degrees per radian): the gyro values look like deg/s read as rad/s — check gyro_unit"
+            );
+            self.problems.push(p.clone());
+            self.gyro_unit_problems.push(p);
+        } else if earth_rate_ratio > 1000.0 {
+            let p = format!(
+                "mean angular rate {:.4} deg/s on a static stretch is {:.0}× Earth rate (even MEMS gyro \
+                 biases stay below ~100×): check gyro_unit (deg/s read as rad/s gives 57.3×)",
+                w.norm() * deg,
+                earth_rate_ratio
+            );
+            self.problems.push(p.clone());
+            self.gyro_unit_problems.push(p);
+        } else if earth_rate_ratio < 0.2 {
+            self.problems.push(format!(
+                "mean angular rate {:.3e} deg/h on a static stretch is {:.3}× Earth rate (15.04 deg/h), which \
+                 any gyro at rest measures: check gyro_unit (rad/s read as deg/s gives 1/57.3)",
+                w.norm() * deg * 3600.0,
+                earth_rate_ratio
+            ));
+        }
     }
-    if gaps > 0 {
-        notes.push(format!(
-            "{gaps} intervals longer than twice the median (the longest {:.4} s)",
-            intervals.last().copied().unwrap_or(0.0)
-        ));
-    }
-    ImuCheck {
-        samples: s.len(),
-        duration_s: imu.duration(),
-        rate_hz: 1.0 / median,
-        interval_min_s: intervals.first().copied().unwrap_or(0.0),
-        interval_max_s: intervals.last().copied().unwrap_or(0.0),
-        jitter_rms_s: jitter,
-        gaps,
-        window_s: [w0, w1],
-        f_spread_mps2: spread,
-        is_static,
-        f_mean_mps2: [f.x, f.y, f.z],
-        w_mean_radps: [w.x, w.y, w.z],
-        gravity_ratio,
-        gravity_mps2: g,
-        earth_rate_ratio,
-        roll_deg: roll * deg,
-        pitch_deg: pitch * deg,
-        heading_deg: heading,
-        tilt_deg: tilt * deg,
-        problems,
-        unit_problems,
-        gyro_unit_problems,
-        notes,
+
+    /// Notes on the clock: jitter above 1 % of the `median` interval [s], and `gaps` (intervals
+    /// over twice the median; `intervals` [s] sorted).
+    fn clock(&mut self, jitter: f64, median: f64, intervals: &[f64], gaps: usize) {
+        if jitter > 0.01 * median {
+            self.notes.push(format!(
+                "the clock jitters: intervals {:.6}–{:.6} s, RMS {:.2e} s about the median {median:.6} s \
+                 (each sample's own interval is used)",
+                intervals.first().copied().unwrap_or(0.0),
+                intervals.last().copied().unwrap_or(0.0),
+                jitter
+            ));
+        }
+        if gaps > 0 {
+            self.notes.push(format!(
+                "{gaps} intervals longer than twice the median (the longest {:.4} s)",
+                intervals.last().copied().unwrap_or(0.0)
+            ));
+        }
     }
 }
 

@@ -340,6 +340,17 @@ pub(super) fn channel_word(c: &str) -> String {
 /// The plain-words summary: what the baseline gets wrong, what was found, the gain.
 pub(super) fn summary(e: &Explanation) -> Vec<String> {
     let mut out = Vec::new();
+    tight_priors_words(e, &mut out);
+    let t_ref = time_reference(e);
+    baseline_consistency_words(e, t_ref, &mut out);
+    findings_words(e, &mut out);
+    left_over_words(e, t_ref, &mut out);
+    not_named_words(e, &mut out);
+    out
+}
+
+/// The summary's line on baseline priors the data find too tight (and whether they were widened).
+fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
     if !e.baseline_priors_tight.is_empty() {
         let w = &e.baseline_priors_tight;
         let values = w
@@ -382,12 +393,22 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             )
         });
     }
+}
+
+/// The time [s] the summary counts data times from: the first update's whole second when the
+/// times are large (GPS seconds on real data), else 0.
+fn time_reference(e: &Explanation) -> f64 {
     // data times (GPS seconds on real data) are counted from the first update when large
-    let t_ref = if e.baseline.t_start.abs() > 1e5 {
+    if e.baseline.t_start.abs() > 1e5 {
         e.baseline.t_start.floor()
     } else {
         0.0
-    };
+    }
+}
+
+/// The summary's lines on where the baseline misfits the data (innovations too large, correlated
+/// or too small), or that it is consistent; times from `t_ref` [s].
+fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
     let mut consistent = true;
     for ch in &e.baseline.channels {
         let inconsistent = ch.nis_mean > ch.nis_band[1] * 1.5
@@ -438,6 +459,10 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             sig3(e.baseline.nis_mean)
         ));
     }
+}
+
+/// The summary's lines on the findings: none significant, each one, and the extended model's gain.
+fn findings_words(e: &Explanation, out: &mut Vec<String>) {
     if e.findings.is_empty() {
         let nameable = e
             .candidates
@@ -503,6 +528,11 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
         s.push('.');
         out.push(s);
     }
+}
+
+/// The summary's lines on what the extension leaves: the unexplained share of the misfit and the
+/// structure left in the innovations; times from `t_ref` [s].
+fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
     if let Some(left) = e.misfit_unexplained {
         if e.findings.is_empty() || left > 0.1 {
             out.push(format!(
@@ -555,6 +585,11 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             said.join("; ")
         ));
     }
+}
+
+/// The summary's lines on candidates not named: implausible, unconfirmed, not separable, not
+/// testable.
+fn not_named_words(e: &Explanation, out: &mut Vec<String>) {
     if !e.implausible.is_empty() {
         let list: Vec<String> = e
             .implausible
@@ -602,5 +637,4 @@ pub(super) fn summary(e: &Explanation) -> Vec<String> {
             e.not_testable.join(", ")
         ));
     }
-    out
 }

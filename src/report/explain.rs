@@ -167,6 +167,22 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     for line in &e.summary {
         s.push_str(&format!("- {line}\n"));
     }
+    baseline_section(e, &mut s);
+    candidates_section(e, &mut s);
+    findings_section(e, &mut s);
+    gain_section(e, &mut s);
+    notes_section(&mut s);
+    if !figures.is_empty() {
+        s.push_str("\n## Figures\n\n");
+        for (file, caption) in figures {
+            s.push_str(&format!("![{caption}]({file})\n\n*{caption}*\n\n"));
+        }
+    }
+    s
+}
+
+/// Section 1 of the Markdown report: the baseline's fit, channel by channel, and against truth.
+fn baseline_section(e: &Explanation, s: &mut String) {
     s.push_str("\n## 1. What the baseline gets wrong\n\n");
     s.push_str(&format!(
         "Baseline {}: log-likelihood {}, mean NIS {} (1 when consistent), whiteness p {} \
@@ -216,6 +232,10 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
             ));
         }
     }
+}
+
+/// Section 2 of the Markdown report: the table of candidates, each tested alone.
+fn candidates_section(e: &Explanation, s: &mut String) {
     s.push_str(&format!(
         "\n## 2. Candidates (baseline pass, each alone; α = {} family-wise, Holm)\n\n\
          | term | group | llr | p (Holm) | GLR estimate | σ | unit | note |\n|---|---|---|---|---|---|---|---|\n",
@@ -248,6 +268,10 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
             ));
         }
     }
+}
+
+/// Section 3 of the Markdown report: the findings and the extended model.
+fn findings_section(e: &Explanation, s: &mut String) {
     s.push_str("\n## 3. Findings and the extended model\n\n");
     if e.findings.is_empty() {
         s.push_str("Nothing is significant; the model stays as it is.\n");
@@ -276,7 +300,12 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     if extended_preset(e).is_some() {
         s.push_str(" (its `presets.toml` entry is in `extended.toml`)");
     }
-    s.push_str(".\n\n## 4. Gain\n\n| | baseline | extended |\n|---|---|---|\n");
+    s.push_str(".\n");
+}
+
+/// Section 4 of the Markdown report: the gain of the extended model over the baseline.
+fn gain_section(e: &Explanation, s: &mut String) {
+    s.push_str("\n## 4. Gain\n\n| | baseline | extended |\n|---|---|---|\n");
     s.push_str(&format!(
         "| log-likelihood | {} | {} |\n| mean NIS | {} | {} |\n| whiteness p | {} | {} |\n",
         num(e.baseline.loglik),
@@ -293,6 +322,10 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
             num(a)
         ));
     }
+}
+
+/// The Markdown report's notes on how to read the tests and the words it uses.
+fn notes_section(s: &mut String) {
     s.push_str(
         "\nThe candidate tests are quasi-likelihood tests: when the baseline's innovations are \
          larger than predicted (mean NIS φ > 1), information and score are divided by φ. A term \
@@ -310,13 +343,6 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
          member the spec's priors find most plausible and says which excitation would separate \
          them.\n",
     );
-    if !figures.is_empty() {
-        s.push_str("\n## Figures\n\n");
-        for (file, caption) in figures {
-            s.push_str(&format!("![{caption}]({file})\n\n*{caption}*\n\n"));
-        }
-    }
-    s
 }
 
 /// Standard base64 (RFC 4648, with padding), for figures embedded in the HTML report.

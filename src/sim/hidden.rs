@@ -217,6 +217,46 @@ fn baseline_errors(rng: &mut Rng, with_d: bool, skip: &[String]) -> String {
     s
 }
 
+/// What every group's draw shares: the case's length, windows, vibration and effect sizes.
+struct Draw {
+    /// Length of the case [s].
+    seconds: f64,
+    /// Vibration frequency [Hz].
+    freq: f64,
+    /// Length of one of the six windows [s].
+    w: f64,
+    /// First window on (start, end) [s].
+    on1: (f64, f64),
+    /// Second window on (start, end) [s].
+    on2: (f64, f64),
+    /// Schedule: the first window at scale 1, the second at 0.5.
+    steps: String,
+    /// Vibration amplitude [g].
+    amp: f64,
+    /// The effect at the strongest excitation (mg or deg/h).
+    effect: f64,
+    /// The effect as an acceleration [m/s²].
+    effect_si_acc: f64,
+    /// The effect as an angular rate [rad/s].
+    effect_si_gyro: f64,
+    /// Vibration amplitude [m/s²].
+    a_si: f64,
+}
+
+/// The parts of a case a group's draw sets: scenario pieces, hidden terms, baseline.
+struct Parts {
+    /// The `[[segment]]`s.
+    segments: String,
+    /// The `[[vibration]]`s.
+    vib: String,
+    /// Hidden terms and their true values, SI.
+    hidden: Vec<(String, f64)>,
+    /// Baseline model that lacks them.
+    baseline: String,
+    /// The baseline has its own d_x, d_y, d_z errors.
+    with_d: bool,
+}
+
 /// Draws a case of `kind` from `seed`. Cases last `seconds` (≥ 300) of 2 kHz IMU data at rest
 /// (or a short drive for the g-sensitivity group), with windows of excitation that switch on
 /// and off or step in amplitude, so that the hidden term is separable from the baseline's bias
@@ -235,206 +275,281 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
         on1.0, on1.1, on2.0, on2.1
     );
     let amp = (4.0 + 4.0 * rng.uniform()).round(); // g
-    let mut segments = format!("[[segment]]\nkind = \"rest\"\nduration_s = {seconds}\n");
-    let mut vib = String::new();
-    let mut hidden: Vec<(String, f64)> = Vec::new();
-    let mut baseline = "P31".to_string();
-    let mut with_d = true;
-    let axes = ["x", "y", "z"];
-    let effect_si_acc = effect * 1e-3 * G0;
-    let effect_si_gyro = effect * std::f64::consts::PI / 180.0 / 3600.0;
-    let a_si = amp * G0;
-    let group: String;
-    let description: String;
-    match kind {
-        CaseKind::Null => {
-            group = "null".into();
-            let ax = *pick(&mut rng, &axes[..2]);
-            vib = sine(ax, amp, freq, &steps);
-            description = format!(
-                "nothing hidden; {amp} g / {} g vibration on {ax}",
-                amp / 2.0
-            );
-        }
-        CaseKind::Two => {
-            group = "two".into();
-            baseline = "P28".into();
-            with_d = false;
-            // x alone, y alone, then both at half amplitude: two amplitudes per axis separate
-            // the quadratic terms from the asymmetric scale factors
-            let both = (5.0 * w, 5.5 * w);
-            let sched = |on: (f64, f64)| {
-                format!(
-                    "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5]]",
-                    on.0, on.1, both.0, both.1
-                )
-            };
-            vib = sine("x", amp, freq, &sched(on1)) + &sine("y", amp, freq + 7.0, &sched(on2));
-            let d = effect_si_acc / (a_si * a_si / 2.0);
-            hidden.push(("d_x".into(), d));
-            hidden.push(("d_y".into(), -0.7 * d));
-            description = format!(
-                "d_x and d_y hidden; {amp} g vibration on x, then y, then both at {} g",
-                amp / 2.0
-            );
-        }
+    let d = Draw {
+        seconds,
+        freq,
+        w,
+        on1,
+        on2,
+        steps,
+        amp,
+        effect,
+        effect_si_acc: effect * 1e-3 * G0,
+        effect_si_gyro: effect * std::f64::consts::PI / 180.0 / 3600.0,
+        a_si: amp * G0,
+    };
+    let mut p = Parts {
+        segments: format!("[[segment]]\nkind = \"rest\"\nduration_s = {seconds}\n"),
+        vib: String::new(),
+        hidden: Vec::new(),
+        baseline: "P31".to_string(),
+        with_d: true,
+    };
+    let (group, description): (String, String) = match kind {
+        CaseKind::Null => ("null".into(), draw_null(&mut rng, &d, &mut p)),
+        CaseKind::Two => ("two".into(), draw_two(&d, &mut p)),
         CaseKind::One(g) => {
-            group = g.into();
-            match g {
-                "d" => {
-                    baseline = "P28".into();
-                    with_d = false;
-                    let ax = *pick(&mut rng, &axes[..2]);
-                    vib = sine(ax, amp, freq, &steps);
-                    let v = effect_si_acc / (a_si * a_si / 2.0);
-                    hidden.push((format!("d_{ax}"), v));
-                }
-                "kaq" => {
-                    let (name, j, k) =
-                        *pick(&mut rng, &[("kaq_x_xy", "x", "y"), ("kaq_y_xy", "x", "y")]);
-                    // single-axis windows, then both in phase
-                    let s_j = format!(
-                        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
-                        on1.0, on1.1, on2.0, on2.1
-                    );
-                    let s_k = format!(
-                        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
-                        2.0 * w,
-                        2.5 * w,
-                        on2.0,
-                        on2.1
-                    );
-                    vib = sine(j, amp, freq, &s_j) + &sine(k, amp, freq, &s_k);
-                    let v = effect_si_acc / (a_si * a_si / 2.0);
-                    hidden.push((name.into(), v));
-                }
-                "kas" => {
-                    let ax = *pick(&mut rng, &axes[..2]);
-                    vib = sine(ax, amp, freq, &steps);
-                    let v = effect_si_acc / (a_si * 2.0 / std::f64::consts::PI);
-                    hidden.push((format!("kas_{ax}"), v));
-                }
-                "kao" => {
-                    // gravity along z plus vibration beyond 1 g along z; the vertical channel shows it
-                    baseline = "P31+vertical".into();
-                    vib = sine("z", amp, freq, &steps);
-                    let v = effect_si_acc / (a_si * a_si / 2.0);
-                    hidden.push(("kao_z".into(), v));
-                }
-                "kgf" => {
-                    // a short drive: accelerations along x, turns (centripetal f_y)
-                    let (name, fj) = *pick(
-                        &mut rng,
-                        &[("kgf_xx", 0), ("kgf_yx", 1), ("kgf_xy", 2), ("kgf_yy", 3)],
-                    );
-                    let n = ((seconds - 60.0) / 60.0).floor().max(1.0) as usize;
-                    segments = String::from("[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n");
-                    for i in 0..n {
-                        if fj < 2 {
-                            let a = if i % 2 == 0 { 2.0 } else { -2.0 };
-                            segments.push_str(&format!("[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = {a}\n[[segment]]\nkind = \"cruise\"\nduration_s = 50.0\n"));
-                        } else {
-                            let r = if i % 2 == 0 { 6.0 } else { -6.0 };
-                            if i == 0 {
-                                segments.push_str("[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = 2.0\n");
-                            }
-                            segments.push_str(&format!("[[segment]]\nkind = \"turn\"\nduration_s = 15.0\nyaw_rate_deg_s = {r}\n[[segment]]\nkind = \"cruise\"\nduration_s = 35.0\n"));
-                        }
-                    }
-                    let g_exc = if fj < 2 {
-                        2.0
-                    } else {
-                        20.0 * 6.0f64.to_radians()
-                    };
-                    let v = effect_si_gyro / g_exc;
-                    hidden.push((name.into(), v));
-                }
-                "kgq" => {
-                    let (name, j, k) = *pick(&mut rng, &[("kgq_x", "y", "z"), ("kgq_y", "x", "z")]);
-                    let s_j = format!(
-                        "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
-                        on1.0, on1.1, on2.0, on2.1
-                    );
-                    let s_k = format!("[[{:.1}, {:.1}, 1.0]]", on2.0, on2.1);
-                    vib = sine(j, amp, freq, &s_j) + &sine(k, amp, freq, &s_k);
-                    let v = effect_si_gyro / (a_si * a_si / 2.0);
-                    hidden.push((name.into(), v));
-                }
-                "size" => {
-                    let (name, ax) = *pick(
-                        &mut rng,
-                        &[("size_x", "yaw"), ("size_y", "yaw"), ("size_x", "pitch")],
-                    );
-                    let amp_deg = 0.5;
-                    let f_ang = 10.0;
-                    vib = angular(ax, amp_deg, f_ang, &steps);
-                    let om = 2.0 * std::f64::consts::PI * f_ang * amp_deg.to_radians();
-                    let v = effect_si_acc / (om * om / 2.0);
-                    hidden.push((name.into(), v));
-                }
-                "gnss_time" | "gnss_time_kgf" => {
-                    segments = drive_segments(seconds);
-                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                    // 20–300 ms
-                    let dt = sgn * effect * (0.02 + 0.28 * rng.uniform());
-                    hidden.push(("dt_gnss".into(), dt));
-                    if g == "gnss_time_kgf" {
-                        // and a sensor term beside it: a MEMS-class gyro g-sensitivity, excited
-                        // by the drive's speed changes (±1 m/s²) and turns
-                        hidden.push(("kgf_yx".into(), 3.0 * effect_si_gyro));
-                    }
-                }
-                "gnss_lever" => {
-                    segments = drive_segments(seconds);
-                    let name = *pick(&mut rng, &["lever_x", "lever_y"]);
-                    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                    // 0.1–2 m
-                    hidden.push((name.into(), sgn * effect * (0.1 + 1.9 * rng.uniform())));
-                }
-                "inner_lever" | "accel_delay" | "inner_lever_delay" => {
-                    segments = turntable_segments();
-                    if g != "accel_delay" {
-                        let name = *pick(
-                            &mut rng,
-                            &[
-                                "size_x_y", "size_x_z", "size_y_x", "size_y_z", "size_z_x",
-                                "size_z_y",
-                            ],
-                        );
-                        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                        // 20–60 mm
-                        hidden.push((name.into(), sgn * effect * (0.02 + 0.04 * rng.uniform())));
-                    }
-                    if g != "inner_lever" {
-                        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                        // 1–3 ms, the same for the three accelerometers
-                        let tau = sgn * effect * (1e-3 + 2e-3 * rng.uniform());
-                        for a in ["x", "y", "z"] {
-                            hidden.push((format!("tau_{a}"), tau));
-                        }
-                    }
-                }
-                other => panic!("unknown group {other}"),
+            draw_one(g, &mut rng, &d, &mut p);
+            (g.into(), one_description(g, &p, effect))
+        }
+    };
+    assemble(seed, group, description, lat, effect, &mut rng, p)
+}
+
+/// A null case: nothing hidden, a stepped sine vibration on x or y; returns the description.
+fn draw_null(rng: &mut Rng, d: &Draw, p: &mut Parts) -> String {
+    let amp = d.amp;
+    let axes = ["x", "y", "z"];
+    let ax = *pick(rng, &axes[..2]);
+    p.vib = sine(ax, amp, d.freq, &d.steps);
+    format!(
+        "nothing hidden; {amp} g / {} g vibration on {ax}",
+        amp / 2.0
+    )
+}
+
+/// A case hiding d_x and d_y on different windows; returns the description.
+fn draw_two(d: &Draw, p: &mut Parts) -> String {
+    let (amp, freq, w, a_si) = (d.amp, d.freq, d.w, d.a_si);
+    p.baseline = "P28".into();
+    p.with_d = false;
+    // x alone, y alone, then both at half amplitude: two amplitudes per axis separate
+    // the quadratic terms from the asymmetric scale factors
+    let both = (5.0 * w, 5.5 * w);
+    let sched = |on: (f64, f64)| {
+        format!(
+            "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 0.5]]",
+            on.0, on.1, both.0, both.1
+        )
+    };
+    p.vib = sine("x", amp, freq, &sched(d.on1)) + &sine("y", amp, freq + 7.0, &sched(d.on2));
+    let dd = d.effect_si_acc / (a_si * a_si / 2.0);
+    p.hidden.push(("d_x".into(), dd));
+    p.hidden.push(("d_y".into(), -0.7 * dd));
+    format!(
+        "d_x and d_y hidden; {amp} g vibration on x, then y, then both at {} g",
+        amp / 2.0
+    )
+}
+
+/// Draws the hidden term(s) of group `g` and the scenario pieces that excite them.
+fn draw_one(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    match g {
+        "d" | "kaq" | "kas" | "kao" | "kgq" | "size" => draw_vibrated(g, rng, d, p),
+        "kgf" => draw_kgf(rng, d, p),
+        "gnss_time" | "gnss_time_kgf" | "gnss_lever" => draw_gnss(g, rng, d, p),
+        "inner_lever" | "accel_delay" | "inner_lever_delay" => draw_turntable(g, rng, d, p),
+        other => panic!("unknown group {other}"),
+    }
+}
+
+/// A term of group `g` excited by vibration at rest (d, kaq, kas, kao, kgq, size).
+fn draw_vibrated(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    let (amp, freq, w, on1, on2, steps) = (d.amp, d.freq, d.w, d.on1, d.on2, &d.steps);
+    let (effect_si_acc, effect_si_gyro, a_si) = (d.effect_si_acc, d.effect_si_gyro, d.a_si);
+    let axes = ["x", "y", "z"];
+    match g {
+        "d" => {
+            p.baseline = "P28".into();
+            p.with_d = false;
+            let ax = *pick(rng, &axes[..2]);
+            p.vib = sine(ax, amp, freq, steps);
+            let v = effect_si_acc / (a_si * a_si / 2.0);
+            p.hidden.push((format!("d_{ax}"), v));
+        }
+        "kaq" => {
+            let (name, j, k) = *pick(rng, &[("kaq_x_xy", "x", "y"), ("kaq_y_xy", "x", "y")]);
+            // single-axis windows, then both in phase
+            let s_j = format!(
+                "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                on1.0, on1.1, on2.0, on2.1
+            );
+            let s_k = format!(
+                "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                2.0 * w,
+                2.5 * w,
+                on2.0,
+                on2.1
+            );
+            p.vib = sine(j, amp, freq, &s_j) + &sine(k, amp, freq, &s_k);
+            let v = effect_si_acc / (a_si * a_si / 2.0);
+            p.hidden.push((name.into(), v));
+        }
+        "kas" => {
+            let ax = *pick(rng, &axes[..2]);
+            p.vib = sine(ax, amp, freq, steps);
+            let v = effect_si_acc / (a_si * 2.0 / std::f64::consts::PI);
+            p.hidden.push((format!("kas_{ax}"), v));
+        }
+        "kao" => {
+            // gravity along z plus vibration beyond 1 g along z; the vertical channel shows it
+            p.baseline = "P31+vertical".into();
+            p.vib = sine("z", amp, freq, steps);
+            let v = effect_si_acc / (a_si * a_si / 2.0);
+            p.hidden.push(("kao_z".into(), v));
+        }
+        "kgq" => {
+            let (name, j, k) = *pick(rng, &[("kgq_x", "y", "z"), ("kgq_y", "x", "z")]);
+            let s_j = format!(
+                "[[{:.1}, {:.1}, 1.0], [{:.1}, {:.1}, 1.0]]",
+                on1.0, on1.1, on2.0, on2.1
+            );
+            let s_k = format!("[[{:.1}, {:.1}, 1.0]]", on2.0, on2.1);
+            p.vib = sine(j, amp, freq, &s_j) + &sine(k, amp, freq, &s_k);
+            let v = effect_si_gyro / (a_si * a_si / 2.0);
+            p.hidden.push((name.into(), v));
+        }
+        "size" => {
+            let (name, ax) = *pick(
+                rng,
+                &[("size_x", "yaw"), ("size_y", "yaw"), ("size_x", "pitch")],
+            );
+            let amp_deg = 0.5;
+            let f_ang = 10.0;
+            p.vib = angular(ax, amp_deg, f_ang, steps);
+            let om = 2.0 * std::f64::consts::PI * f_ang * amp_deg.to_radians();
+            let v = effect_si_acc / (om * om / 2.0);
+            p.hidden.push((name.into(), v));
+        }
+        other => panic!("unknown group {other}"),
+    }
+}
+
+/// A gyro g-sensitivity kgf_* excited by a short drive (accelerations along x, or turns).
+fn draw_kgf(rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    let seconds = d.seconds;
+    // a short drive: accelerations along x, turns (centripetal f_y)
+    let (name, fj) = *pick(
+        rng,
+        &[("kgf_xx", 0), ("kgf_yx", 1), ("kgf_xy", 2), ("kgf_yy", 3)],
+    );
+    let n = ((seconds - 60.0) / 60.0).floor().max(1.0) as usize;
+    let segments = &mut p.segments;
+    *segments = String::from("[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n");
+    for i in 0..n {
+        if fj < 2 {
+            let a = if i % 2 == 0 { 2.0 } else { -2.0 };
+            segments.push_str(&format!("[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = {a}\n[[segment]]\nkind = \"cruise\"\nduration_s = 50.0\n"));
+        } else {
+            let r = if i % 2 == 0 { 6.0 } else { -6.0 };
+            if i == 0 {
+                segments.push_str(
+                    "[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = 2.0\n",
+                );
             }
-            let info = common::TERMS.iter().find(|t| t.name == hidden[0].0);
-            let size = match info.map(|t| t.sensor) {
-                Some(crate::model::catalog::Sensor::Gyro) => format!("{effect} deg/h"),
-                // a GNSS term or a lever arm: its value
-                Some(_) if TURNTABLE_GROUPS.contains(&g) => {
-                    let t = info.expect("matched");
-                    format!("{:.1} {}", hidden[0].1 / t.display_to_si, t.display)
-                }
-                Some(crate::model::catalog::Sensor::Gnss) => {
-                    let t = info.expect("matched");
-                    format!("{:.3} {}", hidden[0].1 / t.display_to_si, t.display)
-                }
-                _ => format!("{effect} mg"),
-            };
-            description = format!("{} hidden ({size}), baseline {baseline}", hidden[0].0);
+            segments.push_str(&format!("[[segment]]\nkind = \"turn\"\nduration_s = 15.0\nyaw_rate_deg_s = {r}\n[[segment]]\nkind = \"cruise\"\nduration_s = 35.0\n"));
         }
     }
+    let g_exc = if fj < 2 {
+        2.0
+    } else {
+        20.0 * 6.0f64.to_radians()
+    };
+    let v = d.effect_si_gyro / g_exc;
+    p.hidden.push((name.into(), v));
+}
+
+/// A GNSS term of group `g` on a drive: the time offset (and kgf_yx beside it) or a lever arm.
+fn draw_gnss(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    let effect = d.effect;
+    p.segments = drive_segments(d.seconds);
+    if g == "gnss_lever" {
+        let name = *pick(rng, &["lever_x", "lever_y"]);
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        // 0.1–2 m
+        p.hidden
+            .push((name.into(), sgn * effect * (0.1 + 1.9 * rng.uniform())));
+        return;
+    }
+    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+    // 20–300 ms
+    let dt = sgn * effect * (0.02 + 0.28 * rng.uniform());
+    p.hidden.push(("dt_gnss".into(), dt));
+    if g == "gnss_time_kgf" {
+        // and a sensor term beside it: a MEMS-class gyro g-sensitivity, excited
+        // by the drive's speed changes (±1 m/s²) and turns
+        p.hidden.push(("kgf_yx".into(), 3.0 * d.effect_si_gyro));
+    }
+}
+
+/// An inner lever arm (20–60 mm times the effect) and/or an accelerometer delay (1–3 ms times
+/// the effect) of group `g`, on a turntable.
+fn draw_turntable(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    let effect = d.effect;
+    p.segments = turntable_segments();
+    if g != "accel_delay" {
+        let name = *pick(
+            rng,
+            &[
+                "size_x_y", "size_x_z", "size_y_x", "size_y_z", "size_z_x", "size_z_y",
+            ],
+        );
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        // 20–60 mm
+        p.hidden
+            .push((name.into(), sgn * effect * (0.02 + 0.04 * rng.uniform())));
+    }
+    if g != "inner_lever" {
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        // 1–3 ms, the same for the three accelerometers
+        let tau = sgn * effect * (1e-3 + 2e-3 * rng.uniform());
+        for a in ["x", "y", "z"] {
+            p.hidden.push((format!("tau_{a}"), tau));
+        }
+    }
+}
+
+/// The description of a one-group case: the first hidden term and its size (`effect` in deg/h
+/// or mg, or the term's own value for a GNSS or turntable term).
+fn one_description(g: &str, p: &Parts, effect: f64) -> String {
+    let hidden = &p.hidden;
+    let info = common::TERMS.iter().find(|t| t.name == hidden[0].0);
+    let size = match info.map(|t| t.sensor) {
+        Some(crate::model::catalog::Sensor::Gyro) => format!("{effect} deg/h"),
+        // a GNSS term or a lever arm: its value
+        Some(_) if TURNTABLE_GROUPS.contains(&g) => {
+            let t = info.expect("matched");
+            format!("{:.1} {}", hidden[0].1 / t.display_to_si, t.display)
+        }
+        Some(crate::model::catalog::Sensor::Gnss) => {
+            let t = info.expect("matched");
+            format!("{:.3} {}", hidden[0].1 / t.display_to_si, t.display)
+        }
+        _ => format!("{effect} mg"),
+    };
+    format!("{} hidden ({size}), baseline {}", hidden[0].0, p.baseline)
+}
+
+/// The case from its drawn parts: the baseline's errors (drawn last), the scenario text at
+/// latitude `lat` [deg], the priors it declares.
+fn assemble(
+    seed: u64,
+    group: String,
+    description: String,
+    lat: f64,
+    effect: f64,
+    rng: &mut Rng,
+    p: Parts,
+) -> HiddenCase {
+    let Parts {
+        segments,
+        vib,
+        hidden,
+        baseline,
+        with_d,
+    } = p;
     let skip: Vec<String> = hidden.iter().map(|h| h.0.clone()).collect();
-    let mut errors = baseline_errors(&mut rng, with_d, &skip);
+    let mut errors = baseline_errors(rng, with_d, &skip);
     for (name, v) in &hidden {
         errors.push_str(&format!("{name} = \"{v:e} {}\"\n", unit_of(name)));
     }

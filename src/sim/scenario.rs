@@ -341,7 +341,7 @@ impl Scenario {
                 .unwrap_or(0);
             anyhow!("{origin}:{line}: {}", e.message().trim())
         })?;
-        let at = |needle: &str| format!("{origin}:{}", line_of(text, needle));
+        let src = Src { text, origin };
         // default IMU rate: 2 kHz with vibration (DESIGN §2: increments attenuate <f^2>), else 100 Hz
 
         let imu_rate_hz = raw.imu_rate_hz.unwrap_or(if raw.vibration.is_empty() {
@@ -349,309 +349,21 @@ impl Scenario {
         } else {
             2000.0
         });
-
-        if !(imu_rate_hz > 0.0 && imu_rate_hz <= MAX_RATE_HZ) {
-            bail!(
-                "{}: imu_rate_hz = {imu_rate_hz} must be in (0, {MAX_RATE_HZ}] Hz",
-                at("imu_rate_hz")
-            );
-        }
-        if !(raw.truth_rate_hz > 0.0 && raw.truth_rate_hz <= imu_rate_hz) {
-            bail!(
-                "{}: truth_rate_hz must be in (0, imu_rate_hz]",
-                at("truth_rate_hz")
-            );
-        }
-        let st = &raw.start;
-        if st.lat_deg.is_nan() || st.lat_deg.abs() >= 89.0 {
-            bail!(
-                "{}: lat_deg = {} must be within ±89°",
-                at("lat_deg"),
-                st.lat_deg
-            );
-        }
-        use crate::io::bounds;
-        if let Some(p) = bounds::lon_deg(st.lon_deg) {
-            bail!("{}: lon_deg: {p}", at("lon_deg"));
-        }
-        if let Some(p) = bounds::height_m(st.h_m) {
-            bail!("{}: h_m: {p}", at("h_m"));
-        }
-        if let Some(p) = bounds::attitude_deg(st.euler_deg) {
-            bail!("{}: euler_deg: {p}", at("euler_deg"));
-        }
-        if !(0.0..=1e4).contains(&st.speed_mps) {
-            bail!(
-                "{}: speed_mps = {} must be in 0 .. 1e4 m/s",
-                at("speed_mps"),
-                st.speed_mps
-            );
-        }
-        if raw.segment.is_empty() {
-            bail!("{origin}: at least one [[segment]] is needed");
-        }
+        check_rates_and_start(&raw, &src, imu_rate_hz)?;
         let mut warnings = Vec::new();
-        let mut speed = raw.start.speed_mps;
-        for (k, s) in raw.segment.iter().enumerate() {
-            let where_ = format!("{origin}: segment {} (`{}`)", k + 1, s.kind);
-            if !(s.duration_s > 0.0 && s.duration_s <= MAX_DURATION_S) {
-                bail!(
-                    "{where_}: duration_s = {} must be in (0, {MAX_DURATION_S}] s",
-                    s.duration_s
-                );
-            }
-            if !(s.accel_mps2.abs() <= 1e3 && s.yaw_rate_deg_s.abs() <= 1e4) {
-                bail!(
-                    "{where_}: accel_mps2 = {} (|a| <= 1000 m/s^2) or yaw_rate_deg_s = {} (|r| <= 1e4 deg/s) out of range",
-                    s.accel_mps2,
-                    s.yaw_rate_deg_s
-                );
-            }
-            if s.kind != "rotate" && (s.axis.is_some() || s.angle_deg.is_some()) {
-                bail!("{where_}: `axis` and `angle_deg` belong to `rotate` segments");
-            }
-            match s.kind.as_str() {
-                "rest" if speed != 0.0 => {
-                    bail!("{where_}: rest needs zero speed (speed is {speed} m/s)")
-                }
-                "rest" | "cruise" | "turn" => {}
-                "accelerate" => speed += s.accel_mps2 * s.duration_s,
-                "rotate" => check_rotate(s, &where_, imu_rate_hz, &mut warnings)?,
-                other => bail!(
-                    "{where_}: unknown kind `{other}` (rest, cruise, accelerate, turn, rotate)"
-                ),
-            }
-            if speed < 0.0 {
-                bail!("{where_}: speed would become negative");
-            }
-            if speed > 1e4 {
-                bail!("{where_}: speed would exceed 1e4 m/s");
-            }
-        }
-        if raw.segment.iter().any(|s| s.kind == "rotate") {
-            if raw.start.speed_mps != 0.0
-                || raw
-                    .segment
-                    .iter()
-                    .any(|s| !matches!(s.kind.as_str(), "rest" | "rotate"))
-            {
-                bail!(
-                    "{origin}: a `rotate` segment is a turntable rotation at rest: the scenario may then hold only `rest` and `rotate` segments, from speed_mps = 0"
-                );
-            }
-            if raw.vibration.iter().any(|v| v.kind == "angular") {
-                bail!(
-                    "{origin}: angular vibration and `rotate` segments cannot be combined (the turntable sets the attitude)"
-                );
-            }
-        }
+        check_segments(&raw, origin, imu_rate_hz, &mut warnings)?;
         for v in &raw.vibration {
-            let where_ = format!(
-                "{}: vibration `{}` on `{}`",
-                at(&format!("axis = \"{}\"", v.axis)),
-                v.kind,
-                v.axis
-            );
-            let linear_axes = ["n", "e", "d", "x", "y", "z"];
-            match v.kind.as_str() {
-                "sine" | "random" if !linear_axes.contains(&v.axis.as_str()) => {
-                    bail!("{where_}: axis must be one of n e d x y z")
-                }
-                "angular" if !["roll", "pitch", "yaw"].contains(&v.axis.as_str()) => {
-                    bail!("{where_}: axis must be roll, pitch or yaw")
-                }
-                "sine" | "random" | "angular" => {}
-                other => bail!("{where_}: unknown kind `{other}` (sine, random, angular)"),
-            }
-            // a key of another kind would be ignored without a word (and went unchecked: a
-            // random source took `freq_hz = nan`)
-            let foreign = if v.kind == "random" {
-                [
-                    (v.amplitude.is_some(), "amplitude"),
-                    (v.freq_hz != 0.0, "freq_hz"),
-                    (v.phase_deg != 0.0, "phase_deg"),
-                ]
-            } else {
-                [
-                    (v.psd.is_some(), "psd"),
-                    (v.band_hz.is_some(), "band_hz"),
-                    (v.components.is_some(), "components"),
-                ]
-            };
-            if let Some((_, key)) = foreign.iter().find(|(set, _)| *set) {
-                let uses = if v.kind == "random" {
-                    "psd, band_hz, components"
-                } else {
-                    "amplitude, freq_hz, phase_deg"
-                };
-                bail!(
-                    "{where_}: `{key}` does not apply to a `{}` vibration (it takes {uses}, schedule)",
-                    v.kind
-                );
-            }
-            match v.kind.as_str() {
-                "sine" => {
-                    let a = v
-                        .amplitude
-                        .as_deref()
-                        .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
-                    let a = units::parse_quantity_as(a, "m/s^2")
-                        .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
-                    if a.is_nan() || a.abs() > 1000.0 * units::STANDARD_GRAVITY {
-                        bail!("{where_}: amplitude must be within ±1000 g");
-                    }
-                }
-                "angular" => {
-                    let a = v
-                        .amplitude
-                        .as_deref()
-                        .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
-                    let a = units::parse_quantity_as(a, "rad")
-                        .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
-                    if a.is_nan() || a.abs() > std::f64::consts::PI {
-                        bail!("{where_}: amplitude must be within ±180 deg");
-                    }
-                }
-                _ => {
-                    let p = v
-                        .psd
-                        .as_deref()
-                        .ok_or_else(|| anyhow!("{where_}: psd missing"))?;
-                    let p = units::parse_quantity_as(p, "m^2/s^4/Hz")
-                        .map_err(|e| anyhow!("{where_}: psd: {e}"))?;
-                    let g2 = units::STANDARD_GRAVITY.powi(2);
-                    if !(0.0..=100.0 * g2).contains(&p) {
-                        bail!("{where_}: psd must be in 0 .. 100 g^2/Hz");
-                    }
-                    let b = v
-                        .band_hz
-                        .ok_or_else(|| anyhow!("{where_}: band_hz missing"))?;
-                    if !(b[0] > 0.0 && b[1] > b[0] && b[1] <= MAX_VIB_HZ) {
-                        bail!("{where_}: band_hz must be [low, high] with 0 < low < high <= {MAX_VIB_HZ} Hz");
-                    }
-                    if b[1] > 0.5 * imu_rate_hz {
-                        warnings.push(format!(
-                            "{where_}: band_hz reaches {} Hz, above the Nyquist frequency of the {imu_rate_hz} Hz IMU: the increments average it away",
-                            b[1]
-                        ));
-                    }
-                    if let Some(c) = v.components {
-                        if !(1..=MAX_COMPONENTS).contains(&c) {
-                            bail!("{where_}: components = {c} must be in 1 ..= {MAX_COMPONENTS}");
-                        }
-                    }
-                }
-            }
-            if v.kind != "random" {
-                if !(v.freq_hz > 0.0 && v.freq_hz <= MAX_VIB_HZ) {
-                    bail!(
-                        "{where_}: freq_hz = {} must be in (0, {MAX_VIB_HZ}] Hz",
-                        v.freq_hz
-                    );
-                }
-                if v.freq_hz > 0.5 * imu_rate_hz {
-                    warnings.push(format!(
-                        "{where_}: freq_hz = {} is above the Nyquist frequency of the {imu_rate_hz} Hz IMU: the increments average it away",
-                        v.freq_hz
-                    ));
-                }
-            }
-            if !v.phase_deg.is_finite() {
-                bail!("{where_}: phase_deg must be finite");
-            }
-            for w in v.schedule.iter().flatten() {
-                if !(w.iter().all(|x| x.is_finite()) && w[1] > w[0] && w[2].abs() <= 1e3) {
-                    bail!("{where_}: schedule window {w:?} must be finite with end > start and |scale| <= 1000");
-                }
-            }
+            check_vibration(v, &src, imu_rate_hz, &mut warnings)?;
         }
-        let mut errors = Vec::new();
-        for (name, value) in &raw.errors {
-            let at_e = at(&format!("{name} "));
-            let k = common::TERMS
-                .iter()
-                .position(|t| t.name == name)
-                .ok_or_else(|| {
-                    anyhow!("{at_e}: [errors]: unknown term `{name}` (see `sinsmodel model list`)")
-                })?;
-            let si = units::parse_quantity_as(value, common::TERMS[k].unit).map_err(|e| {
-                anyhow!(
-                    "{at_e}: [errors] {name}: {e} (unit of {name}: {})",
-                    common::TERMS[k].unit
-                )
-            })?;
-            if !si.is_finite() {
-                bail!("{at_e}: [errors] {name} = {value} is not finite in SI units");
-            }
-            if let Some(why) = common::TERMS[k].beyond_limit(si) {
-                bail!("{at_e}: [errors] {name} = {value}: {why}");
-            }
-            errors.push((k, si));
-        }
-        let q = |v: &Option<String>, unit: &str, key: &str| -> Result<f64> {
-            match v {
-                Some(s) => {
-                    let x = units::parse_quantity_as(s, unit)
-                        .map_err(|e| anyhow!("{}: [noise] {key}: {e}", at(key)))?;
-                    if !(x.is_finite() && x >= 0.0) {
-                        bail!("{}: [noise] {key} = {s} must be finite and >= 0", at(key));
-                    }
-                    Ok(x)
-                }
-                None => Ok(0.0),
-            }
-        };
-        let n = &raw.noise;
-        let noise = NoiseSi {
-            arw: q(&n.arw, "rad/sqrt(s)", "arw")?,
-            vrw: q(&n.vrw, "m/s/sqrt(s)", "vrw")?,
-            gyro_bias_rw: q(&n.gyro_bias_rw, "rad/s/sqrt(s)", "gyro_bias_rw")?,
-            accel_bias_rw: q(&n.accel_bias_rw, "m/s^2/sqrt(s)", "accel_bias_rw")?,
-            gyro_quantum: q(&n.gyro_quantum, "rad", "gyro_quantum")?,
-            accel_quantum: q(&n.accel_quantum, "m/s", "accel_quantum")?,
-        };
-        let gnss = match &raw.gnss {
-            Some(g) => {
-                if !(g.rate_hz > 0.0 && g.rate_hz <= imu_rate_hz) {
-                    bail!(
-                        "{}: [gnss] rate_hz must be in (0, imu_rate_hz]",
-                        at("rate_hz")
-                    );
-                }
-                let sne = units::parse_quantity_as(&g.sigma_ne, "m")
-                    .map_err(|e| anyhow!("{}: [gnss] sigma_ne: {e}", at("sigma_ne")))?;
-                let sd = units::parse_quantity_as(&g.sigma_d, "m")
-                    .map_err(|e| anyhow!("{}: [gnss] sigma_d: {e}", at("sigma_d")))?;
-                // gnss.txt holds heights to 0.1 mm: a σ must be well above that
-                if !((1e-3..=1e4).contains(&sne) && (1e-3..=1e4).contains(&sd)) {
-                    bail!(
-                        "{}: [gnss] sigma_ne and sigma_d must be in [1e-3, 1e4] m (gnss.txt holds positions to 0.1 mm)",
-                        at("sigma_ne")
-                    );
-                }
-                Some((g.rate_hz, sne, sd, g.noisy))
-            }
-            None => None,
-        };
-        let gnss_sigma_v = match raw.gnss.as_ref().and_then(|g| g.sigma_v.as_ref()) {
-            Some(v) => {
-                let sv = units::parse_quantity_as(v, "m/s")
-                    .map_err(|e| anyhow!("{}: [gnss] sigma_v: {e}", at("sigma_v")))?;
-                if !(1e-4..=100.0).contains(&sv) {
-                    bail!(
-                        "{}: [gnss] sigma_v must be in [1e-4, 100] m/s (gnss.txt holds velocities to 1 um/s)",
-                        at("sigma_v")
-                    );
-                }
-                Some(sv)
-            }
-            None => None,
-        };
+        let errors = parse_errors(&raw.errors, &src)?;
+        let noise = parse_noise(&raw.noise, &src)?;
+        let gnss = parse_gnss(raw.gnss.as_ref(), &src, imu_rate_hz)?;
+        let gnss_sigma_v = parse_gnss_sigma_v(raw.gnss.as_ref(), &src)?;
         let clock_jitter_periods = raw.clock_jitter_periods.unwrap_or(1);
         if !(1..=4).contains(&clock_jitter_periods) {
             bail!(
                 "{}: clock_jitter_periods = {clock_jitter_periods} must be 1 (a uniform clock) to 4 (samples spanning 1 to 4 periods; the readers refuse gaps over 5 median intervals)",
-                at("clock_jitter_periods")
+                src.at("clock_jitter_periods")
             );
         }
         Ok(Scenario {
@@ -671,4 +383,383 @@ impl Scenario {
             warnings,
         })
     }
+}
+
+/// The scenario text and its name, to say where in it a message points.
+struct Src<'a> {
+    /// The scenario text.
+    text: &'a str,
+    /// Its name in messages.
+    origin: &'a str,
+}
+
+impl Src<'_> {
+    /// `origin:line` of the first line starting with key `needle` (line 0 when none does).
+    fn at(&self, needle: &str) -> String {
+        format!("{}:{}", self.origin, line_of(self.text, needle))
+    }
+}
+
+/// Checks the IMU rate `imu_rate_hz` [Hz] (at most 1e5 Hz), the truth rate and the start.
+fn check_rates_and_start(raw: &RawScenario, src: &Src, imu_rate_hz: f64) -> Result<()> {
+    if !(imu_rate_hz > 0.0 && imu_rate_hz <= MAX_RATE_HZ) {
+        bail!(
+            "{}: imu_rate_hz = {imu_rate_hz} must be in (0, {MAX_RATE_HZ}] Hz",
+            src.at("imu_rate_hz")
+        );
+    }
+    if !(raw.truth_rate_hz > 0.0 && raw.truth_rate_hz <= imu_rate_hz) {
+        bail!(
+            "{}: truth_rate_hz must be in (0, imu_rate_hz]",
+            src.at("truth_rate_hz")
+        );
+    }
+    let st = &raw.start;
+    if st.lat_deg.is_nan() || st.lat_deg.abs() >= 89.0 {
+        bail!(
+            "{}: lat_deg = {} must be within ±89°",
+            src.at("lat_deg"),
+            st.lat_deg
+        );
+    }
+    use crate::io::bounds;
+    if let Some(p) = bounds::lon_deg(st.lon_deg) {
+        bail!("{}: lon_deg: {p}", src.at("lon_deg"));
+    }
+    if let Some(p) = bounds::height_m(st.h_m) {
+        bail!("{}: h_m: {p}", src.at("h_m"));
+    }
+    if let Some(p) = bounds::attitude_deg(st.euler_deg) {
+        bail!("{}: euler_deg: {p}", src.at("euler_deg"));
+    }
+    if !(0.0..=1e4).contains(&st.speed_mps) {
+        bail!(
+            "{}: speed_mps = {} must be in 0 .. 1e4 m/s",
+            src.at("speed_mps"),
+            st.speed_mps
+        );
+    }
+    Ok(())
+}
+
+/// Checks the motion segments (durations, rates, kinds, the speed they lead to within 0 to
+/// 1e4 m/s, `rotate` only at rest) at an IMU rate of `imu_rate_hz` [Hz].
+fn check_segments(
+    raw: &RawScenario,
+    origin: &str,
+    imu_rate_hz: f64,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    if raw.segment.is_empty() {
+        bail!("{origin}: at least one [[segment]] is needed");
+    }
+    let mut speed = raw.start.speed_mps;
+    for (k, s) in raw.segment.iter().enumerate() {
+        let where_ = format!("{origin}: segment {} (`{}`)", k + 1, s.kind);
+        if !(s.duration_s > 0.0 && s.duration_s <= MAX_DURATION_S) {
+            bail!(
+                "{where_}: duration_s = {} must be in (0, {MAX_DURATION_S}] s",
+                s.duration_s
+            );
+        }
+        if !(s.accel_mps2.abs() <= 1e3 && s.yaw_rate_deg_s.abs() <= 1e4) {
+            bail!(
+                "{where_}: accel_mps2 = {} (|a| <= 1000 m/s^2) or yaw_rate_deg_s = {} (|r| <= 1e4 deg/s) out of range",
+                s.accel_mps2,
+                s.yaw_rate_deg_s
+            );
+        }
+        if s.kind != "rotate" && (s.axis.is_some() || s.angle_deg.is_some()) {
+            bail!("{where_}: `axis` and `angle_deg` belong to `rotate` segments");
+        }
+        match s.kind.as_str() {
+            "rest" if speed != 0.0 => {
+                bail!("{where_}: rest needs zero speed (speed is {speed} m/s)")
+            }
+            "rest" | "cruise" | "turn" => {}
+            "accelerate" => speed += s.accel_mps2 * s.duration_s,
+            "rotate" => check_rotate(s, &where_, imu_rate_hz, warnings)?,
+            other => {
+                bail!("{where_}: unknown kind `{other}` (rest, cruise, accelerate, turn, rotate)")
+            }
+        }
+        if speed < 0.0 {
+            bail!("{where_}: speed would become negative");
+        }
+        if speed > 1e4 {
+            bail!("{where_}: speed would exceed 1e4 m/s");
+        }
+    }
+    if raw.segment.iter().any(|s| s.kind == "rotate") {
+        if raw.start.speed_mps != 0.0
+            || raw
+                .segment
+                .iter()
+                .any(|s| !matches!(s.kind.as_str(), "rest" | "rotate"))
+        {
+            bail!(
+                "{origin}: a `rotate` segment is a turntable rotation at rest: the scenario may then hold only `rest` and `rotate` segments, from speed_mps = 0"
+            );
+        }
+        if raw.vibration.iter().any(|v| v.kind == "angular") {
+            bail!(
+                "{origin}: angular vibration and `rotate` segments cannot be combined (the turntable sets the attitude)"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Checks one vibration source at an IMU rate of `imu_rate_hz` [Hz]; one above the Nyquist
+/// frequency is pushed to `warnings`.
+fn check_vibration(
+    v: &Vibration,
+    src: &Src,
+    imu_rate_hz: f64,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    let where_ = format!(
+        "{}: vibration `{}` on `{}`",
+        src.at(&format!("axis = \"{}\"", v.axis)),
+        v.kind,
+        v.axis
+    );
+    check_vibration_keys(v, &where_)?;
+    check_vibration_level(v, &where_, imu_rate_hz, warnings)?;
+    if v.kind != "random" {
+        if !(v.freq_hz > 0.0 && v.freq_hz <= MAX_VIB_HZ) {
+            bail!(
+                "{where_}: freq_hz = {} must be in (0, {MAX_VIB_HZ}] Hz",
+                v.freq_hz
+            );
+        }
+        if v.freq_hz > 0.5 * imu_rate_hz {
+            warnings.push(format!(
+                "{where_}: freq_hz = {} is above the Nyquist frequency of the {imu_rate_hz} Hz IMU: the increments average it away",
+                v.freq_hz
+            ));
+        }
+    }
+    if !v.phase_deg.is_finite() {
+        bail!("{where_}: phase_deg must be finite");
+    }
+    for w in v.schedule.iter().flatten() {
+        if !(w.iter().all(|x| x.is_finite()) && w[1] > w[0] && w[2].abs() <= 1e3) {
+            bail!("{where_}: schedule window {w:?} must be finite with end > start and |scale| <= 1000");
+        }
+    }
+    Ok(())
+}
+
+/// Checks a vibration source's kind, its axis, and that it sets no key of another kind.
+fn check_vibration_keys(v: &Vibration, where_: &str) -> Result<()> {
+    let linear_axes = ["n", "e", "d", "x", "y", "z"];
+    match v.kind.as_str() {
+        "sine" | "random" if !linear_axes.contains(&v.axis.as_str()) => {
+            bail!("{where_}: axis must be one of n e d x y z")
+        }
+        "angular" if !["roll", "pitch", "yaw"].contains(&v.axis.as_str()) => {
+            bail!("{where_}: axis must be roll, pitch or yaw")
+        }
+        "sine" | "random" | "angular" => {}
+        other => bail!("{where_}: unknown kind `{other}` (sine, random, angular)"),
+    }
+    // a key of another kind would be ignored without a word (and went unchecked: a
+    // random source took `freq_hz = nan`)
+    let foreign = if v.kind == "random" {
+        [
+            (v.amplitude.is_some(), "amplitude"),
+            (v.freq_hz != 0.0, "freq_hz"),
+            (v.phase_deg != 0.0, "phase_deg"),
+        ]
+    } else {
+        [
+            (v.psd.is_some(), "psd"),
+            (v.band_hz.is_some(), "band_hz"),
+            (v.components.is_some(), "components"),
+        ]
+    };
+    if let Some((_, key)) = foreign.iter().find(|(set, _)| *set) {
+        let uses = if v.kind == "random" {
+            "psd, band_hz, components"
+        } else {
+            "amplitude, freq_hz, phase_deg"
+        };
+        bail!(
+            "{where_}: `{key}` does not apply to a `{}` vibration (it takes {uses}, schedule)",
+            v.kind
+        );
+    }
+    Ok(())
+}
+
+/// Checks a vibration source's level: a sine's amplitude (within ±1000 g), an angular one's
+/// (within ±180°), a random one's PSD (0 to 100 g²/Hz), band [Hz] and components.
+fn check_vibration_level(
+    v: &Vibration,
+    where_: &str,
+    imu_rate_hz: f64,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    match v.kind.as_str() {
+        "sine" => {
+            let a = v
+                .amplitude
+                .as_deref()
+                .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
+            let a = units::parse_quantity_as(a, "m/s^2")
+                .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
+            if a.is_nan() || a.abs() > 1000.0 * units::STANDARD_GRAVITY {
+                bail!("{where_}: amplitude must be within ±1000 g");
+            }
+        }
+        "angular" => {
+            let a = v
+                .amplitude
+                .as_deref()
+                .ok_or_else(|| anyhow!("{where_}: amplitude missing"))?;
+            let a = units::parse_quantity_as(a, "rad")
+                .map_err(|e| anyhow!("{where_}: amplitude: {e}"))?;
+            if a.is_nan() || a.abs() > std::f64::consts::PI {
+                bail!("{where_}: amplitude must be within ±180 deg");
+            }
+        }
+        _ => {
+            let p = v
+                .psd
+                .as_deref()
+                .ok_or_else(|| anyhow!("{where_}: psd missing"))?;
+            let p = units::parse_quantity_as(p, "m^2/s^4/Hz")
+                .map_err(|e| anyhow!("{where_}: psd: {e}"))?;
+            let g2 = units::STANDARD_GRAVITY.powi(2);
+            if !(0.0..=100.0 * g2).contains(&p) {
+                bail!("{where_}: psd must be in 0 .. 100 g^2/Hz");
+            }
+            let b = v
+                .band_hz
+                .ok_or_else(|| anyhow!("{where_}: band_hz missing"))?;
+            if !(b[0] > 0.0 && b[1] > b[0] && b[1] <= MAX_VIB_HZ) {
+                bail!(
+                    "{where_}: band_hz must be [low, high] with 0 < low < high <= {MAX_VIB_HZ} Hz"
+                );
+            }
+            if b[1] > 0.5 * imu_rate_hz {
+                warnings.push(format!(
+                    "{where_}: band_hz reaches {} Hz, above the Nyquist frequency of the {imu_rate_hz} Hz IMU: the increments average it away",
+                    b[1]
+                ));
+            }
+            if let Some(c) = v.components {
+                if !(1..=MAX_COMPONENTS).contains(&c) {
+                    bail!("{where_}: components = {c} must be in 1 ..= {MAX_COMPONENTS}");
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The injected errors of `[errors]`: (term index in `common::TERMS`, SI value).
+fn parse_errors(raw: &BTreeMap<String, String>, src: &Src) -> Result<Vec<(usize, f64)>> {
+    let mut errors = Vec::new();
+    for (name, value) in raw {
+        let at_e = src.at(&format!("{name} "));
+        let k = common::TERMS
+            .iter()
+            .position(|t| t.name == name)
+            .ok_or_else(|| {
+                anyhow!("{at_e}: [errors]: unknown term `{name}` (see `sinsmodel model list`)")
+            })?;
+        let si = units::parse_quantity_as(value, common::TERMS[k].unit).map_err(|e| {
+            anyhow!(
+                "{at_e}: [errors] {name}: {e} (unit of {name}: {})",
+                common::TERMS[k].unit
+            )
+        })?;
+        if !si.is_finite() {
+            bail!("{at_e}: [errors] {name} = {value} is not finite in SI units");
+        }
+        if let Some(why) = common::TERMS[k].beyond_limit(si) {
+            bail!("{at_e}: [errors] {name} = {value}: {why}");
+        }
+        errors.push((k, si));
+    }
+    Ok(errors)
+}
+
+/// The `[noise]` levels in SI (an absent one 0).
+fn parse_noise(n: &NoiseSpec, src: &Src) -> Result<NoiseSi> {
+    let q = |v: &Option<String>, unit: &str, key: &str| -> Result<f64> {
+        match v {
+            Some(s) => {
+                let x = units::parse_quantity_as(s, unit)
+                    .map_err(|e| anyhow!("{}: [noise] {key}: {e}", src.at(key)))?;
+                if !(x.is_finite() && x >= 0.0) {
+                    bail!(
+                        "{}: [noise] {key} = {s} must be finite and >= 0",
+                        src.at(key)
+                    );
+                }
+                Ok(x)
+            }
+            None => Ok(0.0),
+        }
+    };
+    Ok(NoiseSi {
+        arw: q(&n.arw, "rad/sqrt(s)", "arw")?,
+        vrw: q(&n.vrw, "m/s/sqrt(s)", "vrw")?,
+        gyro_bias_rw: q(&n.gyro_bias_rw, "rad/s/sqrt(s)", "gyro_bias_rw")?,
+        accel_bias_rw: q(&n.accel_bias_rw, "m/s^2/sqrt(s)", "accel_bias_rw")?,
+        gyro_quantum: q(&n.gyro_quantum, "rad", "gyro_quantum")?,
+        accel_quantum: q(&n.accel_quantum, "m/s", "accel_quantum")?,
+    })
+}
+
+/// GNSS aiding as (rate [Hz], σ_ne [m], σ_d [m], noisy), its rate at most `imu_rate_hz` [Hz].
+fn parse_gnss(
+    g: Option<&GnssSpec>,
+    src: &Src,
+    imu_rate_hz: f64,
+) -> Result<Option<(f64, f64, f64, bool)>> {
+    Ok(match g {
+        Some(g) => {
+            if !(g.rate_hz > 0.0 && g.rate_hz <= imu_rate_hz) {
+                bail!(
+                    "{}: [gnss] rate_hz must be in (0, imu_rate_hz]",
+                    src.at("rate_hz")
+                );
+            }
+            let sne = units::parse_quantity_as(&g.sigma_ne, "m")
+                .map_err(|e| anyhow!("{}: [gnss] sigma_ne: {e}", src.at("sigma_ne")))?;
+            let sd = units::parse_quantity_as(&g.sigma_d, "m")
+                .map_err(|e| anyhow!("{}: [gnss] sigma_d: {e}", src.at("sigma_d")))?;
+            // gnss.txt holds heights to 0.1 mm: a σ must be well above that
+            if !((1e-3..=1e4).contains(&sne) && (1e-3..=1e4).contains(&sd)) {
+                bail!(
+                    "{}: [gnss] sigma_ne and sigma_d must be in [1e-3, 1e4] m (gnss.txt holds positions to 0.1 mm)",
+                    src.at("sigma_ne")
+                );
+            }
+            Some((g.rate_hz, sne, sd, g.noisy))
+        }
+        None => None,
+    })
+}
+
+/// The 1-σ [m/s] of the GNSS velocity written with each fix, if any (1e-4 to 100 m/s).
+fn parse_gnss_sigma_v(g: Option<&GnssSpec>, src: &Src) -> Result<Option<f64>> {
+    Ok(match g.and_then(|g| g.sigma_v.as_ref()) {
+        Some(v) => {
+            let sv = units::parse_quantity_as(v, "m/s")
+                .map_err(|e| anyhow!("{}: [gnss] sigma_v: {e}", src.at("sigma_v")))?;
+            if !(1e-4..=100.0).contains(&sv) {
+                bail!(
+                    "{}: [gnss] sigma_v must be in [1e-4, 100] m/s (gnss.txt holds velocities to 1 um/s)",
+                    src.at("sigma_v")
+                );
+            }
+            Some(sv)
+        }
+        None => None,
+    })
 }

@@ -3,7 +3,7 @@
 //! any spec term by name (applied to the instantaneous signals, then integrated), white noise,
 //! bias random walk and quantisation. Seeded and bit-reproducible.
 
-use crate::io::aiding::PositionFix;
+use crate::io::aiding::{PositionFix, VelocityFix};
 use crate::io::imu::{ImuData, ImuSample};
 use crate::io::truth::TruthRow;
 use crate::model::catalog::Sensor;
@@ -11,7 +11,7 @@ use crate::model::generated::common;
 use crate::nav::earth;
 use crate::nav::strapdown::NavState;
 use crate::sim::rng::Rng;
-use crate::sim::scenario::Scenario;
+use crate::sim::scenario::{NoiseSi, Scenario};
 use crate::sim::trajectory::Trajectory;
 use nalgebra::{UnitQuaternion, Vector3};
 
@@ -110,26 +110,229 @@ fn gnss_shift(
     out
 }
 
+/// What stays fixed through a simulation: the trajectory, the step, the injected errors.
+struct Run<'a> {
+    /// The scenario.
+    sc: &'a Scenario,
+    /// Its trajectory.
+    traj: Trajectory,
+    /// IMU period [s].
+    dt: f64,
+    /// Gauss–Legendre sub-intervals per IMU period.
+    sub: usize,
+    /// The injected IMU (and GNSS) terms.
+    injected: Vec<Injected>,
+    /// An injected regressor reads the true derivatives of the rate and specific force.
+    needs_rates: bool,
+    /// The scenario's GNSS terms: (term index in `common::TERMS`, SI value).
+    gnss_terms: Vec<(usize, f64)>,
+}
+
+impl<'a> Run<'a> {
+    /// The trajectory, step, sub-steps and injected terms of scenario `sc`.
+    fn new(sc: &'a Scenario) -> Self {
+        let traj = Trajectory::new(sc);
+        let dt = 1.0 / sc.imu_rate_hz;
+        let sub = ((16.0 * traj.max_freq_hz / sc.imu_rate_hz).ceil() as usize).max(1);
+        let injected: Vec<Injected> = sc
+            .errors
+            .iter()
+            .map(|&(k, value)| Injected {
+                sensor: common::TERMS[k].sensor,
+                axis: common::TERMS[k].axis,
+                regressor: common::TERMS[k].regressor,
+                value,
+            })
+            .collect();
+        // the true derivatives are formed only when an injected regressor reads them
+        let needs_rates = injected
+            .iter()
+            .any(|inj| crate::model::regressor_reads(inj.regressor, &["dw", "df"]));
+        let gnss_terms: Vec<(usize, f64)> = sc
+            .errors
+            .iter()
+            .copied()
+            .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Gnss)
+            .collect();
+        Run {
+            sc,
+            traj,
+            dt,
+            sub,
+            injected,
+            needs_rates,
+            gnss_terms,
+        }
+    }
+
+    /// The error-injected increments over the IMU interval from `t0` [s]: Δθ [rad], Δv [m/s],
+    /// and the change of (lat [rad], lon [rad], h [m]), by Gauss–Legendre on `sub` sub-intervals.
+    fn increments(
+        &self,
+        e: &earth::LocalEarth,
+        t0: f64,
+    ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let (traj, dt, sub) = (&self.traj, self.dt, self.sub);
+        let mut dth = Vector3::zeros();
+        let mut dvel = Vector3::zeros();
+        let mut dpos = Vector3::zeros();
+        let hsub = dt / sub as f64;
+        for s in 0..sub {
+            let a = t0 + s as f64 * hsub;
+            for (x, w) in GL_NODES.iter().zip(GL_WEIGHTS) {
+                let tn = a + 0.5 * hsub * (x + 1.0);
+                let k = traj.at(tn);
+                let (f, mut om, rate) = body_signals(e, &k);
+                let mut sig = crate::model::ImuSignals::new(f, om);
+                if self.needs_rates {
+                    // d(ω_ib^b)/dt and d(f^b)/dt of the analytic motion, by a central difference
+                    let (f_p, om_p, _) = body_signals(e, &traj.at(tn + DW_STEP));
+                    let (f_m, om_m, _) = body_signals(e, &traj.at(tn - DW_STEP));
+                    sig.dw = (om_p - om_m) / (2.0 * DW_STEP);
+                    sig.df = (f_p - f_m) / (2.0 * DW_STEP);
+                }
+                let mut fm = f;
+                for inj in &self.injected {
+                    let r = common::regressor_value(inj.regressor, &sig);
+                    match inj.sensor {
+                        Sensor::Gyro => om[inj.axis] += inj.value * r,
+                        Sensor::Accel => fm[inj.axis] += inj.value * r,
+                        // in the aiding (`gnss_shift`), not in the IMU
+                        Sensor::Gnss => {}
+                    }
+                }
+                let wt = 0.5 * hsub * w;
+                dth += wt * om;
+                dvel += wt * fm;
+                dpos += wt * rate;
+            }
+        }
+        (dth, dvel, dpos)
+    }
+
+    /// The truth row at `t1` [s] at position `pos` (lat, lon [rad], h [m]).
+    fn truth_row(&self, t1: f64, pos: [f64; 3]) -> TruthRow {
+        let k1 = self.traj.at(t1);
+        TruthRow {
+            t: t1,
+            lat: pos[0],
+            lon: pos[1],
+            h: pos[2],
+            v: k1.v,
+            euler: k1.euler,
+        }
+    }
+
+    /// The GNSS fix at `t1` [s] at true position `pos` (lat, lon [rad], h [m]): moved by the
+    /// GNSS terms, with noise of 1-σ `sne`, `sd` [m] when `noisy` (`rng`), and its velocity when
+    /// the scenario gives `sigma_v` (noise from `rng_v`).
+    fn gnss_fix(
+        &self,
+        e: &earth::LocalEarth,
+        t1: f64,
+        pos: [f64; 3],
+        (sne, sd, noisy): (f64, f64, bool),
+        rng: &mut Rng,
+        rng_v: &mut Rng,
+    ) -> (PositionFix, Option<VelocityFix>) {
+        let (lat, h) = (pos[0], pos[2]);
+        let seen = gnss_shift(&self.truth_row(t1, pos), e, &self.traj, &self.gnss_terms);
+        let (mut glat, mut glon, mut gh) = (seen.lat, seen.lon, seen.h);
+        if noisy {
+            glat += sne * rng.normal() / (earth::radius_meridian(lat) + h);
+            glon += sne * rng.normal() / ((earth::radius_transverse(lat) + h) * lat.cos());
+            gh += sd * rng.normal();
+        }
+        let fix = PositionFix {
+            t: t1,
+            lat: glat,
+            lon: glon,
+            h: gh,
+            sigma: [sne, sne, sd],
+        };
+        let velocity = self.sc.gnss_sigma_v.map(|sv| {
+            let mut v = seen.v;
+            if noisy {
+                for j in 0..3 {
+                    v[j] += sv * rng_v.normal();
+                }
+            }
+            VelocityFix {
+                v_ned: [v.x, v.y, v.z],
+                sigma: sv,
+            }
+        });
+        (fix, velocity)
+    }
+}
+
+/// The sensor errors carried from sample to sample: bias random walks and quantisation
+/// remainders.
+struct SensorState {
+    /// Gyro bias [rad/s].
+    gyro_bias: Vector3<f64>,
+    /// Accelerometer bias [m/s²].
+    accel_bias: Vector3<f64>,
+    /// Angle not yet output by the gyro quantiser [rad].
+    carry_th: Vector3<f64>,
+    /// Velocity not yet output by the accelerometer quantiser [m/s].
+    carry_dv: Vector3<f64>,
+}
+
+impl SensorState {
+    /// No bias, nothing carried.
+    fn new() -> Self {
+        SensorState {
+            gyro_bias: Vector3::zeros(),
+            accel_bias: Vector3::zeros(),
+            carry_th: Vector3::zeros(),
+            carry_dv: Vector3::zeros(),
+        }
+    }
+
+    /// Adds white noise, bias random walk and quantisation to one sample's increments `dth`
+    /// [rad] and `dvel` [m/s] over `dt` [s] (`sqdt` = √dt [√s]).
+    fn corrupt(
+        &mut self,
+        noise: &NoiseSi,
+        dt: f64,
+        sqdt: f64,
+        rng: &mut Rng,
+        dth: &mut Vector3<f64>,
+        dvel: &mut Vector3<f64>,
+    ) {
+        if noise.arw > 0.0 || noise.vrw > 0.0 {
+            for j in 0..3 {
+                dth[j] += noise.arw * sqdt * rng.normal();
+                dvel[j] += noise.vrw * sqdt * rng.normal();
+            }
+        }
+        if noise.gyro_bias_rw > 0.0 || noise.accel_bias_rw > 0.0 {
+            for j in 0..3 {
+                self.gyro_bias[j] += noise.gyro_bias_rw * sqdt * rng.normal();
+                self.accel_bias[j] += noise.accel_bias_rw * sqdt * rng.normal();
+            }
+            *dth += self.gyro_bias * dt;
+            *dvel += self.accel_bias * dt;
+        }
+        if noise.gyro_quantum > 0.0 {
+            let total = *dth + self.carry_th;
+            *dth = total.map(|x| (x / noise.gyro_quantum).round() * noise.gyro_quantum);
+            self.carry_th = total - *dth;
+        }
+        if noise.accel_quantum > 0.0 {
+            let total = *dvel + self.carry_dv;
+            *dvel = total.map(|x| (x / noise.accel_quantum).round() * noise.accel_quantum);
+            self.carry_dv = total - *dvel;
+        }
+    }
+}
+
 /// Runs a scenario. `progress` is called with the fraction done (for a progress bar).
 pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
-    let traj = Trajectory::new(sc);
-    let dt = 1.0 / sc.imu_rate_hz;
+    let run = Run::new(sc);
+    let (traj, dt) = (&run.traj, run.dt);
     let n = (traj.duration * sc.imu_rate_hz).round() as usize;
-    let sub = ((16.0 * traj.max_freq_hz / sc.imu_rate_hz).ceil() as usize).max(1);
-    let injected: Vec<Injected> = sc
-        .errors
-        .iter()
-        .map(|&(k, value)| Injected {
-            sensor: common::TERMS[k].sensor,
-            axis: common::TERMS[k].axis,
-            regressor: common::TERMS[k].regressor,
-            value,
-        })
-        .collect();
-    // the true derivatives are formed only when an injected regressor reads them
-    let needs_rates = injected
-        .iter()
-        .any(|inj| crate::model::regressor_reads(inj.regressor, &["dw", "df"]));
     let mut rng = Rng::new(sc.seed);
     // GNSS velocity noise on a stream of its own: adding velocities changes no other draw
     let mut rng_v = Rng::new(sc.seed ^ 0xbb67_ae85_84ca_a73b);
@@ -156,25 +359,16 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         v: k0.v,
         euler: k0.euler,
     }];
-    let gnss_terms: Vec<(usize, f64)> = sc
-        .errors
-        .iter()
-        .copied()
-        .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Gnss)
-        .collect();
     let mut gnss_truth = vec![gnss_shift(
         &truth[0],
         &earth::LocalEarth::new(lat, h),
-        &traj,
-        &gnss_terms,
+        traj,
+        &run.gnss_terms,
     )];
     let mut gnss = Vec::new();
     let mut gnss_velocity = Vec::new();
     let mut samples = Vec::with_capacity(n);
-    let mut gyro_bias = Vector3::zeros();
-    let mut accel_bias = Vector3::zeros();
-    let mut carry_th = Vector3::zeros();
-    let mut carry_dv = Vector3::zeros();
+    let mut sensor = SensorState::new();
     let noise = sc.noise;
     let sqdt = dt.sqrt();
     let report_every = (n / 200).max(1);
@@ -184,66 +378,10 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         let t1 = (i + 1) as f64 * dt;
         // increments and position: Gauss–Legendre on `sub` sub-intervals
         e.follow(lat, h);
-        let mut dth = Vector3::zeros();
-        let mut dvel = Vector3::zeros();
-        let mut dpos = Vector3::zeros();
-        let hsub = dt / sub as f64;
-        for s in 0..sub {
-            let a = t0 + s as f64 * hsub;
-            for (x, w) in GL_NODES.iter().zip(GL_WEIGHTS) {
-                let tn = a + 0.5 * hsub * (x + 1.0);
-                let k = traj.at(tn);
-                let (f, mut om, rate) = body_signals(&e, &k);
-                let mut sig = crate::model::ImuSignals::new(f, om);
-                if needs_rates {
-                    // d(ω_ib^b)/dt and d(f^b)/dt of the analytic motion, by a central difference
-                    let (f_p, om_p, _) = body_signals(&e, &traj.at(tn + DW_STEP));
-                    let (f_m, om_m, _) = body_signals(&e, &traj.at(tn - DW_STEP));
-                    sig.dw = (om_p - om_m) / (2.0 * DW_STEP);
-                    sig.df = (f_p - f_m) / (2.0 * DW_STEP);
-                }
-                let mut fm = f;
-                for inj in &injected {
-                    let r = common::regressor_value(inj.regressor, &sig);
-                    match inj.sensor {
-                        Sensor::Gyro => om[inj.axis] += inj.value * r,
-                        Sensor::Accel => fm[inj.axis] += inj.value * r,
-                        // in the aiding (`gnss_shift`), not in the IMU
-                        Sensor::Gnss => {}
-                    }
-                }
-                let wt = 0.5 * hsub * w;
-                dth += wt * om;
-                dvel += wt * fm;
-                dpos += wt * rate;
-            }
-        }
+        let (mut dth, mut dvel, dpos) = run.increments(&e, t0);
         let (lat1, lon1, h1) = (lat + dpos.x, lon + dpos.y, h + dpos.z);
         // noise, bias random walk, quantisation
-        if noise.arw > 0.0 || noise.vrw > 0.0 {
-            for j in 0..3 {
-                dth[j] += noise.arw * sqdt * rng.normal();
-                dvel[j] += noise.vrw * sqdt * rng.normal();
-            }
-        }
-        if noise.gyro_bias_rw > 0.0 || noise.accel_bias_rw > 0.0 {
-            for j in 0..3 {
-                gyro_bias[j] += noise.gyro_bias_rw * sqdt * rng.normal();
-                accel_bias[j] += noise.accel_bias_rw * sqdt * rng.normal();
-            }
-            dth += gyro_bias * dt;
-            dvel += accel_bias * dt;
-        }
-        if noise.gyro_quantum > 0.0 {
-            let total = dth + carry_th;
-            dth = total.map(|x| (x / noise.gyro_quantum).round() * noise.gyro_quantum);
-            carry_th = total - dth;
-        }
-        if noise.accel_quantum > 0.0 {
-            let total = dvel + carry_dv;
-            dvel = total.map(|x| (x / noise.accel_quantum).round() * noise.accel_quantum);
-            carry_dv = total - dvel;
-        }
+        sensor.corrupt(&noise, dt, sqdt, &mut rng, &mut dth, &mut dvel);
         samples.push(ImuSample {
             t: t1,
             dtheta: dth,
@@ -253,59 +391,22 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         lon = lon1;
         h = h1;
         if (i + 1) % truth_every == 0 {
-            let k1 = traj.at(t1);
-            let row = TruthRow {
-                t: t1,
-                lat,
-                lon,
-                h,
-                v: k1.v,
-                euler: k1.euler,
-            };
+            let row = run.truth_row(t1, [lat, lon, h]);
             truth.push(row);
-            gnss_truth.push(gnss_shift(&row, &e, &traj, &gnss_terms));
+            gnss_truth.push(gnss_shift(&row, &e, traj, &run.gnss_terms));
         }
         if let (Some(every), Some((_, sne, sd, noisy))) = (gnss_every, sc.gnss) {
             if (i + 1) % every == 0 {
-                let k1 = traj.at(t1);
-                let seen = gnss_shift(
-                    &TruthRow {
-                        t: t1,
-                        lat,
-                        lon,
-                        h,
-                        v: k1.v,
-                        euler: k1.euler,
-                    },
+                let (fix, velocity) = run.gnss_fix(
                     &e,
-                    &traj,
-                    &gnss_terms,
+                    t1,
+                    [lat, lon, h],
+                    (sne, sd, noisy),
+                    &mut rng,
+                    &mut rng_v,
                 );
-                let (mut glat, mut glon, mut gh) = (seen.lat, seen.lon, seen.h);
-                if noisy {
-                    glat += sne * rng.normal() / (earth::radius_meridian(lat) + h);
-                    glon += sne * rng.normal() / ((earth::radius_transverse(lat) + h) * lat.cos());
-                    gh += sd * rng.normal();
-                }
-                gnss.push(PositionFix {
-                    t: t1,
-                    lat: glat,
-                    lon: glon,
-                    h: gh,
-                    sigma: [sne, sne, sd],
-                });
-                if let Some(sv) = sc.gnss_sigma_v {
-                    let mut v = seen.v;
-                    if noisy {
-                        for j in 0..3 {
-                            v[j] += sv * rng_v.normal();
-                        }
-                    }
-                    gnss_velocity.push(crate::io::aiding::VelocityFix {
-                        v_ned: [v.x, v.y, v.z],
-                        sigma: sv,
-                    });
-                }
+                gnss.push(fix);
+                gnss_velocity.extend(velocity);
             }
         }
         if i % report_every == 0 {
