@@ -1,6 +1,8 @@
 //! Rust code emission: the shared `common` module (catalogue, regressors, navigation block,
-//! per-term columns, measurements) and one module per preset (index constants, `fill_a`,
-//! `fill_h_*`, the regressor accumulator, and the sparse covariance kernel).
+//! per-term columns, measurements), one module per preset (index constants, `fill_a`,
+//! `fill_h_*`, the regressor accumulator, and B = Φ − I for the covariance kernel that
+//! `src/model/kernel.rs` holds once for all presets) and the root `models` module with the
+//! `PRESETS` table.
 
 use crate::layout::{term_column, Layout, StateRef, SymEntry};
 use crate::spec::{Sensor, Spec, WhiteNoise};
@@ -543,8 +545,8 @@ fn signals_binding(spec: &Spec, regs: &[usize]) -> (syn::Ident, TokenStream) {
     )
 }
 
-/// One preset module: index constants, the regressor accumulator, `fill_a`, `fill_h_*`, the
-/// sparse covariance kernel and slice wrappers, each emitted by its own step below.
+/// One preset module: index constants, the regressor accumulator, `fill_a`, `fill_h_*`, B = Φ − I
+/// and the wrappers of the shared covariance kernel, each emitted by its own step below.
 pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let names: Vec<String> = (0..layout.states.len())
         .map(|i| layout.state_name(spec, i).to_string())
@@ -559,6 +561,7 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let tokens = quote! {
         use super::common::NAV_COUNT;
         use crate::model::catalog::StateRef;
+        use crate::model::kernel::{self, PhiRows};
         use crate::model::ImuSignals;
         use crate::nav::nav_point::NavPoint;
         #constants
@@ -775,10 +778,22 @@ fn preset_fill_h(spec: &Spec, layout: &Layout, names: &[String]) -> TokenStream 
     }
 }
 
-/// The covariance kernel: B = Φ − I on its pattern, P ← Φ P Φᵀ + diag(q)·dt, x ← Φ x.
+/// The covariance kernel: B = Φ − I on its pattern, and the wrappers that hand it to the shared
+/// P ← Φ P Φᵀ + diag(q)·dt, x ← Φ x of `crate::model::kernel`.
 fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenStream {
-    let n = names.len();
-    let phi = phi_pattern(n, pattern);
+    let phi = phi_pattern(names.len(), pattern);
+    let constants = phi_constants(names, &phi);
+    let fill_b = preset_fill_b(names, &phi);
+    let wrappers = kernel_wrappers();
+    quote! {
+        #constants
+        #fill_b
+        #wrappers
+    }
+}
+
+/// `ND`, `DYN_ROWS`, `B_NNZ` and `B_COLS`: the structure of B = Φ − I.
+fn phi_constants(names: &[String], phi: &PhiPattern) -> TokenStream {
     let nd = phi.rows.len();
     let dyn_rows = phi.rows.iter().map(|r| const_name(&names[*r]));
     let b_cols = phi.rows.iter().map(|&i| {
@@ -786,38 +801,6 @@ fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenS
         quote!(&[#(#cols),*])
     });
     let b_nnz = phi.entries.len();
-    let second_order = phi.entries.iter().any(|e| !e.3.is_empty());
-    let half = if second_order {
-        quote!(let half_dt2 = 0.5 * dt * dt;)
-    } else {
-        quote!()
-    };
-    let b_lines = phi.rows.iter().enumerate().map(|(rd, &i)| {
-        let cm = comment(&format!("row {}", names[i]));
-        let ri = const_name(&names[i]);
-        let lines = phi
-            .entries
-            .iter()
-            .filter(|e| e.0 == i)
-            .map(|(_, j, direct, ks)| {
-                let cj = const_name(&names[*j]);
-                let prods = ks.iter().map(|k| {
-                    let ck = const_name(&names[*k]);
-                    quote!(a[#ri][#ck] * a[#ck][#cj])
-                });
-                let second = if ks.is_empty() {
-                    quote!()
-                } else {
-                    quote!(half_dt2 * (#(#prods)+*))
-                };
-                match (*direct, ks.is_empty()) {
-                    (true, true) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt;),
-                    (true, false) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt + #second;),
-                    (false, _) => quote!(b[#rd][#cj] = #second;),
-                }
-            });
-        quote!(#cm #(#lines)*)
-    });
     quote! {
         /// Number of rows of Φ that differ from the identity (the navigation rows).
         pub const ND: usize = #nd;
@@ -827,124 +810,101 @@ fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenS
         pub const B_NNZ: usize = #b_nnz;
         /// Columns of the non-zeros of B in each dynamic row.
         pub const B_COLS: [&[usize]; ND] = [#(#b_cols),*];
+    }
+}
 
+/// `fill_b`: B = A·dt + A²·dt²/2, one line per non-zero, a comment above each row.
+fn preset_fill_b(names: &[String], phi: &PhiPattern) -> TokenStream {
+    let second_order = phi.entries.iter().any(|e| !e.3.is_empty());
+    let half = if second_order {
+        quote!(let half_dt2 = 0.5 * dt * dt;)
+    } else {
+        quote!()
+    };
+    let b_lines = phi.rows.iter().enumerate().map(|(rd, &i)| {
+        let cm = comment(&format!("row {}", names[i]));
+        let lines = phi
+            .entries
+            .iter()
+            .filter(|e| e.0 == i)
+            .map(|(_, j, direct, ks)| b_entry(names, rd, i, *j, *direct, ks));
+        quote!(#cm #(#lines)*)
+    });
+    quote! {
         /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows (second-order series; dt in s).
         pub fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
             #half
             #(#b_lines)*
         }
+    }
+}
 
-        /// P ← Φ P Φᵀ + diag(q)·dt with Φ = I + B: P + BP + (BP)ᵀ + BPBᵀ on the pattern only.
-        /// `q` is the continuous white-noise density of each state (SI²/s). Uses AVX2 when the CPU
-        /// has it (same arithmetic, wider registers: results are identical).
-        pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU supports AVX2, checked just above.
-                    unsafe { propagate_avx2(a, dt, q, p, None) };
-                    return;
-                }
+/// One line of `fill_b`: B[rd][j] from A[i][j]·dt (when `direct`) and Σₖ A[i][k]·A[k][j]·dt²/2.
+fn b_entry(
+    names: &[String],
+    rd: usize,
+    i: usize,
+    j: usize,
+    direct: bool,
+    ks: &[usize],
+) -> TokenStream {
+    let ri = const_name(&names[i]);
+    let cj = const_name(&names[j]);
+    let prods = ks.iter().map(|k| {
+        let ck = const_name(&names[*k]);
+        quote!(a[#ri][#ck] * a[#ck][#cj])
+    });
+    let second = if ks.is_empty() {
+        quote!()
+    } else {
+        quote!(half_dt2 * (#(#prods)+*))
+    };
+    match (direct, ks.is_empty()) {
+        (true, true) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt;),
+        (true, false) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt + #second;),
+        (false, _) => quote!(b[#rd][#cj] = #second;),
+    }
+}
+
+/// The preset's `PhiRows` implementation and its one-line wrappers of the shared kernel.
+fn kernel_wrappers() -> TokenStream {
+    quote! {
+        /// B = Φ − I of this preset, for the shared covariance kernel `crate::model::kernel`.
+        #[derive(Debug, Clone, Copy)]
+        pub struct Phi;
+
+        impl PhiRows<N, ND> for Phi {
+            const DYN_ROWS: [usize; ND] = DYN_ROWS;
+            const B_COLS: [&'static [usize]; ND] = B_COLS;
+            #[inline]
+            fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
+                fill_b(a, dt, b)
             }
-            propagate_body(a, dt, q, p, None)
+        }
+
+        /// P ← Φ P Φᵀ + diag(q)·dt on this preset's pattern (`crate::model::kernel::propagate_cov`).
+        pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
+            kernel::propagate_cov::<Phi, N, ND>(a, dt, q, p)
         }
 
         /// `propagate_cov` plus the state: x ← Φ x with the same Φ.
         pub fn propagate_cov_and_state(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N], x: &mut [f64; N]) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU supports AVX2, checked just above.
-                    unsafe { propagate_avx2(a, dt, q, p, Some(x)) };
-                    return;
-                }
-            }
-            propagate_body(a, dt, q, p, Some(x))
-        }
-
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = "avx2")]
-        fn propagate_avx2(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N], x: Option<&mut [f64; N]>) {
-            propagate_body(a, dt, q, p, x)
-        }
-
-        #[inline(always)]
-        fn propagate_body(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N], x: Option<&mut [f64; N]>) {
-            let mut b = [[0.0; N]; ND];
-            fill_b(a, dt, &mut b);
-            if let Some(x) = x {
-                propagate_state(&b, x);
-            }
-            // M = B P, row by row as a sum of scaled rows of P (contiguous, vectorisable)
-            let mut m = [[0.0; N]; ND];
-            for r in 0..ND {
-                let mut acc = [0.0; N];
-                for &k in B_COLS[r] {
-                    let bk = b[r][k];
-                    let pk = &p[k];
-                    for j in 0..N {
-                        acc[j] += bk * pk[j];
-                    }
-                }
-                m[r] = acc;
-            }
-            for r in 0..ND {
-                let i = DYN_ROWS[r];
-                for s in 0..ND {
-                    // (M Bᵀ)[r][s] over all columns (B is zero off its pattern), in four
-                    // interleaved partial sums so the products vectorise
-                    let (mr, bs) = (&m[r], &b[s]);
-                    let mut lanes = [0.0; 4];
-                    for (mc, bc) in mr.chunks_exact(4).zip(bs.chunks_exact(4)) {
-                        for l in 0..4 {
-                            lanes[l] += mc[l] * bc[l];
-                        }
-                    }
-                    let mut v = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-                    for (mk, bk) in mr.chunks_exact(4).remainder().iter().zip(bs.chunks_exact(4).remainder()) {
-                        v += mk * bk;
-                    }
-                    p[i][DYN_ROWS[s]] += v;
-                }
-                for j in 0..N {
-                    p[i][j] += m[r][j];
-                    p[j][i] += m[r][j];
-                }
-            }
-            for i in 0..N {
-                p[i][i] += q[i] * dt;
-            }
+            kernel::propagate_cov_and_state::<Phi, N, ND>(a, dt, q, p, x)
         }
 
         /// x ← Φ x with Φ = I + B (B from `fill_b`).
         pub fn propagate_state(b: &[[f64; N]; ND], x: &mut [f64; N]) {
-            let mut dx = [0.0; ND];
-            for r in 0..ND {
-                for &k in B_COLS[r] {
-                    dx[r] += b[r][k] * x[k];
-                }
-            }
-            for r in 0..ND {
-                x[DYN_ROWS[r]] += dx[r];
-            }
+            kernel::propagate_state::<Phi, N, ND>(b, x)
         }
-
 
         /// `propagate_cov` on slices: `a` and `p` are N×N row-major, `q` has N entries.
         pub fn propagate_cov_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
-            let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
-            let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
-            let q: &[f64; N] = q.try_into().expect("q of length N");
-            propagate_cov(a, dt, q, p);
+            kernel::propagate_cov_dyn::<Phi, N, ND>(a, dt, q, p)
         }
 
         /// `propagate_cov_and_state` on slices.
         pub fn propagate_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64], x: &mut [f64]) {
-            let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
-            let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
-            let q: &[f64; N] = q.try_into().expect("q of length N");
-            let x: &mut [f64; N] = x.try_into().expect("x of length N");
-            propagate_cov_and_state(a, dt, q, p, x);
+            kernel::propagate_dyn::<Phi, N, ND>(a, dt, q, p, x)
         }
     }
 }

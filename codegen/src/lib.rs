@@ -1,6 +1,7 @@
 //! sinsmodel-codegen: compiles the declarative SINS error-model spec (`model-spec/*.toml`) into
-//! Rust: sparse A(t) and H fill functions, regressor accumulators and sparse covariance kernels
-//! for every preset (with and without the vertical channel), plus per-term column functions for
+//! Rust: sparse A(t) and H fill functions, regressor accumulators and the B = Φ − I of the sparse
+//! covariance kernel (whose arithmetic the main crate holds once, in `src/model/kernel.rs`) for
+//! every preset (with and without the vertical channel), plus per-term column functions for
 //! models composed at run time.
 //!
 //! Called from the main crate's `build.rs` (prost-build style): output goes to `OUT_DIR`, files are
