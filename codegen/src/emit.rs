@@ -910,7 +910,7 @@ fn kernel_wrappers() -> TokenStream {
 }
 
 /// The root file included by the main crate: one module per generated file plus a preset table.
-pub fn root_module(modules: &[(String, String)]) -> String {
+pub fn root_module(spec: &Spec, modules: &[(String, String)]) -> String {
     let mods = modules.iter().map(|(m, name)| {
         let id = format_ident!("{}", m);
         let file = format!("/{m}.rs");
@@ -921,5 +921,70 @@ pub fn root_module(modules: &[(String, String)]) -> String {
             pub mod #id { include!(concat!(env!("OUT_DIR"), #file)); }
         }
     });
-    format_file(quote!(#(#mods)*))
+    let table = preset_table(spec);
+    format_file(quote! {
+        #(#mods)*
+        #table
+    })
+}
+
+/// The `PRESETS` table: every preset, with and without `+vertical`, and its generated kernels.
+fn preset_table(spec: &Spec) -> TokenStream {
+    let rows = spec.presets.iter().flat_map(|p| {
+        [false, true].map(|vertical| {
+            let name = if vertical {
+                format!("{}+vertical", p.name)
+            } else {
+                p.name.clone()
+            };
+            preset_table_row(&crate::module_name(&name), &str_expr(&p.doc))
+        })
+    });
+    quote! {
+        /// Every generated preset model, by name (with and without `+vertical`).
+        pub const PRESETS: &[crate::model::catalog::PresetKernels] = &[#(#rows),*];
+    }
+}
+
+/// A `&'static str` expression for `text`: a literal, or `concat!` of pieces of at most
+/// [`STR_PIECE`] characters (split after a space) so that no generated line is over 100.
+fn str_expr(text: &str) -> TokenStream {
+    if text.chars().count() <= STR_PIECE {
+        return quote!(#text);
+    }
+    let mut pieces = vec![String::new()];
+    for word in text.split_inclusive(' ') {
+        let last = pieces.last_mut().expect("one piece at least");
+        if !last.is_empty() && last.chars().count() + word.chars().count() > STR_PIECE {
+            pieces.push(word.to_string());
+        } else {
+            last.push_str(word);
+        }
+    }
+    quote!(concat!(#(#pieces),*))
+}
+
+/// Longest string literal [`str_expr`] writes on one line.
+const STR_PIECE: usize = 72;
+
+/// One `PresetKernels` of the table: the names of module `module`'s constants and kernels.
+fn preset_table_row(module: &str, doc: &TokenStream) -> TokenStream {
+    let m = format_ident!("{}", module);
+    quote! {
+        crate::model::catalog::PresetKernels {
+            name: #m::NAME,
+            doc: #doc,
+            vertical: #m::VERTICAL,
+            states: &#m::STATES,
+            state_refs: &#m::STATE_REFS,
+            a_pattern: &#m::A_PATTERN,
+            regressor_ids: &#m::REGRESSOR_IDS,
+            measurements: &#m::MEASUREMENTS,
+            fill_a: #m::fill_a_dyn,
+            fill_h: #m::fill_h_dyn,
+            propagate_cov: #m::propagate_cov_dyn,
+            accumulate: #m::accumulate_dyn,
+            propagate: #m::propagate_dyn,
+        }
+    }
 }
