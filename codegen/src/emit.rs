@@ -162,6 +162,40 @@ fn f64_lit(v: f64) -> TokenStream {
 /// The `common` module: catalogue of states/terms/measurements, regressor evaluation, the full
 /// navigation block, per-term columns and measurement rows for runtime-composed models.
 pub fn common_module(spec: &Spec) -> String {
+    let nav_entries = nav_block_entries(spec);
+    let items = [
+        common_nav_states(spec),
+        common_terms(spec),
+        common_patterns(spec, &nav_entries),
+        common_regressors(spec),
+        common_noise_and_grades(spec),
+        common_measurements(spec),
+        regressor_value_fn(spec),
+        fill_nav_block_fn(spec, &nav_entries),
+        term_column_fn(spec),
+        residual_fn(spec),
+        measurement_entries_fn(spec),
+    ];
+    format_file(quote! {
+        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
+        use crate::model::ImuSignals;
+        use crate::nav::nav_point::NavPoint;
+        #(#items)*
+    })
+}
+
+/// The entries of the full (vertical) navigation block of A(t).
+fn nav_block_entries(spec: &Spec) -> Vec<SymEntry> {
+    let full = Layout {
+        name: "nav".into(),
+        vertical: true,
+        states: (0..spec.nav_states.len()).map(StateRef::Nav).collect(),
+    };
+    full.a_entries(spec)
+}
+
+/// `NAV_COUNT`, an index constant per navigation state, and `NAV_STATES`.
+fn common_nav_states(spec: &Spec) -> TokenStream {
     let n_nav = spec.nav_states.len();
     let nav_consts = spec.nav_states.iter().enumerate().map(|(i, s)| {
         let c = const_name(&s.name);
@@ -182,6 +216,17 @@ pub fn common_module(spec: &Spec) -> String {
         };
         quote!(NavStateInfo { name: #name, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, vertical: #vertical, white_noise: #white_noise, doc: #doc })
     });
+    quote! {
+        /// Number of navigation states with the vertical channel.
+        pub const NAV_COUNT: usize = #n_nav;
+        #(#nav_consts)*
+        /// Navigation states in spec order (vertical ones flagged).
+        pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [#(#nav_infos),*];
+    }
+}
+
+/// `TERM_COUNT` and `TERMS`, the catalogue of instrument error terms.
+fn common_terms(spec: &Spec) -> TokenStream {
     let n_terms = spec.terms.len();
     let term_infos = spec.terms.iter().map(|t| {
         let (name, unit, display, group, doc, library) = (&t.name, &t.unit, &t.display, &t.group, &t.doc, t.library);
@@ -202,47 +247,16 @@ pub fn common_module(spec: &Spec) -> String {
         };
         quote!(TermInfo { name: #name, sensor: #sensor, axis: #axis, regressor: #reg, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, noise: #noise, limit: #limit, group: #group, doc: #doc, library: #library })
     });
-    let n_reg = spec.regressors.len();
-    let reg_sources = spec.regressors.iter().map(|r| r.expr.source.clone());
-    let reg_signals = (0..spec.regressors.len()).map(|r| {
-        let names = signals_read(spec, &[r]);
-        quote!(&[#(#names),*])
-    });
-    let reg_const = spec.regressors.iter().map(|r| r.constant);
-    let reg_arms = spec.regressors.iter().enumerate().map(|(i, r)| {
-        let ast = &r.expr.ast;
-        quote!(#i => #ast,)
-    });
-    let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
-    let (s_param, s_bind) = signals_binding(spec, &all_regs);
-    let r_param = param(
-        "r",
-        spec.terms
-            .iter()
-            .any(|t| !spec.regressors[t.regressor].constant),
-    );
+    quote! {
+        /// Number of instrument error terms in the spec.
+        pub const TERM_COUNT: usize = #n_terms;
+        /// Instrument error terms in spec order.
+        pub const TERMS: [TermInfo; TERM_COUNT] = [#(#term_infos),*];
+    }
+}
 
-    // full navigation block
-    let full = Layout {
-        name: "nav".into(),
-        vertical: true,
-        states: (0..n_nav).map(StateRef::Nav).collect(),
-    };
-    let nav_entries = full.a_entries(spec);
-    let nav_refs: Vec<&SymEntry> = nav_entries.iter().collect();
-    let nav_binds = bindings(&nav_refs);
-    let nav_lines = nav_entries.iter().map(|e| {
-        let r = const_name(&spec.nav_states[e.row].name);
-        let c = const_name(&spec.nav_states[e.col].name);
-        let label = format!(
-            "A[{}][{}]",
-            spec.nav_states[e.row].name, spec.nav_states[e.col].name
-        );
-        let v = &e.value;
-        let cm = entry_comment(&label, &e.comment, v);
-        quote!(#cm a[#r][#c] = #v;)
-    });
-
+/// `NAV_PATTERN` (the navigation block's non-zeros) and `TERM_ROWS` (the rows a term fills).
+fn common_patterns(spec: &Spec, nav_entries: &[SymEntry]) -> TokenStream {
     let nav_pattern = nav_entries.iter().map(|e| {
         let (r, c) = (
             const_name(&spec.nav_states[e.row].name),
@@ -260,30 +274,67 @@ pub fn common_module(spec: &Spec) -> String {
         let rows = rows.iter().map(|r| const_name(&spec.nav_states[*r].name));
         quote!(&[#(#rows),*])
     });
+    quote! {
+        /// Structural non-zeros of the full navigation block.
+        pub const NAV_PATTERN: [(usize, usize); #n_nav_nnz] = [#(#nav_pattern),*];
+        /// Navigation rows each term's column fills (composition rule of DESIGN §4).
+        pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [#(#term_rows),*];
+    }
+}
 
-    // per-term columns
-    let term_arms = spec.terms.iter().enumerate().map(|(t, term)| {
-        let col = term_column(spec, t, quote!(r));
-        let refs: Vec<&SymEntry> = col.iter().map(|(_, e)| e).collect();
-        let binds = bindings(&refs);
-        let head = comment(&format!(
-            "{}: {:?} {} axis, regressor {}",
-            term.name,
-            term.sensor,
-            ["x", "y", "z"][term.axis],
-            spec.regressors[term.regressor].expr.source
-        ));
-        let lines = col.iter().map(|(row, e)| {
-            let rc = const_name(&spec.nav_states[*row].name);
-            let v = &e.value;
-            let label = format!("A[{}][{}]", spec.nav_states[*row].name, term.name);
-            let cm = entry_comment(&label, &e.comment, v);
-            quote!(#cm col[#rc] = #v;)
-        });
-        quote!(#t => { #head #binds #(#lines)* })
+/// `REGRESSOR_COUNT`, `REGRESSORS`, `REGRESSOR_CONSTANT` and `REGRESSOR_SIGNALS`.
+fn common_regressors(spec: &Spec) -> TokenStream {
+    let n_reg = spec.regressors.len();
+    let reg_sources = spec.regressors.iter().map(|r| r.expr.source.clone());
+    let reg_signals = (0..spec.regressors.len()).map(|r| {
+        let names = signals_read(spec, &[r]);
+        quote!(&[#(#names),*])
     });
+    let reg_const = spec.regressors.iter().map(|r| r.constant);
+    quote! {
+        /// Number of distinct regressors.
+        pub const REGRESSOR_COUNT: usize = #n_reg;
+        /// Regressor expressions over the body-frame signals f [m/s²] and w [rad/s].
+        pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [#(#reg_sources),*];
+        /// True for regressors that use no IMU signal (no accumulation needed).
+        pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [#(#reg_const),*];
+        /// The IMU signals (`f`, `w`, `dw`, `df`) each regressor reads.
+        pub const REGRESSOR_SIGNALS: [&[&str]; REGRESSOR_COUNT] = [#(#reg_signals),*];
+    }
+}
 
-    // measurements
+/// The spec's white sensor noise (`GYRO_ARW`, `ACCEL_VRW`) and the sensor grades (`GRADES`).
+fn common_noise_and_grades(spec: &Spec) -> TokenStream {
+    let arw = f64_lit(spec.sensor_noise.gyro_arw);
+    let vrw = f64_lit(spec.sensor_noise.accel_vrw);
+    let n_grades = spec.grades.len();
+    let grade_infos = spec.grades.iter().map(|g| {
+        let (name, doc, arw_text, vrw_text) = (&g.name, &g.doc, &g.gyro_arw_text, &g.accel_vrw_text);
+        let (g_arw, g_vrw) = (f64_lit(g.gyro_arw), f64_lit(g.accel_vrw));
+        let nav = g.nav_sigma.iter().map(|v| match v {
+            Some(v) => {
+                let v = f64_lit(*v);
+                quote!(Some(#v))
+            }
+            None => quote!(None),
+        });
+        let terms = g.term_sigma.iter().map(|v| f64_lit(*v));
+        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*] })
+    });
+    quote! {
+        /// Gyro angle random walk [rad/√s] (spec default).
+        pub const GYRO_ARW: f64 = #arw;
+        /// Accelerometer velocity random walk [m/s/√s] (spec default).
+        pub const ACCEL_VRW: f64 = #vrw;
+        /// Number of sensor grades in grades.toml (navigation, the spec's defaults, not counted).
+        pub const GRADE_COUNT: usize = #n_grades;
+        /// Sensor grades for `--grade`: white noise and the prior of every state (grades.toml).
+        pub const GRADES: [GradeInfo; GRADE_COUNT] = [#(#grade_infos),*];
+    }
+}
+
+/// `MEASUREMENT_COUNT` and `MEASUREMENTS`, the catalogue of measurement types.
+fn common_measurements(spec: &Spec) -> TokenStream {
     let n_meas = spec.measurements.len();
     let meas_infos = spec.measurements.iter().map(|m| {
         let (name, doc) = (&m.name, &m.doc);
@@ -307,6 +358,103 @@ pub fn common_module(spec: &Spec) -> String {
         };
         quote!(MeasurementInfo { name: #name, doc: #doc, sigma: #sigma, aiding: #aiding, rows: &[#(#rows),*], states: &[#(#states),*] })
     });
+    quote! {
+        /// Number of measurement types.
+        pub const MEASUREMENT_COUNT: usize = #n_meas;
+        /// Measurement types.
+        pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
+    }
+}
+
+/// `regressor_value`: one match arm per regressor expression.
+fn regressor_value_fn(spec: &Spec) -> TokenStream {
+    let reg_arms = spec.regressors.iter().enumerate().map(|(i, r)| {
+        let ast = &r.expr.ast;
+        quote!(#i => #ast,)
+    });
+    let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
+    let (s_param, s_bind) = signals_binding(spec, &all_regs);
+    quote! {
+        /// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
+        pub fn regressor_value(id: usize, #s_param: &ImuSignals) -> f64 {
+            #s_bind
+            match id {
+                #(#reg_arms)*
+                _ => panic!("regressor index {id} out of range"),
+            }
+        }
+    }
+}
+
+/// `fill_nav_block`: one line per non-zero of the full navigation block.
+fn fill_nav_block_fn(spec: &Spec, nav_entries: &[SymEntry]) -> TokenStream {
+    let nav_refs: Vec<&SymEntry> = nav_entries.iter().collect();
+    let nav_binds = bindings(&nav_refs);
+    let nav_lines = nav_entries.iter().map(|e| {
+        let r = const_name(&spec.nav_states[e.row].name);
+        let c = const_name(&spec.nav_states[e.col].name);
+        let label = format!(
+            "A[{}][{}]",
+            spec.nav_states[e.row].name, spec.nav_states[e.col].name
+        );
+        let v = &e.value;
+        let cm = entry_comment(&label, &e.comment, v);
+        quote!(#cm a[#r][#c] = #v;)
+    });
+    quote! {
+        /// Writes the structural non-zeros of the full (vertical) navigation block of A(t).
+        pub fn fill_nav_block(nav: &NavPoint, a: &mut [[f64; NAV_COUNT]; NAV_COUNT]) {
+            #nav_binds
+            #(#nav_lines)*
+        }
+    }
+}
+
+/// `term_column`: one match arm per term, writing its column over the navigation rows.
+fn term_column_fn(spec: &Spec) -> TokenStream {
+    let r_param = param(
+        "r",
+        spec.terms
+            .iter()
+            .any(|t| !spec.regressors[t.regressor].constant),
+    );
+    let term_arms = (0..spec.terms.len()).map(|t| term_column_arm(spec, t));
+    quote! {
+        /// Writes term `term`'s column over the navigation rows; `r` is the step mean of its regressor.
+        pub fn term_column(term: usize, nav: &NavPoint, #r_param: f64, col: &mut [f64; NAV_COUNT]) {
+            match term {
+                #(#term_arms)*
+                _ => panic!("term index {term} out of range"),
+            }
+        }
+    }
+}
+
+/// The `term_column` arm of term `t`: a comment naming it, its bindings and its entries.
+fn term_column_arm(spec: &Spec, t: usize) -> TokenStream {
+    let term = &spec.terms[t];
+    let col = term_column(spec, t, quote!(r));
+    let refs: Vec<&SymEntry> = col.iter().map(|(_, e)| e).collect();
+    let binds = bindings(&refs);
+    let head = comment(&format!(
+        "{}: {:?} {} axis, regressor {}",
+        term.name,
+        term.sensor,
+        ["x", "y", "z"][term.axis],
+        spec.regressors[term.regressor].expr.source
+    ));
+    let lines = col.iter().map(|(row, e)| {
+        let rc = const_name(&spec.nav_states[*row].name);
+        let v = &e.value;
+        let label = format!("A[{}][{}]", spec.nav_states[*row].name, term.name);
+        let cm = entry_comment(&label, &e.comment, v);
+        quote!(#cm col[#rc] = #v;)
+    });
+    quote!(#t => { #head #binds #(#lines)* })
+}
+
+/// `residual`: one match arm per measurement, binding the state quantities its rows use.
+fn residual_fn(spec: &Spec) -> TokenStream {
     let residual_arms = spec.measurements.iter().enumerate().map(|(m, meas)| {
         let mut used = BTreeSet::new();
         for r in &meas.rows {
@@ -333,118 +481,7 @@ pub fn common_module(spec: &Spec) -> String {
         });
         quote!(#m => { #(#binds)* #(#lines)* })
     });
-    let meas_arms = spec.measurements.iter().enumerate().map(|(m, meas)| {
-        let entries: Vec<SymEntry> = meas
-            .rows
-            .iter()
-            .enumerate()
-            .flat_map(|(row, r)| {
-                r.h.iter().map(move |h| {
-                    let ast = &h.expr.ast;
-                    SymEntry {
-                        row,
-                        col: 0,
-                        comment: h.expr.source.clone(),
-                        value: quote!(#ast),
-                    }
-                })
-            })
-            .collect();
-        let refs: Vec<&SymEntry> = entries.iter().collect();
-        let binds = bindings(&refs);
-        let states: Vec<&str> = meas
-            .rows
-            .iter()
-            .flat_map(|r| r.h.iter().map(|h| h.state.as_str()))
-            .collect();
-        let lines = entries.iter().zip(states).map(|(e, s)| {
-            let row = e.row;
-            let v = &e.value;
-            let label = format!("H[{}][{}]", meas.rows[row].name, s);
-            let cm = entry_comment(&label, &e.comment, v);
-            quote!(#cm emit(#row, #s, #v);)
-        });
-        quote!(#m => { #binds #(#lines)* })
-    });
-
-    let arw = f64_lit(spec.sensor_noise.gyro_arw);
-    let vrw = f64_lit(spec.sensor_noise.accel_vrw);
-    let n_grades = spec.grades.len();
-    let grade_infos = spec.grades.iter().map(|g| {
-        let (name, doc, arw_text, vrw_text) = (&g.name, &g.doc, &g.gyro_arw_text, &g.accel_vrw_text);
-        let (g_arw, g_vrw) = (f64_lit(g.gyro_arw), f64_lit(g.accel_vrw));
-        let nav = g.nav_sigma.iter().map(|v| match v {
-            Some(v) => {
-                let v = f64_lit(*v);
-                quote!(Some(#v))
-            }
-            None => quote!(None),
-        });
-        let terms = g.term_sigma.iter().map(|v| f64_lit(*v));
-        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*] })
-    });
-    let tokens = quote! {
-        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
-        use crate::model::ImuSignals;
-        use crate::nav::nav_point::NavPoint;
-
-        /// Number of navigation states with the vertical channel.
-        pub const NAV_COUNT: usize = #n_nav;
-        #(#nav_consts)*
-        /// Navigation states in spec order (vertical ones flagged).
-        pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [#(#nav_infos),*];
-        /// Number of instrument error terms in the spec.
-        pub const TERM_COUNT: usize = #n_terms;
-        /// Instrument error terms in spec order.
-        pub const TERMS: [TermInfo; TERM_COUNT] = [#(#term_infos),*];
-        /// Structural non-zeros of the full navigation block.
-        pub const NAV_PATTERN: [(usize, usize); #n_nav_nnz] = [#(#nav_pattern),*];
-        /// Navigation rows each term's column fills (composition rule of DESIGN §4).
-        pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [#(#term_rows),*];
-        /// Number of distinct regressors.
-        pub const REGRESSOR_COUNT: usize = #n_reg;
-        /// Regressor expressions over the body-frame signals f [m/s²] and w [rad/s].
-        pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [#(#reg_sources),*];
-        /// True for regressors that use no IMU signal (no accumulation needed).
-        pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [#(#reg_const),*];
-        /// The IMU signals (`f`, `w`, `dw`, `df`) each regressor reads.
-        pub const REGRESSOR_SIGNALS: [&[&str]; REGRESSOR_COUNT] = [#(#reg_signals),*];
-        /// Gyro angle random walk [rad/√s] (spec default).
-        pub const GYRO_ARW: f64 = #arw;
-        /// Accelerometer velocity random walk [m/s/√s] (spec default).
-        pub const ACCEL_VRW: f64 = #vrw;
-        /// Number of sensor grades in grades.toml (navigation, the spec's defaults, not counted).
-        pub const GRADE_COUNT: usize = #n_grades;
-        /// Sensor grades for `--grade`: white noise and the prior of every state (grades.toml).
-        pub const GRADES: [GradeInfo; GRADE_COUNT] = [#(#grade_infos),*];
-        /// Number of measurement types.
-        pub const MEASUREMENT_COUNT: usize = #n_meas;
-        /// Measurement types.
-        pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
-
-        /// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
-        pub fn regressor_value(id: usize, #s_param: &ImuSignals) -> f64 {
-            #s_bind
-            match id {
-                #(#reg_arms)*
-                _ => panic!("regressor index {id} out of range"),
-            }
-        }
-
-        /// Writes the structural non-zeros of the full (vertical) navigation block of A(t).
-        pub fn fill_nav_block(nav: &NavPoint, a: &mut [[f64; NAV_COUNT]; NAV_COUNT]) {
-            #nav_binds
-            #(#nav_lines)*
-        }
-
-        /// Writes term `term`'s column over the navigation rows; `r` is the step mean of its regressor.
-        pub fn term_column(term: usize, nav: &NavPoint, #r_param: f64, col: &mut [f64; NAV_COUNT]) {
-            match term {
-                #(#term_arms)*
-                _ => panic!("term index {term} out of range"),
-            }
-        }
-
+    quote! {
         /// Forms measurement `m` from the filter's state `s` and the aiding record `aid` (the one
         /// `MEASUREMENTS[m].aiding` names): the residual z = computed − aided and its 1-σ per
         /// component, as measurements.toml writes them.
@@ -454,7 +491,13 @@ pub fn common_module(spec: &Spec) -> String {
                 _ => panic!("measurement index {m} out of range"),
             }
         }
+    }
+}
 
+/// `measurement_entries`: one match arm per measurement, emitting its non-zero H entries.
+fn measurement_entries_fn(spec: &Spec) -> TokenStream {
+    let meas_arms = (0..spec.measurements.len()).map(|m| measurement_entries_arm(spec, m));
+    quote! {
         /// Calls `emit(component, state, value)` for each non-zero H entry of measurement `m`.
         pub fn measurement_entries(m: usize, nav: &NavPoint, emit: &mut dyn FnMut(usize, &'static str, f64)) {
             match m {
@@ -462,8 +505,43 @@ pub fn common_module(spec: &Spec) -> String {
                 _ => panic!("measurement index {m} out of range"),
             }
         }
-    };
-    format_file(tokens)
+    }
+}
+
+/// The `measurement_entries` arm of measurement `m`: its bindings and one `emit` per entry.
+fn measurement_entries_arm(spec: &Spec, m: usize) -> TokenStream {
+    let meas = &spec.measurements[m];
+    let entries: Vec<SymEntry> = meas
+        .rows
+        .iter()
+        .enumerate()
+        .flat_map(|(row, r)| {
+            r.h.iter().map(move |h| {
+                let ast = &h.expr.ast;
+                SymEntry {
+                    row,
+                    col: 0,
+                    comment: h.expr.source.clone(),
+                    value: quote!(#ast),
+                }
+            })
+        })
+        .collect();
+    let refs: Vec<&SymEntry> = entries.iter().collect();
+    let binds = bindings(&refs);
+    let states: Vec<&str> = meas
+        .rows
+        .iter()
+        .flat_map(|r| r.h.iter().map(|h| h.state.as_str()))
+        .collect();
+    let lines = entries.iter().zip(states).map(|(e, s)| {
+        let row = e.row;
+        let v = &e.value;
+        let label = format!("H[{}][{}]", meas.rows[row].name, s);
+        let cm = entry_comment(&label, &e.comment, v);
+        quote!(#cm emit(#row, #s, #v);)
+    });
+    quote!(#m => { #binds #(#lines)* })
 }
 
 /// Structural pattern of B = Φ − I = A·dt + A²·dt²/2 and, per entry, the k of A²'s sum.
