@@ -4,6 +4,7 @@
 
 use super::common::NAV_COUNT;
 use crate::model::catalog::StateRef;
+use crate::model::kernel::{self, PhiRows};
 use crate::model::ImuSignals;
 use crate::nav::nav_point::NavPoint;
 
@@ -504,18 +505,22 @@ pub fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
     b[6][NABLA_Z] = half_dt2 * (a[DLON][DV_E] * a[DV_E][NABLA_Z]);
 }
 
-/// P ← Φ P Φᵀ + diag(q)·dt with Φ = I + B: P + BP + (BP)ᵀ + BPBᵀ on the pattern only.
-/// `q` is the continuous white-noise density of each state (SI²/s). Uses AVX2 when the CPU
-/// has it (same arithmetic, wider registers: results are identical).
-pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            unsafe { propagate_avx2(a, dt, q, p, None) };
-            return;
-        }
+/// B = Φ − I of this preset, for the shared covariance kernel `crate::model::kernel`.
+#[derive(Debug, Clone, Copy)]
+pub struct Phi;
+
+impl PhiRows<N, ND> for Phi {
+    const DYN_ROWS: [usize; ND] = DYN_ROWS;
+    const B_COLS: [&'static [usize]; ND] = B_COLS;
+    #[inline]
+    fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
+        fill_b(a, dt, b)
     }
-    propagate_body(a, dt, q, p, None)
+}
+
+/// P ← Φ P Φᵀ + diag(q)·dt on this preset's pattern (`crate::model::kernel::propagate_cov`).
+pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
+    kernel::propagate_cov::<Phi, N, ND>(a, dt, q, p)
 }
 
 /// `propagate_cov` plus the state: x ← Φ x with the same Φ.
@@ -526,112 +531,22 @@ pub fn propagate_cov_and_state(
     p: &mut [[f64; N]; N],
     x: &mut [f64; N],
 ) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            unsafe { propagate_avx2(a, dt, q, p, Some(x)) };
-            return;
-        }
-    }
-    propagate_body(a, dt, q, p, Some(x))
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn propagate_avx2(
-    a: &[[f64; N]; N],
-    dt: f64,
-    q: &[f64; N],
-    p: &mut [[f64; N]; N],
-    x: Option<&mut [f64; N]>,
-) {
-    propagate_body(a, dt, q, p, x)
-}
-
-#[inline(always)]
-fn propagate_body(
-    a: &[[f64; N]; N],
-    dt: f64,
-    q: &[f64; N],
-    p: &mut [[f64; N]; N],
-    x: Option<&mut [f64; N]>,
-) {
-    let mut b = [[0.0; N]; ND];
-    fill_b(a, dt, &mut b);
-    if let Some(x) = x {
-        propagate_state(&b, x);
-    }
-    let mut m = [[0.0; N]; ND];
-    for r in 0..ND {
-        let mut acc = [0.0; N];
-        for &k in B_COLS[r] {
-            let bk = b[r][k];
-            let pk = &p[k];
-            for j in 0..N {
-                acc[j] += bk * pk[j];
-            }
-        }
-        m[r] = acc;
-    }
-    for r in 0..ND {
-        let i = DYN_ROWS[r];
-        for s in 0..ND {
-            let (mr, bs) = (&m[r], &b[s]);
-            let mut lanes = [0.0; 4];
-            for (mc, bc) in mr.chunks_exact(4).zip(bs.chunks_exact(4)) {
-                for l in 0..4 {
-                    lanes[l] += mc[l] * bc[l];
-                }
-            }
-            let mut v = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-            for (mk, bk) in mr
-                .chunks_exact(4)
-                .remainder()
-                .iter()
-                .zip(bs.chunks_exact(4).remainder())
-            {
-                v += mk * bk;
-            }
-            p[i][DYN_ROWS[s]] += v;
-        }
-        for j in 0..N {
-            p[i][j] += m[r][j];
-            p[j][i] += m[r][j];
-        }
-    }
-    for i in 0..N {
-        p[i][i] += q[i] * dt;
-    }
+    kernel::propagate_cov_and_state::<Phi, N, ND>(a, dt, q, p, x)
 }
 
 /// x ← Φ x with Φ = I + B (B from `fill_b`).
 pub fn propagate_state(b: &[[f64; N]; ND], x: &mut [f64; N]) {
-    let mut dx = [0.0; ND];
-    for r in 0..ND {
-        for &k in B_COLS[r] {
-            dx[r] += b[r][k] * x[k];
-        }
-    }
-    for r in 0..ND {
-        x[DYN_ROWS[r]] += dx[r];
-    }
+    kernel::propagate_state::<Phi, N, ND>(b, x)
 }
 
 /// `propagate_cov` on slices: `a` and `p` are N×N row-major, `q` has N entries.
 pub fn propagate_cov_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
-    let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
-    let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
-    let q: &[f64; N] = q.try_into().expect("q of length N");
-    propagate_cov(a, dt, q, p);
+    kernel::propagate_cov_dyn::<Phi, N, ND>(a, dt, q, p)
 }
 
 /// `propagate_cov_and_state` on slices.
 pub fn propagate_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64], x: &mut [f64]) {
-    let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
-    let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
-    let q: &[f64; N] = q.try_into().expect("q of length N");
-    let x: &mut [f64; N] = x.try_into().expect("x of length N");
-    propagate_cov_and_state(a, dt, q, p, x);
+    kernel::propagate_dyn::<Phi, N, ND>(a, dt, q, p, x)
 }
 
 const _: () = assert!(ND <= NAV_COUNT);

@@ -1,6 +1,8 @@
 //! Rust code emission: the shared `common` module (catalogue, regressors, navigation block,
-//! per-term columns, measurements) and one module per preset (index constants, `fill_a`,
-//! `fill_h_*`, the regressor accumulator, and the sparse covariance kernel).
+//! per-term columns, measurements), one module per preset (index constants, `fill_a`,
+//! `fill_h_*`, the regressor accumulator, and B = Φ − I for the covariance kernel that
+//! `src/model/kernel.rs` holds once for all presets) and the root `models` module with the
+//! `PRESETS` table.
 
 use crate::layout::{term_column, Layout, StateRef, SymEntry};
 use crate::spec::{Sensor, Spec, WhiteNoise};
@@ -160,6 +162,40 @@ fn f64_lit(v: f64) -> TokenStream {
 /// The `common` module: catalogue of states/terms/measurements, regressor evaluation, the full
 /// navigation block, per-term columns and measurement rows for runtime-composed models.
 pub fn common_module(spec: &Spec) -> String {
+    let nav_entries = nav_block_entries(spec);
+    let items = [
+        common_nav_states(spec),
+        common_terms(spec),
+        common_patterns(spec, &nav_entries),
+        common_regressors(spec),
+        common_noise_and_grades(spec),
+        common_measurements(spec),
+        regressor_value_fn(spec),
+        fill_nav_block_fn(spec, &nav_entries),
+        term_column_fn(spec),
+        residual_fn(spec),
+        measurement_entries_fn(spec),
+    ];
+    format_file(quote! {
+        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
+        use crate::model::ImuSignals;
+        use crate::nav::nav_point::NavPoint;
+        #(#items)*
+    })
+}
+
+/// The entries of the full (vertical) navigation block of A(t).
+fn nav_block_entries(spec: &Spec) -> Vec<SymEntry> {
+    let full = Layout {
+        name: "nav".into(),
+        vertical: true,
+        states: (0..spec.nav_states.len()).map(StateRef::Nav).collect(),
+    };
+    full.a_entries(spec)
+}
+
+/// `NAV_COUNT`, an index constant per navigation state, and `NAV_STATES`.
+fn common_nav_states(spec: &Spec) -> TokenStream {
     let n_nav = spec.nav_states.len();
     let nav_consts = spec.nav_states.iter().enumerate().map(|(i, s)| {
         let c = const_name(&s.name);
@@ -180,6 +216,17 @@ pub fn common_module(spec: &Spec) -> String {
         };
         quote!(NavStateInfo { name: #name, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, vertical: #vertical, white_noise: #white_noise, doc: #doc })
     });
+    quote! {
+        /// Number of navigation states with the vertical channel.
+        pub const NAV_COUNT: usize = #n_nav;
+        #(#nav_consts)*
+        /// Navigation states in spec order (vertical ones flagged).
+        pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [#(#nav_infos),*];
+    }
+}
+
+/// `TERM_COUNT` and `TERMS`, the catalogue of instrument error terms.
+fn common_terms(spec: &Spec) -> TokenStream {
     let n_terms = spec.terms.len();
     let term_infos = spec.terms.iter().map(|t| {
         let (name, unit, display, group, doc, library) = (&t.name, &t.unit, &t.display, &t.group, &t.doc, t.library);
@@ -200,47 +247,16 @@ pub fn common_module(spec: &Spec) -> String {
         };
         quote!(TermInfo { name: #name, sensor: #sensor, axis: #axis, regressor: #reg, unit: #unit, display: #display, display_to_si: #to_si, sigma: #sigma, noise: #noise, limit: #limit, group: #group, doc: #doc, library: #library })
     });
-    let n_reg = spec.regressors.len();
-    let reg_sources = spec.regressors.iter().map(|r| r.expr.source.clone());
-    let reg_signals = (0..spec.regressors.len()).map(|r| {
-        let names = signals_read(spec, &[r]);
-        quote!(&[#(#names),*])
-    });
-    let reg_const = spec.regressors.iter().map(|r| r.constant);
-    let reg_arms = spec.regressors.iter().enumerate().map(|(i, r)| {
-        let ast = &r.expr.ast;
-        quote!(#i => #ast,)
-    });
-    let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
-    let (s_param, s_bind) = signals_binding(spec, &all_regs);
-    let r_param = param(
-        "r",
-        spec.terms
-            .iter()
-            .any(|t| !spec.regressors[t.regressor].constant),
-    );
+    quote! {
+        /// Number of instrument error terms in the spec.
+        pub const TERM_COUNT: usize = #n_terms;
+        /// Instrument error terms in spec order.
+        pub const TERMS: [TermInfo; TERM_COUNT] = [#(#term_infos),*];
+    }
+}
 
-    // full navigation block
-    let full = Layout {
-        name: "nav".into(),
-        vertical: true,
-        states: (0..n_nav).map(StateRef::Nav).collect(),
-    };
-    let nav_entries = full.a_entries(spec);
-    let nav_refs: Vec<&SymEntry> = nav_entries.iter().collect();
-    let nav_binds = bindings(&nav_refs);
-    let nav_lines = nav_entries.iter().map(|e| {
-        let r = const_name(&spec.nav_states[e.row].name);
-        let c = const_name(&spec.nav_states[e.col].name);
-        let label = format!(
-            "A[{}][{}]",
-            spec.nav_states[e.row].name, spec.nav_states[e.col].name
-        );
-        let v = &e.value;
-        let cm = entry_comment(&label, &e.comment, v);
-        quote!(#cm a[#r][#c] = #v;)
-    });
-
+/// `NAV_PATTERN` (the navigation block's non-zeros) and `TERM_ROWS` (the rows a term fills).
+fn common_patterns(spec: &Spec, nav_entries: &[SymEntry]) -> TokenStream {
     let nav_pattern = nav_entries.iter().map(|e| {
         let (r, c) = (
             const_name(&spec.nav_states[e.row].name),
@@ -258,30 +274,67 @@ pub fn common_module(spec: &Spec) -> String {
         let rows = rows.iter().map(|r| const_name(&spec.nav_states[*r].name));
         quote!(&[#(#rows),*])
     });
+    quote! {
+        /// Structural non-zeros of the full navigation block.
+        pub const NAV_PATTERN: [(usize, usize); #n_nav_nnz] = [#(#nav_pattern),*];
+        /// Navigation rows each term's column fills (composition rule of DESIGN §4).
+        pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [#(#term_rows),*];
+    }
+}
 
-    // per-term columns
-    let term_arms = spec.terms.iter().enumerate().map(|(t, term)| {
-        let col = term_column(spec, t, quote!(r));
-        let refs: Vec<&SymEntry> = col.iter().map(|(_, e)| e).collect();
-        let binds = bindings(&refs);
-        let head = comment(&format!(
-            "{}: {:?} {} axis, regressor {}",
-            term.name,
-            term.sensor,
-            ["x", "y", "z"][term.axis],
-            spec.regressors[term.regressor].expr.source
-        ));
-        let lines = col.iter().map(|(row, e)| {
-            let rc = const_name(&spec.nav_states[*row].name);
-            let v = &e.value;
-            let label = format!("A[{}][{}]", spec.nav_states[*row].name, term.name);
-            let cm = entry_comment(&label, &e.comment, v);
-            quote!(#cm col[#rc] = #v;)
-        });
-        quote!(#t => { #head #binds #(#lines)* })
+/// `REGRESSOR_COUNT`, `REGRESSORS`, `REGRESSOR_CONSTANT` and `REGRESSOR_SIGNALS`.
+fn common_regressors(spec: &Spec) -> TokenStream {
+    let n_reg = spec.regressors.len();
+    let reg_sources = spec.regressors.iter().map(|r| r.expr.source.clone());
+    let reg_signals = (0..spec.regressors.len()).map(|r| {
+        let names = signals_read(spec, &[r]);
+        quote!(&[#(#names),*])
     });
+    let reg_const = spec.regressors.iter().map(|r| r.constant);
+    quote! {
+        /// Number of distinct regressors.
+        pub const REGRESSOR_COUNT: usize = #n_reg;
+        /// Regressor expressions over the body-frame signals f [m/s²] and w [rad/s].
+        pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [#(#reg_sources),*];
+        /// True for regressors that use no IMU signal (no accumulation needed).
+        pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [#(#reg_const),*];
+        /// The IMU signals (`f`, `w`, `dw`, `df`) each regressor reads.
+        pub const REGRESSOR_SIGNALS: [&[&str]; REGRESSOR_COUNT] = [#(#reg_signals),*];
+    }
+}
 
-    // measurements
+/// The spec's white sensor noise (`GYRO_ARW`, `ACCEL_VRW`) and the sensor grades (`GRADES`).
+fn common_noise_and_grades(spec: &Spec) -> TokenStream {
+    let arw = f64_lit(spec.sensor_noise.gyro_arw);
+    let vrw = f64_lit(spec.sensor_noise.accel_vrw);
+    let n_grades = spec.grades.len();
+    let grade_infos = spec.grades.iter().map(|g| {
+        let (name, doc, arw_text, vrw_text) = (&g.name, &g.doc, &g.gyro_arw_text, &g.accel_vrw_text);
+        let (g_arw, g_vrw) = (f64_lit(g.gyro_arw), f64_lit(g.accel_vrw));
+        let nav = g.nav_sigma.iter().map(|v| match v {
+            Some(v) => {
+                let v = f64_lit(*v);
+                quote!(Some(#v))
+            }
+            None => quote!(None),
+        });
+        let terms = g.term_sigma.iter().map(|v| f64_lit(*v));
+        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*] })
+    });
+    quote! {
+        /// Gyro angle random walk [rad/√s] (spec default).
+        pub const GYRO_ARW: f64 = #arw;
+        /// Accelerometer velocity random walk [m/s/√s] (spec default).
+        pub const ACCEL_VRW: f64 = #vrw;
+        /// Number of sensor grades in grades.toml (navigation, the spec's defaults, not counted).
+        pub const GRADE_COUNT: usize = #n_grades;
+        /// Sensor grades for `--grade`: white noise and the prior of every state (grades.toml).
+        pub const GRADES: [GradeInfo; GRADE_COUNT] = [#(#grade_infos),*];
+    }
+}
+
+/// `MEASUREMENT_COUNT` and `MEASUREMENTS`, the catalogue of measurement types.
+fn common_measurements(spec: &Spec) -> TokenStream {
     let n_meas = spec.measurements.len();
     let meas_infos = spec.measurements.iter().map(|m| {
         let (name, doc) = (&m.name, &m.doc);
@@ -305,6 +358,103 @@ pub fn common_module(spec: &Spec) -> String {
         };
         quote!(MeasurementInfo { name: #name, doc: #doc, sigma: #sigma, aiding: #aiding, rows: &[#(#rows),*], states: &[#(#states),*] })
     });
+    quote! {
+        /// Number of measurement types.
+        pub const MEASUREMENT_COUNT: usize = #n_meas;
+        /// Measurement types.
+        pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
+    }
+}
+
+/// `regressor_value`: one match arm per regressor expression.
+fn regressor_value_fn(spec: &Spec) -> TokenStream {
+    let reg_arms = spec.regressors.iter().enumerate().map(|(i, r)| {
+        let ast = &r.expr.ast;
+        quote!(#i => #ast,)
+    });
+    let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
+    let (s_param, s_bind) = signals_binding(spec, &all_regs);
+    quote! {
+        /// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
+        pub fn regressor_value(id: usize, #s_param: &ImuSignals) -> f64 {
+            #s_bind
+            match id {
+                #(#reg_arms)*
+                _ => panic!("regressor index {id} out of range"),
+            }
+        }
+    }
+}
+
+/// `fill_nav_block`: one line per non-zero of the full navigation block.
+fn fill_nav_block_fn(spec: &Spec, nav_entries: &[SymEntry]) -> TokenStream {
+    let nav_refs: Vec<&SymEntry> = nav_entries.iter().collect();
+    let nav_binds = bindings(&nav_refs);
+    let nav_lines = nav_entries.iter().map(|e| {
+        let r = const_name(&spec.nav_states[e.row].name);
+        let c = const_name(&spec.nav_states[e.col].name);
+        let label = format!(
+            "A[{}][{}]",
+            spec.nav_states[e.row].name, spec.nav_states[e.col].name
+        );
+        let v = &e.value;
+        let cm = entry_comment(&label, &e.comment, v);
+        quote!(#cm a[#r][#c] = #v;)
+    });
+    quote! {
+        /// Writes the structural non-zeros of the full (vertical) navigation block of A(t).
+        pub fn fill_nav_block(nav: &NavPoint, a: &mut [[f64; NAV_COUNT]; NAV_COUNT]) {
+            #nav_binds
+            #(#nav_lines)*
+        }
+    }
+}
+
+/// `term_column`: one match arm per term, writing its column over the navigation rows.
+fn term_column_fn(spec: &Spec) -> TokenStream {
+    let r_param = param(
+        "r",
+        spec.terms
+            .iter()
+            .any(|t| !spec.regressors[t.regressor].constant),
+    );
+    let term_arms = (0..spec.terms.len()).map(|t| term_column_arm(spec, t));
+    quote! {
+        /// Writes term `term`'s column over the navigation rows; `r` is the step mean of its regressor.
+        pub fn term_column(term: usize, nav: &NavPoint, #r_param: f64, col: &mut [f64; NAV_COUNT]) {
+            match term {
+                #(#term_arms)*
+                _ => panic!("term index {term} out of range"),
+            }
+        }
+    }
+}
+
+/// The `term_column` arm of term `t`: a comment naming it, its bindings and its entries.
+fn term_column_arm(spec: &Spec, t: usize) -> TokenStream {
+    let term = &spec.terms[t];
+    let col = term_column(spec, t, quote!(r));
+    let refs: Vec<&SymEntry> = col.iter().map(|(_, e)| e).collect();
+    let binds = bindings(&refs);
+    let head = comment(&format!(
+        "{}: {:?} {} axis, regressor {}",
+        term.name,
+        term.sensor,
+        ["x", "y", "z"][term.axis],
+        spec.regressors[term.regressor].expr.source
+    ));
+    let lines = col.iter().map(|(row, e)| {
+        let rc = const_name(&spec.nav_states[*row].name);
+        let v = &e.value;
+        let label = format!("A[{}][{}]", spec.nav_states[*row].name, term.name);
+        let cm = entry_comment(&label, &e.comment, v);
+        quote!(#cm col[#rc] = #v;)
+    });
+    quote!(#t => { #head #binds #(#lines)* })
+}
+
+/// `residual`: one match arm per measurement, binding the state quantities its rows use.
+fn residual_fn(spec: &Spec) -> TokenStream {
     let residual_arms = spec.measurements.iter().enumerate().map(|(m, meas)| {
         let mut used = BTreeSet::new();
         for r in &meas.rows {
@@ -331,118 +481,7 @@ pub fn common_module(spec: &Spec) -> String {
         });
         quote!(#m => { #(#binds)* #(#lines)* })
     });
-    let meas_arms = spec.measurements.iter().enumerate().map(|(m, meas)| {
-        let entries: Vec<SymEntry> = meas
-            .rows
-            .iter()
-            .enumerate()
-            .flat_map(|(row, r)| {
-                r.h.iter().map(move |h| {
-                    let ast = &h.expr.ast;
-                    SymEntry {
-                        row,
-                        col: 0,
-                        comment: h.expr.source.clone(),
-                        value: quote!(#ast),
-                    }
-                })
-            })
-            .collect();
-        let refs: Vec<&SymEntry> = entries.iter().collect();
-        let binds = bindings(&refs);
-        let states: Vec<&str> = meas
-            .rows
-            .iter()
-            .flat_map(|r| r.h.iter().map(|h| h.state.as_str()))
-            .collect();
-        let lines = entries.iter().zip(states).map(|(e, s)| {
-            let row = e.row;
-            let v = &e.value;
-            let label = format!("H[{}][{}]", meas.rows[row].name, s);
-            let cm = entry_comment(&label, &e.comment, v);
-            quote!(#cm emit(#row, #s, #v);)
-        });
-        quote!(#m => { #binds #(#lines)* })
-    });
-
-    let arw = f64_lit(spec.sensor_noise.gyro_arw);
-    let vrw = f64_lit(spec.sensor_noise.accel_vrw);
-    let n_grades = spec.grades.len();
-    let grade_infos = spec.grades.iter().map(|g| {
-        let (name, doc, arw_text, vrw_text) = (&g.name, &g.doc, &g.gyro_arw_text, &g.accel_vrw_text);
-        let (g_arw, g_vrw) = (f64_lit(g.gyro_arw), f64_lit(g.accel_vrw));
-        let nav = g.nav_sigma.iter().map(|v| match v {
-            Some(v) => {
-                let v = f64_lit(*v);
-                quote!(Some(#v))
-            }
-            None => quote!(None),
-        });
-        let terms = g.term_sigma.iter().map(|v| f64_lit(*v));
-        quote!(GradeInfo { name: #name, doc: #doc, gyro_arw: #g_arw, gyro_arw_text: #arw_text, accel_vrw: #g_vrw, accel_vrw_text: #vrw_text, nav_sigma: [#(#nav),*], term_sigma: [#(#terms),*] })
-    });
-    let tokens = quote! {
-        use crate::model::catalog::{Aiding, AidRecord, GradeInfo, MeasRowInfo, MeasurementInfo, NavStateInfo, ResidualState, Sensor, TermInfo, WhiteNoise};
-        use crate::model::ImuSignals;
-        use crate::nav::nav_point::NavPoint;
-
-        /// Number of navigation states with the vertical channel.
-        pub const NAV_COUNT: usize = #n_nav;
-        #(#nav_consts)*
-        /// Navigation states in spec order (vertical ones flagged).
-        pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [#(#nav_infos),*];
-        /// Number of instrument error terms in the spec.
-        pub const TERM_COUNT: usize = #n_terms;
-        /// Instrument error terms in spec order.
-        pub const TERMS: [TermInfo; TERM_COUNT] = [#(#term_infos),*];
-        /// Structural non-zeros of the full navigation block.
-        pub const NAV_PATTERN: [(usize, usize); #n_nav_nnz] = [#(#nav_pattern),*];
-        /// Navigation rows each term's column fills (composition rule of DESIGN §4).
-        pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [#(#term_rows),*];
-        /// Number of distinct regressors.
-        pub const REGRESSOR_COUNT: usize = #n_reg;
-        /// Regressor expressions over the body-frame signals f [m/s²] and w [rad/s].
-        pub const REGRESSORS: [&str; REGRESSOR_COUNT] = [#(#reg_sources),*];
-        /// True for regressors that use no IMU signal (no accumulation needed).
-        pub const REGRESSOR_CONSTANT: [bool; REGRESSOR_COUNT] = [#(#reg_const),*];
-        /// The IMU signals (`f`, `w`, `dw`, `df`) each regressor reads.
-        pub const REGRESSOR_SIGNALS: [&[&str]; REGRESSOR_COUNT] = [#(#reg_signals),*];
-        /// Gyro angle random walk [rad/√s] (spec default).
-        pub const GYRO_ARW: f64 = #arw;
-        /// Accelerometer velocity random walk [m/s/√s] (spec default).
-        pub const ACCEL_VRW: f64 = #vrw;
-        /// Number of sensor grades in grades.toml (navigation, the spec's defaults, not counted).
-        pub const GRADE_COUNT: usize = #n_grades;
-        /// Sensor grades for `--grade`: white noise and the prior of every state (grades.toml).
-        pub const GRADES: [GradeInfo; GRADE_COUNT] = [#(#grade_infos),*];
-        /// Number of measurement types.
-        pub const MEASUREMENT_COUNT: usize = #n_meas;
-        /// Measurement types.
-        pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [#(#meas_infos),*];
-
-        /// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
-        pub fn regressor_value(id: usize, #s_param: &ImuSignals) -> f64 {
-            #s_bind
-            match id {
-                #(#reg_arms)*
-                _ => panic!("regressor index {id} out of range"),
-            }
-        }
-
-        /// Writes the structural non-zeros of the full (vertical) navigation block of A(t).
-        pub fn fill_nav_block(nav: &NavPoint, a: &mut [[f64; NAV_COUNT]; NAV_COUNT]) {
-            #nav_binds
-            #(#nav_lines)*
-        }
-
-        /// Writes term `term`'s column over the navigation rows; `r` is the step mean of its regressor.
-        pub fn term_column(term: usize, nav: &NavPoint, #r_param: f64, col: &mut [f64; NAV_COUNT]) {
-            match term {
-                #(#term_arms)*
-                _ => panic!("term index {term} out of range"),
-            }
-        }
-
+    quote! {
         /// Forms measurement `m` from the filter's state `s` and the aiding record `aid` (the one
         /// `MEASUREMENTS[m].aiding` names): the residual z = computed − aided and its 1-σ per
         /// component, as measurements.toml writes them.
@@ -452,7 +491,13 @@ pub fn common_module(spec: &Spec) -> String {
                 _ => panic!("measurement index {m} out of range"),
             }
         }
+    }
+}
 
+/// `measurement_entries`: one match arm per measurement, emitting its non-zero H entries.
+fn measurement_entries_fn(spec: &Spec) -> TokenStream {
+    let meas_arms = (0..spec.measurements.len()).map(|m| measurement_entries_arm(spec, m));
+    quote! {
         /// Calls `emit(component, state, value)` for each non-zero H entry of measurement `m`.
         pub fn measurement_entries(m: usize, nav: &NavPoint, emit: &mut dyn FnMut(usize, &'static str, f64)) {
             match m {
@@ -460,8 +505,43 @@ pub fn common_module(spec: &Spec) -> String {
                 _ => panic!("measurement index {m} out of range"),
             }
         }
-    };
-    format_file(tokens)
+    }
+}
+
+/// The `measurement_entries` arm of measurement `m`: its bindings and one `emit` per entry.
+fn measurement_entries_arm(spec: &Spec, m: usize) -> TokenStream {
+    let meas = &spec.measurements[m];
+    let entries: Vec<SymEntry> = meas
+        .rows
+        .iter()
+        .enumerate()
+        .flat_map(|(row, r)| {
+            r.h.iter().map(move |h| {
+                let ast = &h.expr.ast;
+                SymEntry {
+                    row,
+                    col: 0,
+                    comment: h.expr.source.clone(),
+                    value: quote!(#ast),
+                }
+            })
+        })
+        .collect();
+    let refs: Vec<&SymEntry> = entries.iter().collect();
+    let binds = bindings(&refs);
+    let states: Vec<&str> = meas
+        .rows
+        .iter()
+        .flat_map(|r| r.h.iter().map(|h| h.state.as_str()))
+        .collect();
+    let lines = entries.iter().zip(states).map(|(e, s)| {
+        let row = e.row;
+        let v = &e.value;
+        let label = format!("H[{}][{}]", meas.rows[row].name, s);
+        let cm = entry_comment(&label, &e.comment, v);
+        quote!(#cm emit(#row, #s, #v);)
+    });
+    quote!(#m => { #binds #(#lines)* })
 }
 
 /// Structural pattern of B = Φ − I = A·dt + A²·dt²/2 and, per entry, the k of A²'s sum.
@@ -543,8 +623,8 @@ fn signals_binding(spec: &Spec, regs: &[usize]) -> (syn::Ident, TokenStream) {
     )
 }
 
-/// One preset module: index constants, the regressor accumulator, `fill_a`, `fill_h_*`, the
-/// sparse covariance kernel and slice wrappers, each emitted by its own step below.
+/// One preset module: index constants, the regressor accumulator, `fill_a`, `fill_h_*`, B = Φ − I
+/// and the wrappers of the shared covariance kernel, each emitted by its own step below.
 pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let names: Vec<String> = (0..layout.states.len())
         .map(|i| layout.state_name(spec, i).to_string())
@@ -559,6 +639,7 @@ pub fn preset_module(spec: &Spec, layout: &Layout) -> String {
     let tokens = quote! {
         use super::common::NAV_COUNT;
         use crate::model::catalog::StateRef;
+        use crate::model::kernel::{self, PhiRows};
         use crate::model::ImuSignals;
         use crate::nav::nav_point::NavPoint;
         #constants
@@ -775,10 +856,22 @@ fn preset_fill_h(spec: &Spec, layout: &Layout, names: &[String]) -> TokenStream 
     }
 }
 
-/// The covariance kernel: B = Φ − I on its pattern, P ← Φ P Φᵀ + diag(q)·dt, x ← Φ x.
+/// The covariance kernel: B = Φ − I on its pattern, and the wrappers that hand it to the shared
+/// P ← Φ P Φᵀ + diag(q)·dt, x ← Φ x of `crate::model::kernel`.
 fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenStream {
-    let n = names.len();
-    let phi = phi_pattern(n, pattern);
+    let phi = phi_pattern(names.len(), pattern);
+    let constants = phi_constants(names, &phi);
+    let fill_b = preset_fill_b(names, &phi);
+    let wrappers = kernel_wrappers();
+    quote! {
+        #constants
+        #fill_b
+        #wrappers
+    }
+}
+
+/// `ND`, `DYN_ROWS`, `B_NNZ` and `B_COLS`: the structure of B = Φ − I.
+fn phi_constants(names: &[String], phi: &PhiPattern) -> TokenStream {
     let nd = phi.rows.len();
     let dyn_rows = phi.rows.iter().map(|r| const_name(&names[*r]));
     let b_cols = phi.rows.iter().map(|&i| {
@@ -786,38 +879,6 @@ fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenS
         quote!(&[#(#cols),*])
     });
     let b_nnz = phi.entries.len();
-    let second_order = phi.entries.iter().any(|e| !e.3.is_empty());
-    let half = if second_order {
-        quote!(let half_dt2 = 0.5 * dt * dt;)
-    } else {
-        quote!()
-    };
-    let b_lines = phi.rows.iter().enumerate().map(|(rd, &i)| {
-        let cm = comment(&format!("row {}", names[i]));
-        let ri = const_name(&names[i]);
-        let lines = phi
-            .entries
-            .iter()
-            .filter(|e| e.0 == i)
-            .map(|(_, j, direct, ks)| {
-                let cj = const_name(&names[*j]);
-                let prods = ks.iter().map(|k| {
-                    let ck = const_name(&names[*k]);
-                    quote!(a[#ri][#ck] * a[#ck][#cj])
-                });
-                let second = if ks.is_empty() {
-                    quote!()
-                } else {
-                    quote!(half_dt2 * (#(#prods)+*))
-                };
-                match (*direct, ks.is_empty()) {
-                    (true, true) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt;),
-                    (true, false) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt + #second;),
-                    (false, _) => quote!(b[#rd][#cj] = #second;),
-                }
-            });
-        quote!(#cm #(#lines)*)
-    });
     quote! {
         /// Number of rows of Φ that differ from the identity (the navigation rows).
         pub const ND: usize = #nd;
@@ -827,130 +888,107 @@ fn preset_kernel(names: &[String], pattern: &BTreeSet<(usize, usize)>) -> TokenS
         pub const B_NNZ: usize = #b_nnz;
         /// Columns of the non-zeros of B in each dynamic row.
         pub const B_COLS: [&[usize]; ND] = [#(#b_cols),*];
+    }
+}
 
+/// `fill_b`: B = A·dt + A²·dt²/2, one line per non-zero, a comment above each row.
+fn preset_fill_b(names: &[String], phi: &PhiPattern) -> TokenStream {
+    let second_order = phi.entries.iter().any(|e| !e.3.is_empty());
+    let half = if second_order {
+        quote!(let half_dt2 = 0.5 * dt * dt;)
+    } else {
+        quote!()
+    };
+    let b_lines = phi.rows.iter().enumerate().map(|(rd, &i)| {
+        let cm = comment(&format!("row {}", names[i]));
+        let lines = phi
+            .entries
+            .iter()
+            .filter(|e| e.0 == i)
+            .map(|(_, j, direct, ks)| b_entry(names, rd, i, *j, *direct, ks));
+        quote!(#cm #(#lines)*)
+    });
+    quote! {
         /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows (second-order series; dt in s).
         pub fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
             #half
             #(#b_lines)*
         }
+    }
+}
 
-        /// P ← Φ P Φᵀ + diag(q)·dt with Φ = I + B: P + BP + (BP)ᵀ + BPBᵀ on the pattern only.
-        /// `q` is the continuous white-noise density of each state (SI²/s). Uses AVX2 when the CPU
-        /// has it (same arithmetic, wider registers: results are identical).
-        pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU supports AVX2, checked just above.
-                    unsafe { propagate_avx2(a, dt, q, p, None) };
-                    return;
-                }
+/// One line of `fill_b`: B[rd][j] from A[i][j]·dt (when `direct`) and Σₖ A[i][k]·A[k][j]·dt²/2.
+fn b_entry(
+    names: &[String],
+    rd: usize,
+    i: usize,
+    j: usize,
+    direct: bool,
+    ks: &[usize],
+) -> TokenStream {
+    let ri = const_name(&names[i]);
+    let cj = const_name(&names[j]);
+    let prods = ks.iter().map(|k| {
+        let ck = const_name(&names[*k]);
+        quote!(a[#ri][#ck] * a[#ck][#cj])
+    });
+    let second = if ks.is_empty() {
+        quote!()
+    } else {
+        quote!(half_dt2 * (#(#prods)+*))
+    };
+    match (direct, ks.is_empty()) {
+        (true, true) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt;),
+        (true, false) => quote!(b[#rd][#cj] = a[#ri][#cj] * dt + #second;),
+        (false, _) => quote!(b[#rd][#cj] = #second;),
+    }
+}
+
+/// The preset's `PhiRows` implementation and its one-line wrappers of the shared kernel.
+fn kernel_wrappers() -> TokenStream {
+    quote! {
+        /// B = Φ − I of this preset, for the shared covariance kernel `crate::model::kernel`.
+        #[derive(Debug, Clone, Copy)]
+        pub struct Phi;
+
+        impl PhiRows<N, ND> for Phi {
+            const DYN_ROWS: [usize; ND] = DYN_ROWS;
+            const B_COLS: [&'static [usize]; ND] = B_COLS;
+            #[inline]
+            fn fill_b(a: &[[f64; N]; N], dt: f64, b: &mut [[f64; N]; ND]) {
+                fill_b(a, dt, b)
             }
-            propagate_body(a, dt, q, p, None)
+        }
+
+        /// P ← Φ P Φᵀ + diag(q)·dt on this preset's pattern (`crate::model::kernel::propagate_cov`).
+        pub fn propagate_cov(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N]) {
+            kernel::propagate_cov::<Phi, N, ND>(a, dt, q, p)
         }
 
         /// `propagate_cov` plus the state: x ← Φ x with the same Φ.
         pub fn propagate_cov_and_state(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N], x: &mut [f64; N]) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU supports AVX2, checked just above.
-                    unsafe { propagate_avx2(a, dt, q, p, Some(x)) };
-                    return;
-                }
-            }
-            propagate_body(a, dt, q, p, Some(x))
-        }
-
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = "avx2")]
-        fn propagate_avx2(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N], x: Option<&mut [f64; N]>) {
-            propagate_body(a, dt, q, p, x)
-        }
-
-        #[inline(always)]
-        fn propagate_body(a: &[[f64; N]; N], dt: f64, q: &[f64; N], p: &mut [[f64; N]; N], x: Option<&mut [f64; N]>) {
-            let mut b = [[0.0; N]; ND];
-            fill_b(a, dt, &mut b);
-            if let Some(x) = x {
-                propagate_state(&b, x);
-            }
-            // M = B P, row by row as a sum of scaled rows of P (contiguous, vectorisable)
-            let mut m = [[0.0; N]; ND];
-            for r in 0..ND {
-                let mut acc = [0.0; N];
-                for &k in B_COLS[r] {
-                    let bk = b[r][k];
-                    let pk = &p[k];
-                    for j in 0..N {
-                        acc[j] += bk * pk[j];
-                    }
-                }
-                m[r] = acc;
-            }
-            for r in 0..ND {
-                let i = DYN_ROWS[r];
-                for s in 0..ND {
-                    // (M Bᵀ)[r][s] over all columns (B is zero off its pattern), in four
-                    // interleaved partial sums so the products vectorise
-                    let (mr, bs) = (&m[r], &b[s]);
-                    let mut lanes = [0.0; 4];
-                    for (mc, bc) in mr.chunks_exact(4).zip(bs.chunks_exact(4)) {
-                        for l in 0..4 {
-                            lanes[l] += mc[l] * bc[l];
-                        }
-                    }
-                    let mut v = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-                    for (mk, bk) in mr.chunks_exact(4).remainder().iter().zip(bs.chunks_exact(4).remainder()) {
-                        v += mk * bk;
-                    }
-                    p[i][DYN_ROWS[s]] += v;
-                }
-                for j in 0..N {
-                    p[i][j] += m[r][j];
-                    p[j][i] += m[r][j];
-                }
-            }
-            for i in 0..N {
-                p[i][i] += q[i] * dt;
-            }
+            kernel::propagate_cov_and_state::<Phi, N, ND>(a, dt, q, p, x)
         }
 
         /// x ← Φ x with Φ = I + B (B from `fill_b`).
         pub fn propagate_state(b: &[[f64; N]; ND], x: &mut [f64; N]) {
-            let mut dx = [0.0; ND];
-            for r in 0..ND {
-                for &k in B_COLS[r] {
-                    dx[r] += b[r][k] * x[k];
-                }
-            }
-            for r in 0..ND {
-                x[DYN_ROWS[r]] += dx[r];
-            }
+            kernel::propagate_state::<Phi, N, ND>(b, x)
         }
-
 
         /// `propagate_cov` on slices: `a` and `p` are N×N row-major, `q` has N entries.
         pub fn propagate_cov_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
-            let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
-            let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
-            let q: &[f64; N] = q.try_into().expect("q of length N");
-            propagate_cov(a, dt, q, p);
+            kernel::propagate_cov_dyn::<Phi, N, ND>(a, dt, q, p)
         }
 
         /// `propagate_cov_and_state` on slices.
         pub fn propagate_dyn(a: &[f64], dt: f64, q: &[f64], p: &mut [f64], x: &mut [f64]) {
-            let a: &[[f64; N]; N] = a.as_chunks::<N>().0.try_into().expect("A of N×N");
-            let p: &mut [[f64; N]; N] = p.as_chunks_mut::<N>().0.try_into().expect("P of N×N");
-            let q: &[f64; N] = q.try_into().expect("q of length N");
-            let x: &mut [f64; N] = x.try_into().expect("x of length N");
-            propagate_cov_and_state(a, dt, q, p, x);
+            kernel::propagate_dyn::<Phi, N, ND>(a, dt, q, p, x)
         }
     }
 }
 
 /// The root file included by the main crate: one module per generated file plus a preset table.
-pub fn root_module(modules: &[(String, String)]) -> String {
+pub fn root_module(spec: &Spec, modules: &[(String, String)]) -> String {
     let mods = modules.iter().map(|(m, name)| {
         let id = format_ident!("{}", m);
         let file = format!("/{m}.rs");
@@ -961,5 +999,70 @@ pub fn root_module(modules: &[(String, String)]) -> String {
             pub mod #id { include!(concat!(env!("OUT_DIR"), #file)); }
         }
     });
-    format_file(quote!(#(#mods)*))
+    let table = preset_table(spec);
+    format_file(quote! {
+        #(#mods)*
+        #table
+    })
+}
+
+/// The `PRESETS` table: every preset, with and without `+vertical`, and its generated kernels.
+fn preset_table(spec: &Spec) -> TokenStream {
+    let rows = spec.presets.iter().flat_map(|p| {
+        [false, true].map(|vertical| {
+            let name = if vertical {
+                format!("{}+vertical", p.name)
+            } else {
+                p.name.clone()
+            };
+            preset_table_row(&crate::module_name(&name), &str_expr(&p.doc))
+        })
+    });
+    quote! {
+        /// Every generated preset model, by name (with and without `+vertical`).
+        pub const PRESETS: &[crate::model::catalog::PresetKernels] = &[#(#rows),*];
+    }
+}
+
+/// A `&'static str` expression for `text`: a literal, or `concat!` of pieces of at most
+/// [`STR_PIECE`] characters (split after a space) so that no generated line is over 100.
+fn str_expr(text: &str) -> TokenStream {
+    if text.chars().count() <= STR_PIECE {
+        return quote!(#text);
+    }
+    let mut pieces = vec![String::new()];
+    for word in text.split_inclusive(' ') {
+        let last = pieces.last_mut().expect("one piece at least");
+        if !last.is_empty() && last.chars().count() + word.chars().count() > STR_PIECE {
+            pieces.push(word.to_string());
+        } else {
+            last.push_str(word);
+        }
+    }
+    quote!(concat!(#(#pieces),*))
+}
+
+/// Longest string literal [`str_expr`] writes on one line.
+const STR_PIECE: usize = 72;
+
+/// One `PresetKernels` of the table: the names of module `module`'s constants and kernels.
+fn preset_table_row(module: &str, doc: &TokenStream) -> TokenStream {
+    let m = format_ident!("{}", module);
+    quote! {
+        crate::model::catalog::PresetKernels {
+            name: #m::NAME,
+            doc: #doc,
+            vertical: #m::VERTICAL,
+            states: &#m::STATES,
+            state_refs: &#m::STATE_REFS,
+            a_pattern: &#m::A_PATTERN,
+            regressor_ids: &#m::REGRESSOR_IDS,
+            measurements: &#m::MEASUREMENTS,
+            fill_a: #m::fill_a_dyn,
+            fill_h: #m::fill_h_dyn,
+            propagate_cov: #m::propagate_cov_dyn,
+            accumulate: #m::accumulate_dyn,
+            propagate: #m::propagate_dyn,
+        }
+    }
 }

@@ -313,88 +313,13 @@ fn floatify(e: &mut syn::Expr) {
     }
 }
 
+/// Checks that `e` uses only what an expression of `kind` may: literals, symbols, arithmetic and
+/// the allowed methods.
 fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
     match e {
-        syn::Expr::Lit(l) => match &l.lit {
-            // a suffix (`1.5f32`, `2u8`) would change the generated code's types
-            syn::Lit::Float(f) if !f.suffix().is_empty() => Err(format!(
-                "literal `{}` has a type suffix (write plain numbers)",
-                f.token()
-            )),
-            syn::Lit::Int(i) if !i.suffix().is_empty() => Err(format!(
-                "literal `{}` has a type suffix (write plain numbers)",
-                i.token()
-            )),
-            // the generated code writes the value as an f64 literal: it must be one
-            syn::Lit::Float(f) if !f.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(
-                format!("literal `{}` is beyond the range of f64", f.token()),
-            ),
-            syn::Lit::Int(i) if !i.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(format!(
-                "literal `{}` is beyond the range of f64",
-                i.token()
-            )),
-            syn::Lit::Float(_) | syn::Lit::Int(_) => Ok(()),
-            _ => Err("only numeric literals are allowed".into()),
-        },
-        syn::Expr::Path(p) => {
-            let name = p
-                .path
-                .get_ident()
-                .map(|i| i.to_string())
-                .ok_or_else(|| format!("unknown symbol `{}`", p.to_token_stream()))?;
-            match kind {
-                ExprKind::Residual if RESIDUAL_STATE_SYMBOLS.iter().any(|(n, _)| *n == name) => {
-                    Ok(())
-                }
-                ExprKind::Residual => Err(format!(
-                    "unknown symbol `{name}` (a residual uses {} and aid.FIELD)",
-                    RESIDUAL_STATE_SYMBOLS
-                        .iter()
-                        .map(|(n, _)| *n)
-                        .collect::<Vec<_>>()
-                        .join(" ")
-                )),
-                ExprKind::Navigation if is_nav_symbol(&name) => Ok(()),
-                ExprKind::Navigation => Err(format!(
-                    "unknown symbol `{name}` (navigation symbols: {})",
-                    nav_symbol_list()
-                )),
-                ExprKind::Regressor => Err(format!(
-                    "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2], w.x w.y w.z [rad/s], dw.x dw.y dw.z [rad/s^2] and df.x df.y df.z [m/s^3])"
-                )),
-            }
-        }
-        syn::Expr::Field(f) => {
-            let base = match &*f.base {
-                syn::Expr::Path(p) => p.path.get_ident().map(|i| i.to_string()),
-                _ => None,
-            };
-            let member = match &f.member {
-                syn::Member::Named(i) => i.to_string(),
-                syn::Member::Unnamed(_) => String::new(),
-            };
-            let ok_member = matches!(member.as_str(), "x" | "y" | "z");
-            let aid_field = AID_POSITION_FIELDS.contains(&member.as_str())
-                || AID_VELOCITY_FIELDS.contains(&member.as_str());
-            match (kind, base.as_deref()) {
-                (ExprKind::Residual, Some("aid")) if aid_field => Ok(()),
-                (ExprKind::Residual, _) => Err(format!(
-                    "unknown field `{}` (the aiding record has aid.{} and aid.{})",
-                    f.to_token_stream().to_string().replace(' ', ""),
-                    AID_POSITION_FIELDS.join(" aid."),
-                    AID_VELOCITY_FIELDS.join(" aid.")
-                )),
-                (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
-                (ExprKind::Regressor, _) => Err(format!(
-                    "unknown signal `{}` (use f.x f.y f.z, w.x w.y w.z, dw.x dw.y dw.z or df.x df.y df.z)",
-                    f.to_token_stream().to_string().replace(' ', "")
-                )),
-                (ExprKind::Navigation, _) => Err(format!(
-                    "unknown symbol `{}` (IMU signals belong in a term's regressor)",
-                    f.to_token_stream().to_string().replace(' ', "")
-                )),
-            }
-        }
+        syn::Expr::Lit(l) => check_literal(&l.lit),
+        syn::Expr::Path(p) => check_symbol(p, kind),
+        syn::Expr::Field(f) => check_field(f, kind),
         syn::Expr::Binary(b) => {
             use syn::BinOp::*;
             match b.op {
@@ -417,53 +342,150 @@ fn check(e: &syn::Expr, kind: ExprKind) -> Result<(), String> {
             )),
         },
         syn::Expr::Paren(p) => check(&p.expr, kind),
-        syn::Expr::MethodCall(m) => {
-            let name = m.method.to_string();
-            if !METHODS.contains(&name.as_str()) {
-                return Err(format!(
-                    "unknown method `{name}` (allowed: {})",
-                    METHODS.join(" ")
-                ));
-            }
-            if name == "powi" {
-                let ok = m.args.len() == 1
-                    && matches!(
-                        m.args.first(),
-                        Some(syn::Expr::Lit(syn::ExprLit {
-                            lit: syn::Lit::Int(_),
-                            ..
-                        }))
-                    );
-                if !ok {
-                    return Err("`powi` takes one integer literal".into());
-                }
-                for a in &m.args {
-                    check(a, kind)?;
-                }
-                let k = match m.args.first() {
-                    Some(syn::Expr::Lit(syn::ExprLit {
-                        lit: syn::Lit::Int(i),
-                        ..
-                    })) => i.base10_parse::<i32>().ok(),
-                    _ => None,
-                };
-                if k.is_none_or(|k| k.unsigned_abs() > crate::units::MAX_POWER.unsigned_abs()) {
-                    return Err(format!(
-                        "`powi` exponent out of range (|n| <= {})",
-                        crate::units::MAX_POWER
-                    ));
-                }
-            } else if !m.args.is_empty() {
-                return Err(format!("`{name}` takes no arguments"));
-            }
-            check(&m.receiver, kind)
-        }
+        syn::Expr::MethodCall(m) => check_method_call(m, kind),
         other => Err(format!(
             "`{}` is not allowed (arithmetic, literals, symbols and {} only)",
             other.to_token_stream(),
             METHODS.join(" ")
         )),
     }
+}
+
+/// A literal: a plain number (no type suffix) whose value is a finite f64.
+fn check_literal(lit: &syn::Lit) -> Result<(), String> {
+    match lit {
+        // a suffix (`1.5f32`, `2u8`) would change the generated code's types
+        syn::Lit::Float(f) if !f.suffix().is_empty() => Err(format!(
+            "literal `{}` has a type suffix (write plain numbers)",
+            f.token()
+        )),
+        syn::Lit::Int(i) if !i.suffix().is_empty() => Err(format!(
+            "literal `{}` has a type suffix (write plain numbers)",
+            i.token()
+        )),
+        // the generated code writes the value as an f64 literal: it must be one
+        syn::Lit::Float(f) if !f.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(format!(
+            "literal `{}` is beyond the range of f64",
+            f.token()
+        )),
+        syn::Lit::Int(i) if !i.base10_parse::<f64>().is_ok_and(f64::is_finite) => Err(format!(
+            "literal `{}` is beyond the range of f64",
+            i.token()
+        )),
+        syn::Lit::Float(_) | syn::Lit::Int(_) => Ok(()),
+        _ => Err("only numeric literals are allowed".into()),
+    }
+}
+
+/// A bare symbol (`lat`, `rn`): one of the symbols an expression of `kind` may use.
+fn check_symbol(p: &syn::ExprPath, kind: ExprKind) -> Result<(), String> {
+    let name = p
+        .path
+        .get_ident()
+        .map(|i| i.to_string())
+        .ok_or_else(|| format!("unknown symbol `{}`", p.to_token_stream()))?;
+    match kind {
+        ExprKind::Residual if RESIDUAL_STATE_SYMBOLS.iter().any(|(n, _)| *n == name) => Ok(()),
+        ExprKind::Residual => Err(format!(
+            "unknown symbol `{name}` (a residual uses {} and aid.FIELD)",
+            RESIDUAL_STATE_SYMBOLS
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(" ")
+        )),
+        ExprKind::Navigation if is_nav_symbol(&name) => Ok(()),
+        ExprKind::Navigation => Err(format!(
+            "unknown symbol `{name}` (navigation symbols: {})",
+            nav_symbol_list()
+        )),
+        ExprKind::Regressor => Err(format!(
+            "unknown symbol `{name}` (a regressor uses f.x f.y f.z [m/s^2], w.x w.y w.z [rad/s], dw.x dw.y dw.z [rad/s^2] and df.x df.y df.z [m/s^3])"
+        )),
+    }
+}
+
+/// A field (`f.x`, `aid.lat`): an IMU signal's axis in a regressor, an aiding field in a
+/// residual, never in a navigation expression.
+fn check_field(f: &syn::ExprField, kind: ExprKind) -> Result<(), String> {
+    let base = match &*f.base {
+        syn::Expr::Path(p) => p.path.get_ident().map(|i| i.to_string()),
+        _ => None,
+    };
+    let member = match &f.member {
+        syn::Member::Named(i) => i.to_string(),
+        syn::Member::Unnamed(_) => String::new(),
+    };
+    let ok_member = matches!(member.as_str(), "x" | "y" | "z");
+    let aid_field = AID_POSITION_FIELDS.contains(&member.as_str())
+        || AID_VELOCITY_FIELDS.contains(&member.as_str());
+    match (kind, base.as_deref()) {
+        (ExprKind::Residual, Some("aid")) if aid_field => Ok(()),
+        (ExprKind::Residual, _) => Err(format!(
+            "unknown field `{}` (the aiding record has aid.{} and aid.{})",
+            f.to_token_stream().to_string().replace(' ', ""),
+            AID_POSITION_FIELDS.join(" aid."),
+            AID_VELOCITY_FIELDS.join(" aid.")
+        )),
+        (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
+        (ExprKind::Regressor, _) => Err(format!(
+            "unknown signal `{}` (use f.x f.y f.z, w.x w.y w.z, dw.x dw.y dw.z or df.x df.y df.z)",
+            f.to_token_stream().to_string().replace(' ', "")
+        )),
+        (ExprKind::Navigation, _) => Err(format!(
+            "unknown symbol `{}` (IMU signals belong in a term's regressor)",
+            f.to_token_stream().to_string().replace(' ', "")
+        )),
+    }
+}
+
+/// A method call: an allowed method; `powi` with one integer literal in range, others with none.
+fn check_method_call(m: &syn::ExprMethodCall, kind: ExprKind) -> Result<(), String> {
+    let name = m.method.to_string();
+    if !METHODS.contains(&name.as_str()) {
+        return Err(format!(
+            "unknown method `{name}` (allowed: {})",
+            METHODS.join(" ")
+        ));
+    }
+    if name == "powi" {
+        check_powi_args(m, kind)?;
+    } else if !m.args.is_empty() {
+        return Err(format!("`{name}` takes no arguments"));
+    }
+    check(&m.receiver, kind)
+}
+
+/// `powi`'s argument: exactly one integer literal, at most `units::MAX_POWER` in magnitude.
+fn check_powi_args(m: &syn::ExprMethodCall, kind: ExprKind) -> Result<(), String> {
+    let ok = m.args.len() == 1
+        && matches!(
+            m.args.first(),
+            Some(syn::Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Int(_),
+                ..
+            }))
+        );
+    if !ok {
+        return Err("`powi` takes one integer literal".into());
+    }
+    for a in &m.args {
+        check(a, kind)?;
+    }
+    let k = match m.args.first() {
+        Some(syn::Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        })) => i.base10_parse::<i32>().ok(),
+        _ => None,
+    };
+    if k.is_none_or(|k| k.unsigned_abs() > crate::units::MAX_POWER.unsigned_abs()) {
+        return Err(format!(
+            "`powi` exponent out of range (|n| <= {})",
+            crate::units::MAX_POWER
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

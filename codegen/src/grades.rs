@@ -80,87 +80,132 @@ pub(crate) fn load(
     let raw: RawGrades = src.parse()?;
     let mut grades: Vec<Grade> = Vec::new();
     for g in &raw.grade {
-        let name = g.name.get_ref();
-        let item = format!("grade `{name}`");
-        crate::spec::check_name(src, &g.name, "grade")?;
-        if name == "navigation" || grades.iter().any(|x| &x.name == name) {
+        let grade = load_grade(src, g, &grades, nav_states, terms)?;
+        grades.push(grade);
+    }
+    check_term_grades(terms_src, terms, &grades)?;
+    Ok(grades)
+}
+
+/// One grade: a new name, positive factors for unlisted groups, its state and term priors.
+fn load_grade(
+    src: &Source,
+    g: &RawGrade,
+    earlier: &[Grade],
+    nav_states: &[NavState],
+    terms: &[Term],
+) -> Result<Grade, SpecError> {
+    let name = g.name.get_ref();
+    let item = format!("grade `{name}`");
+    crate::spec::check_name(src, &g.name, "grade")?;
+    if name == "navigation" || earlier.iter().any(|x| &x.name == name) {
+        return Err(src.error(
+            g.name.span(),
+            &item,
+            "duplicate grade (`navigation` is the spec's own defaults and is not listed)",
+        ));
+    }
+    for (sensor, f) in [("gyro", &g.unlisted.gyro), ("accel", &g.unlisted.accel)] {
+        let v = *f.get_ref();
+        if !(v.is_finite() && v > 0.0) {
             return Err(src.error(
-                g.name.span(),
+                f.span(),
                 &item,
-                "duplicate grade (`navigation` is the spec's own defaults and is not listed)",
+                format!("unlisted.{sensor}: the factor must be positive and finite, got {v}"),
             ));
         }
-        for (sensor, f) in [("gyro", &g.unlisted.gyro), ("accel", &g.unlisted.accel)] {
-            let v = *f.get_ref();
-            if !(v.is_finite() && v > 0.0) {
-                return Err(src.error(
-                    f.span(),
-                    &item,
-                    format!("unlisted.{sensor}: the factor must be positive and finite, got {v}"),
-                ));
-            }
-        }
-        let mut nav_sigma = vec![None; nav_states.len()];
-        for (state, q) in &g.states {
-            let Some(i) = nav_states.iter().position(|s| &s.name == state) else {
-                return Err(src.error(
-                    q.span(),
-                    &item,
-                    format!("states: no navigation state `{state}` (navigation.toml)"),
-                ));
-            };
-            let si = quantity(
-                src,
-                q,
-                &nav_states[i].unit,
-                &item,
-                &format!("states.{state}"),
-            )?;
-            nav_sigma[i] = Some(positive(src, q, si, &item, &format!("states.{state}"))?);
-        }
-        for (group, q) in &g.groups {
-            if !terms.iter().any(|t| &t.group == group) {
-                return Err(src.error(
-                    q.span(),
-                    &item,
-                    format!("groups: no term has group `{group}` (terms.toml)"),
-                ));
-            }
-        }
-        let mut term_sigma = Vec::with_capacity(terms.len());
-        let mut term_rule = Vec::with_capacity(terms.len());
-        for t in terms {
-            let (si, rule) = if let Some((_, si, _)) = t.grade_sigma.iter().find(|x| &x.0 == name) {
-                (*si, GradeRule::Term)
-            } else if let Some(q) = g.groups.get(&t.group) {
-                let field = format!("groups.\"{}\" for term `{}`", t.group, t.name);
-                let si = quantity(src, q, &t.unit, &item, &field)?;
-                (positive(src, q, si, &item, &field)?, GradeRule::Group)
-            } else {
-                let k = match t.sensor {
-                    Sensor::Gyro => *g.unlisted.gyro.get_ref(),
-                    Sensor::Accel => *g.unlisted.accel.get_ref(),
-                    // the IMU's grade says nothing about the aiding: its own prior
-                    Sensor::Gnss => 1.0,
-                };
-                (t.sigma * k, GradeRule::Unlisted)
-            };
-            term_sigma.push(si);
-            term_rule.push(rule);
-        }
-        grades.push(Grade {
-            name: name.clone(),
-            doc: g.doc.clone(),
-            gyro_arw: quantity(src, &g.gyro_arw, "rad/sqrt(s)", &item, "gyro_arw")?,
-            gyro_arw_text: g.gyro_arw.get_ref().clone(),
-            accel_vrw: quantity(src, &g.accel_vrw, "m/s/sqrt(s)", &item, "accel_vrw")?,
-            accel_vrw_text: g.accel_vrw.get_ref().clone(),
-            nav_sigma,
-            term_sigma,
-            term_rule,
-        });
     }
-    // a term's own grade_sigma must name a grade
+    let nav_sigma = grade_nav_sigma(src, g, &item, nav_states)?;
+    let (term_sigma, term_rule) = grade_term_sigma(src, g, &item, terms)?;
+    Ok(Grade {
+        name: name.clone(),
+        doc: g.doc.clone(),
+        gyro_arw: quantity(src, &g.gyro_arw, "rad/sqrt(s)", &item, "gyro_arw")?,
+        gyro_arw_text: g.gyro_arw.get_ref().clone(),
+        accel_vrw: quantity(src, &g.accel_vrw, "m/s/sqrt(s)", &item, "accel_vrw")?,
+        accel_vrw_text: g.accel_vrw.get_ref().clone(),
+        nav_sigma,
+        term_sigma,
+        term_rule,
+    })
+}
+
+/// The grade's navigation-state priors (`states`), `None` for each state it does not list.
+fn grade_nav_sigma(
+    src: &Source,
+    g: &RawGrade,
+    item: &str,
+    nav_states: &[NavState],
+) -> Result<Vec<Option<f64>>, SpecError> {
+    let mut nav_sigma = vec![None; nav_states.len()];
+    for (state, q) in &g.states {
+        let Some(i) = nav_states.iter().position(|s| &s.name == state) else {
+            return Err(src.error(
+                q.span(),
+                item,
+                format!("states: no navigation state `{state}` (navigation.toml)"),
+            ));
+        };
+        let si = quantity(
+            src,
+            q,
+            &nav_states[i].unit,
+            item,
+            &format!("states.{state}"),
+        )?;
+        nav_sigma[i] = Some(positive(src, q, si, item, &format!("states.{state}"))?);
+    }
+    Ok(nav_sigma)
+}
+
+/// Every term's prior under the grade and where it comes from (term, group or unlisted rule);
+/// each group the grade lists must be some term's.
+fn grade_term_sigma(
+    src: &Source,
+    g: &RawGrade,
+    item: &str,
+    terms: &[Term],
+) -> Result<(Vec<f64>, Vec<GradeRule>), SpecError> {
+    for (group, q) in &g.groups {
+        if !terms.iter().any(|t| &t.group == group) {
+            return Err(src.error(
+                q.span(),
+                item,
+                format!("groups: no term has group `{group}` (terms.toml)"),
+            ));
+        }
+    }
+    let name = g.name.get_ref();
+    let mut term_sigma = Vec::with_capacity(terms.len());
+    let mut term_rule = Vec::with_capacity(terms.len());
+    for t in terms {
+        let (si, rule) = if let Some((_, si, _)) = t.grade_sigma.iter().find(|x| &x.0 == name) {
+            (*si, GradeRule::Term)
+        } else if let Some(q) = g.groups.get(&t.group) {
+            let field = format!("groups.\"{}\" for term `{}`", t.group, t.name);
+            let si = quantity(src, q, &t.unit, item, &field)?;
+            (positive(src, q, si, item, &field)?, GradeRule::Group)
+        } else {
+            let k = match t.sensor {
+                Sensor::Gyro => *g.unlisted.gyro.get_ref(),
+                Sensor::Accel => *g.unlisted.accel.get_ref(),
+                // the IMU's grade says nothing about the aiding: its own prior
+                Sensor::Gnss => 1.0,
+            };
+            (t.sigma * k, GradeRule::Unlisted)
+        };
+        term_sigma.push(si);
+        term_rule.push(rule);
+    }
+    Ok((term_sigma, term_rule))
+}
+
+/// A term's own `grade_sigma` entries must name grades of grades.toml.
+fn check_term_grades(
+    terms_src: &Source,
+    terms: &[Term],
+    grades: &[Grade],
+) -> Result<(), SpecError> {
     for t in terms {
         for (g, _, line) in &t.grade_sigma {
             if !grades.iter().any(|x| &x.name == g) {
@@ -180,7 +225,7 @@ pub(crate) fn load(
             }
         }
     }
-    Ok(grades)
+    Ok(())
 }
 
 /// `si` if it is a positive, finite prior; else an error at `q`.

@@ -1,6 +1,7 @@
 //! sinsmodel-codegen: compiles the declarative SINS error-model spec (`model-spec/*.toml`) into
-//! Rust: sparse A(t) and H fill functions, regressor accumulators and sparse covariance kernels
-//! for every preset (with and without the vertical channel), plus per-term column functions for
+//! Rust: sparse A(t) and H fill functions, regressor accumulators and the B = Φ − I of the sparse
+//! covariance kernel (whose arithmetic the main crate holds once, in `src/model/kernel.rs`) for
+//! every preset (with and without the vertical channel), plus per-term column functions for
 //! models composed at run time.
 //!
 //! Called from the main crate's `build.rs` (prost-build style): output goes to `OUT_DIR`, files are
@@ -59,42 +60,12 @@ pub fn generate(spec: &Spec) -> Vec<GeneratedFile> {
         .iter()
         .map(|f| (f.module.clone(), f.what.clone()))
         .collect();
-    let mut root = emit::root_module(&mods);
-    root.push_str(&preset_table(spec));
     files.push(GeneratedFile {
         module: "models".into(),
         what: "the root module".into(),
-        text: root,
+        text: emit::root_module(spec, &mods),
     });
     files
-}
-
-/// A `PRESETS` table mapping preset names to their generated kernels, appended to the root.
-fn preset_table(spec: &Spec) -> String {
-    let mut s = String::from(
-        "\n/// Every generated preset model, by name (with and without `+vertical`).\n\
-         pub const PRESETS: &[crate::model::catalog::PresetKernels] = &[\n",
-    );
-    for p in &spec.presets {
-        for vertical in [false, true] {
-            let name = if vertical {
-                format!("{}+vertical", p.name)
-            } else {
-                p.name.clone()
-            };
-            let m = module_name(&name);
-            s.push_str(&format!(
-                "    crate::model::catalog::PresetKernels {{ name: {m}::NAME, doc: {doc:?}, vertical: {m}::VERTICAL, \
-                 states: &{m}::STATES, state_refs: &{m}::STATE_REFS, a_pattern: &{m}::A_PATTERN, \
-                 regressor_ids: &{m}::REGRESSOR_IDS, measurements: &{m}::MEASUREMENTS, \
-                 fill_a: {m}::fill_a_dyn, fill_h: {m}::fill_h_dyn, propagate_cov: {m}::propagate_cov_dyn, \
-                 accumulate: {m}::accumulate_dyn, propagate: {m}::propagate_dyn }},\n",
-                doc = p.doc,
-            ));
-        }
-    }
-    s.push_str("];\n");
-    s
 }
 
 /// Writes `text` to `path` only when the file is missing or its content differs; returns whether

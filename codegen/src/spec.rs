@@ -732,149 +732,209 @@ fn load_terms(
     let mut terms = Vec::new();
     let mut regressors: Vec<Regressor> = Vec::new();
     for t in raw {
-        let item = format!("term `{}`", t.name.get_ref());
-        check_name(src, &t.name, "term")?;
-        if let Some(prev) = names.insert(t.name.get_ref().clone(), "terms.toml".into()) {
-            return Err(src.error(
-                t.name.span(),
-                &item,
-                format!("duplicate name (already defined in {prev})"),
-            ));
-        }
-        let sensor = match t.sensor.get_ref().as_str() {
-            "gyro" => Sensor::Gyro,
-            "accel" => Sensor::Accel,
-            "gnss" => Sensor::Gnss,
-            other => {
-                return Err(src.error(
-                    t.sensor.span(),
-                    &item,
-                    format!("unknown sensor `{other}` (expected `gyro`, `accel` or `gnss`)"),
-                ))
-            }
-        };
-        let unit = units::parse_unit(t.unit.get_ref())
-            .map_err(|e| src.error(t.unit.span(), &item, format!("unit: {e}")))?;
-        let axis = match &t.axis {
-            None if sensor == Sensor::Gnss => 0,
-            None => return Err(src.error(
-                t.name.span(),
-                &item,
-                "missing `axis` (`x`, `y` or `z`: the sensing axis of the gyro or accelerometer)",
-            )),
-            Some(a) => match a.get_ref().as_str() {
-                "x" => 0,
-                "y" => 1,
-                "z" => 2,
-                other => {
-                    return Err(src.error(
-                        a.span(),
-                        &item,
-                        format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
-                    ))
-                }
-            },
-        };
-        let (rexpr, h) = match sensor {
-            Sensor::Gnss => gnss_term_h(src, t, &item)?,
-            _ => {
-                let Some(r) = &t.regressor else {
-                    return Err(src.error(
-                        t.name.span(),
-                        &item,
-                        "missing `regressor` (the body-frame signal the error is proportional to, e.g. `f.x.powi(2)`, or `1` for a bias)",
-                    ));
-                };
-                if let Some(e) = t.h.first() {
-                    return Err(src.error(
-                        e.row.span(),
-                        &item,
-                        "`h` belongs to `sensor = \"gnss\"` terms (a gyro or accelerometer term enters A through its regressor)",
-                    ));
-                }
-                let rexpr = expr::parse(r.get_ref(), ExprKind::Regressor)
-                    .map_err(|m| src.error(r.span(), &item, format!("regressor: {m}")))?;
-                check_term_dimension(src, t, r, &item, sensor, &rexpr, unit.dim)?;
-                (rexpr, Vec::new())
-            }
-        };
-        let key = rexpr.key();
-        let regressor = match regressors.iter().position(|r| r.expr.key() == key) {
-            Some(i) => i,
-            None => {
-                let constant = rexpr.symbols().is_empty();
-                regressors.push(Regressor {
-                    expr: rexpr,
-                    constant,
-                });
-                regressors.len() - 1
-            }
-        };
-        let display = units::parse_unit(t.display.get_ref())
-            .map_err(|e| src.error(t.display.span(), &item, format!("display: {e}")))?;
-        if unit.dim != display.dim {
-            return Err(src.error(
-                t.display.span(),
-                &item,
-                format!(
-                    "display unit `{}` does not match unit `{}`",
-                    t.display.get_ref(),
-                    t.unit.get_ref()
-                ),
-            ));
-        }
-        let sigma = quantity(src, &t.sigma, t.unit.get_ref(), &item, "sigma")?;
-        let noise = match &t.noise {
-            Some(n) => quantity(
-                src,
-                n,
-                &format!("({})/sqrt(s)", t.unit.get_ref()).replace("(1)/", "1/"),
-                &item,
-                "noise",
-            )?,
-            None => 0.0,
-        };
-        let limit = match &t.limit {
-            Some(l) => {
-                let v = quantity(src, l, t.unit.get_ref(), &item, "limit")?;
-                if v.partial_cmp(&sigma) != Some(std::cmp::Ordering::Greater) {
-                    return Err(src.error(
-                        l.span(),
-                        &item,
-                        "limit must be larger than sigma (it bounds what is physically plausible)",
-                    ));
-                }
-                v
-            }
-            None => f64::INFINITY,
-        };
-        terms.push(Term {
-            name: t.name.get_ref().clone(),
-            sensor,
-            axis,
-            regressor,
-            unit: t.unit.get_ref().clone(),
-            display: t.display.get_ref().clone(),
-            display_to_si: display.to_si / unit.to_si,
-            sigma,
-            noise,
-            limit,
-            group: t.group.clone(),
-            doc: t.doc.clone(),
-            library: t.library,
-            grade_sigma: t
-                .grade_sigma
-                .iter()
-                .map(|(g, q)| {
-                    let si =
-                        quantity(src, q, t.unit.get_ref(), &item, &format!("grade_sigma.{g}"))?;
-                    Ok((g.clone(), si, src.line_of(q.span().start)))
-                })
-                .collect::<Result<_, SpecError>>()?,
-            h,
-        });
+        terms.push(load_term(src, t, names, &mut regressors)?);
     }
     Ok((terms, regressors))
+}
+
+/// One term, checked field by field in file order; its regressor is added to `regressors`.
+fn load_term(
+    src: &Source,
+    t: &RawTerm,
+    names: &mut HashMap<String, String>,
+    regressors: &mut Vec<Regressor>,
+) -> Result<Term, SpecError> {
+    let item = format!("term `{}`", t.name.get_ref());
+    check_name(src, &t.name, "term")?;
+    if let Some(prev) = names.insert(t.name.get_ref().clone(), "terms.toml".into()) {
+        return Err(src.error(
+            t.name.span(),
+            &item,
+            format!("duplicate name (already defined in {prev})"),
+        ));
+    }
+    let sensor = term_sensor(src, t, &item)?;
+    let unit = units::parse_unit(t.unit.get_ref())
+        .map_err(|e| src.error(t.unit.span(), &item, format!("unit: {e}")))?;
+    let axis = term_axis(src, t, &item, sensor)?;
+    let (rexpr, h) = match sensor {
+        Sensor::Gnss => gnss_term_h(src, t, &item)?,
+        _ => (
+            sensor_term_regressor(src, t, &item, sensor, unit.dim)?,
+            Vec::new(),
+        ),
+    };
+    let regressor = intern_regressor(regressors, rexpr);
+    let display = term_display(src, t, &item, &unit)?;
+    let sigma = quantity(src, &t.sigma, t.unit.get_ref(), &item, "sigma")?;
+    let noise = term_noise(src, t, &item)?;
+    let limit = term_limit(src, t, &item, sigma)?;
+    let grade_sigma = term_grade_sigma(src, t, &item)?;
+    Ok(Term {
+        name: t.name.get_ref().clone(),
+        sensor,
+        axis,
+        regressor,
+        unit: t.unit.get_ref().clone(),
+        display: t.display.get_ref().clone(),
+        display_to_si: display.to_si / unit.to_si,
+        sigma,
+        noise,
+        limit,
+        group: t.group.clone(),
+        doc: t.doc.clone(),
+        library: t.library,
+        grade_sigma,
+        h,
+    })
+}
+
+/// The term's `sensor`: `gyro`, `accel` or `gnss`.
+fn term_sensor(src: &Source, t: &RawTerm, item: &str) -> Result<Sensor, SpecError> {
+    match t.sensor.get_ref().as_str() {
+        "gyro" => Ok(Sensor::Gyro),
+        "accel" => Ok(Sensor::Accel),
+        "gnss" => Ok(Sensor::Gnss),
+        other => Err(src.error(
+            t.sensor.span(),
+            item,
+            format!("unknown sensor `{other}` (expected `gyro`, `accel` or `gnss`)"),
+        )),
+    }
+}
+
+/// The term's sensing `axis` (0 = x, 1 = y, 2 = z); required except for a GNSS term (0).
+fn term_axis(src: &Source, t: &RawTerm, item: &str, sensor: Sensor) -> Result<usize, SpecError> {
+    match &t.axis {
+        None if sensor == Sensor::Gnss => Ok(0),
+        None => Err(src.error(
+            t.name.span(),
+            item,
+            "missing `axis` (`x`, `y` or `z`: the sensing axis of the gyro or accelerometer)",
+        )),
+        Some(a) => match a.get_ref().as_str() {
+            "x" => Ok(0),
+            "y" => Ok(1),
+            "z" => Ok(2),
+            other => Err(src.error(
+                a.span(),
+                item,
+                format!("unknown axis `{other}` (expected `x`, `y` or `z`)"),
+            )),
+        },
+    }
+}
+
+/// A gyro or accelerometer term's regressor: required, no `h`, and of the right dimension.
+fn sensor_term_regressor(
+    src: &Source,
+    t: &RawTerm,
+    item: &str,
+    sensor: Sensor,
+    unit: units::Dim,
+) -> Result<Expr, SpecError> {
+    let Some(r) = &t.regressor else {
+        return Err(src.error(
+            t.name.span(),
+            item,
+            "missing `regressor` (the body-frame signal the error is proportional to, e.g. `f.x.powi(2)`, or `1` for a bias)",
+        ));
+    };
+    if let Some(e) = t.h.first() {
+        return Err(src.error(
+            e.row.span(),
+            item,
+            "`h` belongs to `sensor = \"gnss\"` terms (a gyro or accelerometer term enters A through its regressor)",
+        ));
+    }
+    let rexpr = expr::parse(r.get_ref(), ExprKind::Regressor)
+        .map_err(|m| src.error(r.span(), item, format!("regressor: {m}")))?;
+    check_term_dimension(src, t, r, item, sensor, &rexpr, unit)?;
+    Ok(rexpr)
+}
+
+/// Index of `rexpr` in `regressors`, appending it when no equal regressor is there yet.
+fn intern_regressor(regressors: &mut Vec<Regressor>, rexpr: Expr) -> usize {
+    let key = rexpr.key();
+    match regressors.iter().position(|r| r.expr.key() == key) {
+        Some(i) => i,
+        None => {
+            let constant = rexpr.symbols().is_empty();
+            regressors.push(Regressor {
+                expr: rexpr,
+                constant,
+            });
+            regressors.len() - 1
+        }
+    }
+}
+
+/// The term's `display` unit, which must measure what its `unit` measures.
+fn term_display(
+    src: &Source,
+    t: &RawTerm,
+    item: &str,
+    unit: &units::Unit,
+) -> Result<units::Unit, SpecError> {
+    let display = units::parse_unit(t.display.get_ref())
+        .map_err(|e| src.error(t.display.span(), item, format!("display: {e}")))?;
+    if unit.dim != display.dim {
+        return Err(src.error(
+            t.display.span(),
+            item,
+            format!(
+                "display unit `{}` does not match unit `{}`",
+                t.display.get_ref(),
+                t.unit.get_ref()
+            ),
+        ));
+    }
+    Ok(display)
+}
+
+/// The term's random-walk density `noise` in unit/√s (0 when not given: a random constant).
+fn term_noise(src: &Source, t: &RawTerm, item: &str) -> Result<f64, SpecError> {
+    match &t.noise {
+        Some(n) => quantity(
+            src,
+            n,
+            &format!("({})/sqrt(s)", t.unit.get_ref()).replace("(1)/", "1/"),
+            item,
+            "noise",
+        ),
+        None => Ok(0.0),
+    }
+}
+
+/// The term's plausibility `limit` (∞ when not given), which must exceed its `sigma`.
+fn term_limit(src: &Source, t: &RawTerm, item: &str, sigma: f64) -> Result<f64, SpecError> {
+    let Some(l) = &t.limit else {
+        return Ok(f64::INFINITY);
+    };
+    let v = quantity(src, l, t.unit.get_ref(), item, "limit")?;
+    if v.partial_cmp(&sigma) != Some(std::cmp::Ordering::Greater) {
+        return Err(src.error(
+            l.span(),
+            item,
+            "limit must be larger than sigma (it bounds what is physically plausible)",
+        ));
+    }
+    Ok(v)
+}
+
+/// The priors the term declares per grade: (grade, 1-σ [SI], line in terms.toml).
+fn term_grade_sigma(
+    src: &Source,
+    t: &RawTerm,
+    item: &str,
+) -> Result<Vec<(String, f64, usize)>, SpecError> {
+    t.grade_sigma
+        .iter()
+        .map(|(g, q)| {
+            let si = quantity(src, q, t.unit.get_ref(), item, &format!("grade_sigma.{g}"))?;
+            Ok((g.clone(), si, src.line_of(q.span().start)))
+        })
+        .collect()
 }
 
 /// A GNSS term: no regressor (it does not enter A; the constant `1` stands for it), and at
@@ -1123,100 +1183,13 @@ fn load_presets(
     terms: &[Term],
     names: &HashMap<String, String>,
 ) -> Result<Vec<Preset>, SpecError> {
-    let horizontal: Vec<&str> = nav_states
-        .iter()
-        .filter(|s| !s.vertical)
-        .map(|s| s.name.as_str())
-        .collect();
     let mut presets: Vec<Preset> = Vec::new();
     for raw in raw {
         let name = raw.name.get_ref();
         let item = format!("preset `{name}`");
-        let span = raw.name.span();
-        let ok_name = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-            && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        if !ok_name || name.eq_ignore_ascii_case("vertical") {
-            return Err(src.error(
-                span,
-                &item,
-                "preset names are letters, digits and `_`, starting with a letter (and not `vertical`)",
-            ));
-        }
-        if presets.iter().any(|p| p.name.eq_ignore_ascii_case(name)) {
-            return Err(src.error(span, &item, "duplicate preset (names are case-insensitive)"));
-        }
-        if terms.iter().any(|t| t.name.eq_ignore_ascii_case(name)) {
-            return Err(src.error(span, &item, "a preset cannot have the name of a term"));
-        }
-        let states: Vec<String> = match (&raw.states, &raw.base) {
-            (Some(s), None) => {
-                if !raw.terms.is_empty() {
-                    return Err(src.error(
-                        span,
-                        &item,
-                        "give either `states`, or `base` and `terms`",
-                    ));
-                }
-                s.clone()
-            }
-            (None, Some(base)) => {
-                let b = presets
-                    .iter()
-                    .find(|p| p.name.eq_ignore_ascii_case(base.get_ref()))
-                    .ok_or_else(|| {
-                        src.error(
-                            base.span(),
-                            &item,
-                            format!("base `{}` is not a preset defined above it", base.get_ref()),
-                        )
-                    })?;
-                let mut s = b.states.clone();
-                s.extend(raw.terms.iter().cloned());
-                s
-            }
-            _ => {
-                return Err(src.error(
-                    span,
-                    &item,
-                    "give either `states` (the full list) or `base` (a preset above) and `terms`",
-                ))
-            }
-        };
-        let mut seen = BTreeSet::new();
-        for s in &states {
-            if !seen.insert(s.as_str()) {
-                return Err(src.error(span.clone(), &item, format!("state `{s}` listed twice")));
-            }
-            if !names.contains_key(s) {
-                return Err(src.error(
-                    span.clone(),
-                    &item,
-                    format!("names missing term `{s}` (not a state of navigation.toml nor a term of terms.toml)"),
-                ));
-            }
-            if nav_states.iter().any(|n| &n.name == s && n.vertical) {
-                return Err(src.error(
-                    span.clone(),
-                    &item,
-                    format!("vertical state `{s}` cannot be listed; write the model as `{name}+vertical`"),
-                ));
-            }
-        }
-        if states.len() < horizontal.len()
-            || states[..horizontal.len()]
-                .iter()
-                .map(String::as_str)
-                .ne(horizontal.iter().copied())
-        {
-            return Err(src.error(
-                span,
-                &item,
-                format!(
-                    "must start with the navigation states {}",
-                    horizontal.join(" ")
-                ),
-            ));
-        }
+        check_preset_name(src, raw, &item, &presets, terms)?;
+        let states = preset_states(src, raw, &item, &presets)?;
+        check_preset_states(src, raw, &item, &states, nav_states, names)?;
         presets.push(Preset {
             name: name.clone(),
             doc: raw.doc.clone(),
@@ -1224,4 +1197,128 @@ fn load_presets(
         });
     }
     Ok(presets)
+}
+
+/// A preset's name: letters, digits and `_`, not `vertical`, not an earlier preset's nor a term's.
+fn check_preset_name(
+    src: &Source,
+    raw: &RawPreset,
+    item: &str,
+    earlier: &[Preset],
+    terms: &[Term],
+) -> Result<(), SpecError> {
+    let name = raw.name.get_ref();
+    let span = raw.name.span();
+    let ok_name = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !ok_name || name.eq_ignore_ascii_case("vertical") {
+        return Err(src.error(
+            span,
+            item,
+            "preset names are letters, digits and `_`, starting with a letter (and not `vertical`)",
+        ));
+    }
+    if earlier.iter().any(|p| p.name.eq_ignore_ascii_case(name)) {
+        return Err(src.error(span, item, "duplicate preset (names are case-insensitive)"));
+    }
+    if terms.iter().any(|t| t.name.eq_ignore_ascii_case(name)) {
+        return Err(src.error(span, item, "a preset cannot have the name of a term"));
+    }
+    Ok(())
+}
+
+/// A preset's state list: its `states`, or the states of its `base` (an earlier preset) followed
+/// by its `terms`.
+fn preset_states(
+    src: &Source,
+    raw: &RawPreset,
+    item: &str,
+    earlier: &[Preset],
+) -> Result<Vec<String>, SpecError> {
+    let span = raw.name.span();
+    match (&raw.states, &raw.base) {
+        (Some(s), None) => {
+            if !raw.terms.is_empty() {
+                return Err(src.error(span, item, "give either `states`, or `base` and `terms`"));
+            }
+            Ok(s.clone())
+        }
+        (None, Some(base)) => {
+            let b = earlier
+                .iter()
+                .find(|p| p.name.eq_ignore_ascii_case(base.get_ref()))
+                .ok_or_else(|| {
+                    src.error(
+                        base.span(),
+                        item,
+                        format!("base `{}` is not a preset defined above it", base.get_ref()),
+                    )
+                })?;
+            let mut s = b.states.clone();
+            s.extend(raw.terms.iter().cloned());
+            Ok(s)
+        }
+        _ => Err(src.error(
+            span,
+            item,
+            "give either `states` (the full list) or `base` (a preset above) and `terms`",
+        )),
+    }
+}
+
+/// A preset's states: each listed once, known, not vertical, and the horizontal navigation
+/// states first, in order.
+fn check_preset_states(
+    src: &Source,
+    raw: &RawPreset,
+    item: &str,
+    states: &[String],
+    nav_states: &[NavState],
+    names: &HashMap<String, String>,
+) -> Result<(), SpecError> {
+    let name = raw.name.get_ref();
+    let span = raw.name.span();
+    let mut seen = BTreeSet::new();
+    for s in states {
+        if !seen.insert(s.as_str()) {
+            return Err(src.error(span.clone(), item, format!("state `{s}` listed twice")));
+        }
+        if !names.contains_key(s) {
+            return Err(src.error(
+                span.clone(),
+                item,
+                format!("names missing term `{s}` (not a state of navigation.toml nor a term of terms.toml)"),
+            ));
+        }
+        if nav_states.iter().any(|n| &n.name == s && n.vertical) {
+            return Err(src.error(
+                span.clone(),
+                item,
+                format!(
+                    "vertical state `{s}` cannot be listed; write the model as `{name}+vertical`"
+                ),
+            ));
+        }
+    }
+    let horizontal: Vec<&str> = nav_states
+        .iter()
+        .filter(|s| !s.vertical)
+        .map(|s| s.name.as_str())
+        .collect();
+    if states.len() < horizontal.len()
+        || states[..horizontal.len()]
+            .iter()
+            .map(String::as_str)
+            .ne(horizontal.iter().copied())
+    {
+        return Err(src.error(
+            span,
+            item,
+            format!(
+                "must start with the navigation states {}",
+                horizontal.join(" ")
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -6,6 +6,7 @@ pub mod catalog;
 pub mod covariance;
 pub mod generated;
 pub mod jacobian;
+pub mod kernel;
 pub mod priors;
 
 use crate::model::catalog::{MeasurementInfo, PresetKernels, StateRef};
