@@ -64,7 +64,14 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Bytes(bytes));
     g.sample_size(10);
     g.bench_function("read", |b| {
-        b.iter(|| black_box(sinsmodel::io::imu::read_text(&path).unwrap().samples.len()))
+        b.iter(|| {
+            black_box(
+                sinsmodel::io::imu_stream::read_text(&path)
+                    .unwrap()
+                    .samples
+                    .len(),
+            )
+        })
     });
     g.finish();
 }

@@ -270,7 +270,7 @@ pub fn imu_text(data: &[u8]) {
 /// A PSINS `.imu` log, through [`ImuStream::open`]; an accepted header must be finite too.
 pub fn psins(data: &[u8]) {
     let p = files(&[("log.imu", data)]);
-    if let Ok(log) = crate::io::readers::psins::read(&p[0]) {
+    if let Ok(log) = crate::io::imu_stream::read_psins(&p[0]) {
         for v in log.euler_deg.iter().chain(&log.v_ned) {
             finite(*v, "PSINS header value");
         }

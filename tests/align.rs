@@ -1,7 +1,6 @@
 //! Static alignment on simulated data of known attitude and on the real RLG log.
 
 use sinsmodel::estimate::align::align;
-use sinsmodel::io::readers::psins;
 use sinsmodel::sim::scenario::Scenario;
 use sinsmodel::sim::simulator::simulate;
 use std::path::PathBuf;
@@ -39,7 +38,7 @@ fn simulated_static_alignment_recovers_attitude_and_latitude() {
 fn lasergyro_alignment_finds_latitude_and_the_disturbed_start() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/data/psins-lasergyro/lasergyro.imu");
-    let log = psins::read(&path).unwrap();
+    let log = sinsmodel::io::imu_stream::read_psins(&path).unwrap();
     let a = align(
         &log.imu,
         None,

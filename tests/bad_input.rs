@@ -161,7 +161,7 @@ fn simulate_then_navigate_round_trip_through_text() {
     for f in ["imu.txt", "truth.txt", "gnss.txt", "scenario.toml"] {
         assert!(out.join(f).exists(), "{f}");
     }
-    let imu = sinsmodel::io::imu::read_text(&out.join("imu.txt")).unwrap();
+    let imu = sinsmodel::io::imu_stream::read_text(&out.join("imu.txt")).unwrap();
     assert_eq!(imu.samples.len(), 6000);
     let fixes = sinsmodel::io::aiding::read(&out.join("gnss.txt")).unwrap();
     assert_eq!(fixes.len(), 60);

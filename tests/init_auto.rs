@@ -113,7 +113,7 @@ fn quiet_start_heading_from_the_drive_off_and_the_mounting() {
         );
     }
     // the IMU turned 20° right in the vehicle: x_s = (cos 20°, sin 20°, 0) in the vehicle's FRD
-    let mut imu = sinsmodel::io::imu::read_text(&sim.join("imu.txt")).unwrap();
+    let mut imu = sinsmodel::io::imu_stream::read_text(&sim.join("imu.txt")).unwrap();
     let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), 20f64.to_radians());
     for x in &mut imu.samples {
         x.dtheta = r.transpose() * x.dtheta;
@@ -195,7 +195,7 @@ fn jittered_moving_mems_case_through_align_allan_and_filter() {
     let scen = root().join("scenarios/mems_moving.toml");
     let sim = simulate(&scen, dir.path(), "jittered");
     let s = |n: &str| sim.join(n).to_str().unwrap().to_string();
-    let imu = sinsmodel::io::imu::read_text(&sim.join("imu.txt")).unwrap();
+    let imu = sinsmodel::io::imu_stream::read_text(&sim.join("imu.txt")).unwrap();
     assert!(imu.jitter_rms() > 0.2 * imu.interval(), "the clock jitters");
 
     // align: honest about what MEMS gyros cannot give

@@ -1,6 +1,6 @@
 //! Readers against the real measured data in ../shared/data (see its README).
 
-use sinsmodel::io::readers::{gnss_imu, psins, rtklib};
+use sinsmodel::io::readers::{gnss_imu, rtklib};
 use std::path::PathBuf;
 
 mod common;
@@ -13,7 +13,8 @@ fn data(rel: &str) -> PathBuf {
 
 #[test]
 fn psins_lasergyro_log() {
-    let log = psins::read(&data("psins-lasergyro/lasergyro.imu")).unwrap();
+    let log =
+        sinsmodel::io::imu_stream::read_psins(&data("psins-lasergyro/lasergyro.imu")).unwrap();
     let imu = &log.imu;
     assert_eq!(imu.samples.len(), 184_718);
     assert!((imu.rate_hz() - 100.0).abs() < 1e-6);
@@ -157,7 +158,7 @@ fn matlab_file_reads_like_the_text_it_came_from() {
         sim.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    let imu = sinsmodel::io::imu::read_text(&sim.join("imu.txt")).unwrap();
+    let imu = sinsmodel::io::imu_stream::read_text(&sim.join("imu.txt")).unwrap();
     let truth = sinsmodel::io::truth::read(&sim.join("truth.txt")).unwrap();
     let mut wm_vm_t = Vec::new();
     for s in &imu.samples {

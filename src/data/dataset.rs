@@ -187,7 +187,7 @@ impl DataOptions {
     /// For a command that passes over the IMU file more than once (explain): reads the file
     /// through once (every sample validated, its end found; memory does not grow with it), then
     /// the aiding epochs inside it, the truth and the initial state. Each pass reads the file
-    /// again ([`crate::explain::ImuInput::File`]).
+    /// again (explain's `ImuInput::File`).
     pub fn load_for_passes(&self, note: &mut dyn FnMut(&str)) -> Result<PassInputs> {
         let mut opened = self.open(note)?;
         while opened.imu.next()?.is_some() {}

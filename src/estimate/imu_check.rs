@@ -246,8 +246,8 @@ impl Said {
             let p = format!(
                 "mean specific force |f| = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
                  while moving too: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong{}",
-                crate::explain::sig3(f.norm()),
-                crate::explain::sig3(gravity_ratio),
+                crate::io::units::sig3(f.norm()),
+                crate::io::units::sig3(gravity_ratio),
                 unit_hint(g / f.norm())
             );
             self.problems.push(p.clone());

@@ -3,7 +3,7 @@
 //! GNSS outage; and the unit constant they share.
 
 use super::filter::FilterRun;
-use crate::data::Outage;
+use crate::io::aiding::Outage;
 use anyhow::{bail, Result};
 
 /// Arcseconds per radian.

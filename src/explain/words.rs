@@ -2,6 +2,7 @@
 
 use super::findings::{Explanation, Finding};
 use super::G0;
+pub use crate::io::units::sig3;
 use crate::model::catalog::Sensor;
 use crate::model::generated::common;
 use crate::model::ImuSignals;
@@ -305,25 +306,6 @@ fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> St
     }
     s.push_str(&share_and_stand_in(f, ""));
     s
-}
-
-/// A number with three significant digits, plain (no exponent) where that reads well.
-pub fn sig3(v: f64) -> String {
-    if !v.is_finite() {
-        return "not determined".into();
-    }
-    let a = v.abs();
-    if a != 0.0 && !(1e-3..1e5).contains(&a) {
-        format!("{v:.2e}")
-    } else if a >= 100.0 {
-        format!("{v:.0}")
-    } else if a >= 10.0 {
-        format!("{v:.1}")
-    } else if a >= 1.0 {
-        format!("{v:.2}")
-    } else {
-        format!("{v:.3}")
-    }
 }
 
 pub(super) fn channel_word(c: &str) -> String {

@@ -163,3 +163,19 @@ pub fn read_with_velocity(path: &Path) -> Result<Vec<(PositionFix, Option<Veloci
         })
         .collect()
 }
+
+/// A GNSS outage window on the data's clock [s].
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Outage {
+    /// First second without aiding, on the data's clock [s].
+    pub start_s: f64,
+    /// End of the window [s].
+    pub end_s: f64,
+}
+
+impl Outage {
+    /// Whether time `t` [s] falls in the window [start, end).
+    pub fn contains(&self, t: f64) -> bool {
+        t >= self.start_s && t < self.end_s
+    }
+}

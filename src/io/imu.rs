@@ -233,12 +233,6 @@ pub fn read_table(path: &Path, ncols: usize, what: &str) -> Result<Vec<(usize, V
     Ok(rows)
 }
 
-/// Reads the text IMU format; any malformed row, NaN, non-increasing time, implausible rate or
-/// force, or gap longer than 5 intervals is an error naming the file and line.
-pub fn read_text(path: &Path) -> Result<ImuData> {
-    crate::io::imu_stream::ImuStream::text(path)?.collect()
-}
-
 /// Writes the text IMU format atomically (shortest round-trip decimal for every number).
 pub fn write_text(path: &Path, data: &ImuData, header: &str) -> Result<()> {
     let mut f = AtomicFile::create(path)?;

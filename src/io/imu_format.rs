@@ -4,9 +4,9 @@
 //! `"0.1 arcsec"` per count), and where the sensor's axes point on the body. Read into the
 //! project's FRD increments over each sample interval. Format: `docs/formats.md`.
 
-use crate::io::imu::{ImuData, ImuSample};
-use crate::io::imu_stream::{ImuStream, SampleSource, MAX_FORCE, MAX_RATE};
+use crate::io::imu::ImuSample;
 use crate::io::lines::{shown, Lines};
+use crate::io::sample_source::{SampleSource, MAX_FORCE, MAX_RATE};
 use crate::io::units::{parse_quantity, parse_unit};
 use anyhow::{anyhow, bail, Context, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -259,21 +259,6 @@ impl ImuFormat {
             Delimiter::Whitespace => line.split_whitespace().collect(),
             Delimiter::Char(c) => line.split(c).map(|f| f.trim().trim_matches('"')).collect(),
         }
-    }
-
-    /// Reads a data file described by this format into FRD increments; errors name the data
-    /// file and line (or the description's line for a column name it lacks).
-    pub fn read(&self, path: &Path) -> Result<ImuData> {
-        self.stream(path)?.collect()
-    }
-
-    /// A stream of the validated samples of a data file described by this format.
-    pub fn stream(&self, path: &Path) -> Result<ImuStream> {
-        ImuStream::with_hint(
-            self.source(path)?,
-            &path.display().to_string(),
-            &format!("[time] unit in {}", self.origin),
-        )
     }
 
     /// The samples of a data file described by this format, read one at a time.

@@ -10,7 +10,7 @@
 //! (imu-check's plausibility, the start time).
 
 use crate::io::imu::{ImuData, ImuSample, TableRows};
-use crate::io::units::STANDARD_GRAVITY;
+pub use crate::io::sample_source::{SampleSource, MAX_FORCE, MAX_RATE};
 use anyhow::{bail, Context, Result};
 use nalgebra::Vector3;
 use std::path::Path;
@@ -21,23 +21,10 @@ pub const HEAD_SECONDS: f64 = 10.0;
 pub const HEAD_MAX_SAMPLES: usize = 200_000;
 /// Fewest samples read ahead, whatever their span (a time in ms read as s makes 10 s hold one).
 pub const HEAD_MIN_SAMPLES: usize = 20;
-/// Largest angular rate any IMU measures [rad/s].
-pub const MAX_RATE: f64 = 100.0;
-/// Largest specific force any IMU measures [m/s²] (2000 g).
-pub const MAX_FORCE: f64 = 2000.0 * STANDARD_GRAVITY;
 /// Plausible median sample interval of an IMU [s]: 10 µs to 10 s.
 pub const INTERVAL_RANGE: (f64, f64) = (1e-5, 10.0);
 /// Largest gap between two samples, in median sample intervals.
 pub const MAX_GAP_INTERVALS: f64 = 5.0;
-
-/// A reader of one IMU format that hands out samples in file order.
-pub trait SampleSource {
-    /// The next sample and the file line it came from (0 when it has no line of its own), or
-    /// None at the end.
-    fn next_sample(&mut self) -> Result<Option<(ImuSample, usize)>>;
-    /// Fraction of the input read so far (for progress; 0 when unknown).
-    fn fraction(&self) -> f64;
-}
 
 /// Samples already in memory (formats read whole, tests, simulated data).
 struct MemorySource {
@@ -454,6 +441,46 @@ fn at(name: &str, line: usize, index: usize) -> String {
     } else {
         format!("{name}: sample {index}")
     }
+}
+
+/// Reading whole files through the validated stream: each reader hands out a source, the
+/// stream checks every sample.
+impl crate::io::imu_format::ImuFormat {
+    /// Reads a data file described by this format into FRD increments; errors name the data
+    /// file and line (or the description's line for a column name it lacks).
+    pub fn read(&self, path: &Path) -> Result<ImuData> {
+        self.stream(path)?.collect()
+    }
+
+    /// A stream of the validated samples of a data file described by this format.
+    pub fn stream(&self, path: &Path) -> Result<ImuStream> {
+        ImuStream::with_hint(
+            self.source(path)?,
+            &path.display().to_string(),
+            &format!("[time] unit in {}", self.origin),
+        )
+    }
+}
+
+/// Reads the text IMU format; any malformed row, NaN, non-increasing time, implausible rate or
+/// force, or gap longer than 5 intervals is an error naming the file and line.
+pub fn read_text(path: &Path) -> Result<ImuData> {
+    ImuStream::text(path)?.collect()
+}
+
+/// Reads a PSINS `.imu` file whole (header and validated samples).
+pub fn read_psins(path: &Path) -> Result<crate::io::readers::psins::PsinsLog> {
+    let (mut log, src) = crate::io::readers::psins::open(path)?;
+    log.imu = ImuStream::new(Box::new(src), &path.display().to_string())?.collect()?;
+    Ok(log)
+}
+
+/// Reads an IMU file as `format` describes it (`--imu-format`), else as the description beside
+/// it (`FILE.format.toml`), else by extension; also returns the words saying which was used.
+/// Every sample is validated ([`crate::io::imu_stream::ImuStream`]).
+pub fn read_imu(path: &Path, format: Option<&Path>) -> Result<(ImuData, String)> {
+    let (stream, how) = ImuStream::open(path, format)?;
+    Ok((stream.collect()?, how))
 }
 
 #[cfg(test)]

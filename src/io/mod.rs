@@ -10,5 +10,7 @@ pub mod imu_format;
 pub mod imu_stream;
 pub mod lines;
 pub mod readers;
+pub mod sample_source;
 pub mod truth;
+pub mod truth_row;
 pub mod units;

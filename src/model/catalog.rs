@@ -86,9 +86,9 @@ impl TermInfo {
             let k = 1.0 / self.display_to_si;
             format!(
                 "{} {} is beyond the {} {} the term can physically have (its `limit` in model-spec/terms.toml): a larger unit written where {} was meant?",
-                crate::explain::sig3(value * k),
+                crate::io::units::sig3(value * k),
                 self.display,
-                crate::explain::sig3(self.limit * k),
+                crate::io::units::sig3(self.limit * k),
                 self.display,
                 self.display
             )

@@ -7,7 +7,7 @@
 //! z = −PSINS Z; attitude roll and pitch kept, yaw = −yaw_PSINS; velocity ENU → NED.
 
 use crate::io::imu::{ImuData, ImuSample};
-use crate::io::truth::TruthRow;
+use crate::io::truth_row::TruthRow;
 use anyhow::{bail, Result};
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};

@@ -8,8 +8,8 @@
 //! velocity ENU → NED.
 
 use crate::io::imu::{parse_numbers, parse_numbers_into, ImuData, ImuSample};
-use crate::io::imu_stream::{ImuStream, SampleSource};
 use crate::io::lines::Lines;
+use crate::io::sample_source::SampleSource;
 use anyhow::{bail, Result};
 use nalgebra::Vector3;
 use std::path::Path;
@@ -167,11 +167,4 @@ pub fn open(path: &Path) -> Result<(PsinsLog, PsinsSource)> {
             n: 0,
         },
     ))
-}
-
-/// Reads a PSINS `.imu` file whole.
-pub fn read(path: &Path) -> Result<PsinsLog> {
-    let (mut log, src) = open(path)?;
-    log.imu = ImuStream::new(Box::new(src), &path.display().to_string())?.collect()?;
-    Ok(log)
 }
