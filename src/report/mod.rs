@@ -1,6 +1,7 @@
 //! Reports: explain's words and Markdown, PNG plots and progress bars (the last two with the
 //! `cli` feature). Rendering only; the experiments are in `experiment`.
 
+pub mod allan;
 pub mod explain;
 #[cfg(feature = "cli")]
 pub mod plot;
