@@ -4,6 +4,9 @@
 pub mod allan;
 pub mod explain;
 #[cfg(feature = "cli")]
+pub mod explain_files;
+pub mod explain_notes;
+#[cfg(feature = "cli")]
 pub mod plot;
 #[cfg(feature = "cli")]
 pub mod progress;
