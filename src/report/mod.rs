@@ -6,7 +6,9 @@ pub mod explain;
 #[cfg(feature = "cli")]
 pub mod explain_files;
 pub mod explain_notes;
+pub mod filter;
 #[cfg(feature = "cli")]
 pub mod plot;
 #[cfg(feature = "cli")]
 pub mod progress;
+pub mod reproduce;
