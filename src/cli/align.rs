@@ -4,6 +4,7 @@ use anyhow::Result;
 use clap::Args;
 use sinsmodel::estimate::align;
 use sinsmodel::io::atomic_file::{self, Provenance};
+use sinsmodel::report::align as report;
 use std::path::PathBuf;
 
 /// Arguments of `align`.
@@ -37,6 +38,36 @@ pub struct AlignArgs {
 
 /// Runs the command.
 pub fn run(args: &AlignArgs) -> Result<()> {
+    check_args(args)?;
+    if let Some(j) = &args.json {
+        args.src
+            .check_output("--json", j, Provenance::Json("align"), args.force)?;
+    }
+    let data = args.src.read(&mut super::data::note)?;
+    let d = std::f64::consts::PI / 180.0;
+    let a = align::align(
+        &data,
+        args.lat.map(|l| l * d),
+        args.seconds,
+        args.lon * d,
+        args.h,
+        args.gyro_bias_sigma * d / 3600.0,
+    )?;
+    for line in report::lines(&a, args.lat.is_some()) {
+        println!("{line}");
+    }
+    if let Some(j) = &args.json {
+        atomic_file::write_text(
+            j,
+            &atomic_file::with_written_by(&serde_json::to_string_pretty(&a)?, "align"),
+        )?;
+        eprintln!("wrote {}", j.display());
+    }
+    Ok(())
+}
+
+/// Refuses a latitude, longitude, height, gyro-bias σ or length out of range.
+fn check_args(args: &AlignArgs) -> Result<()> {
     if let Some(l) = args.lat {
         if !(l.is_finite() && (-89.0..=89.0).contains(&l)) {
             anyhow::bail!("--lat {l} must be within ±89°");
@@ -62,75 +93,6 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         if !(s.is_finite() && s > 0.0) {
             anyhow::bail!("--seconds {s}: expected a positive number of seconds");
         }
-    }
-    if let Some(j) = &args.json {
-        args.src
-            .check_output("--json", j, Provenance::Json("align"), args.force)?;
-    }
-    let data = args.src.read(&mut super::data::note)?;
-    let d = std::f64::consts::PI / 180.0;
-    let a = align::align(
-        &data,
-        args.lat.map(|l| l * d),
-        args.seconds,
-        args.lon * d,
-        args.h,
-        args.gyro_bias_sigma * d / 3600.0,
-    )?;
-    println!(
-        "at rest from {:.0} s after the start (the longest stretch judged at rest)",
-        a.skipped_s
-    );
-    match (a.heading_deg, a.heading_sigma_deg) {
-        (Some(hd), Some(hs)) => println!(
-            "roll {:.4} deg  pitch {:.4} deg  heading {hd:.3} deg (1-sigma {hs:.3} deg)",
-            a.roll_deg, a.pitch_deg
-        ),
-        _ => println!(
-            "roll {:.4} deg  pitch {:.4} deg  heading: not determined (see below)",
-            a.roll_deg, a.pitch_deg
-        ),
-    }
-    if let Some(n) = &a.heading_note {
-        println!("{n}");
-    }
-    match (args.lat, a.lat_deg) {
-        (Some(_), Some(l)) => println!("latitude {l:.4} deg (given)"),
-        (_, None) => println!(
-            "latitude: not determined (it comes from the Earth rate's direction, which the gyro bias hides); pass --lat"
-        ),
-        (None, Some(l)) if a.lat_sigma_deg.is_some_and(|s| s > 0.0) => println!(
-            "latitude {l:.4} deg (estimated from the Earth-rate and gravity directions, 1-sigma {:.4} deg)",
-            a.lat_sigma_deg.unwrap_or_default()
-        ),
-        (None, Some(l)) => println!(
-            "latitude {l:.4} deg (estimated from one window only: no spread to give a sigma; pass --lat if known)"
-        ),
-    }
-    if a.heading_deg.is_none() {
-        // no coarse heading either: the same gyros
-    } else if a.heading_windows_deg.is_empty() {
-        println!("coarse heading: no complete one-minute window in the static data");
-    } else {
-        let (lo, hi) = a
-            .heading_windows_deg
-            .iter()
-            .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-        println!(
-            "coarse heading over {} one-minute windows: {lo:.3} .. {hi:.3} deg",
-            a.heading_windows_deg.len()
-        );
-    }
-    println!(
-        "gyro bias estimates [deg/h]: {:.4} {:.4} {:.4}",
-        a.gyro_bias_deg_h[0], a.gyro_bias_deg_h[1], a.gyro_bias_deg_h[2]
-    );
-    if let Some(j) = &args.json {
-        atomic_file::write_text(
-            j,
-            &atomic_file::with_written_by(&serde_json::to_string_pretty(&a)?, "align"),
-        )?;
-        eprintln!("wrote {}", j.display());
     }
     Ok(())
 }

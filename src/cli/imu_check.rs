@@ -5,6 +5,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 use sinsmodel::estimate::imu_check;
 use sinsmodel::io::atomic_file::{self, Provenance};
+use sinsmodel::report::imu_check as report;
 use std::path::PathBuf;
 
 /// Arguments of `imu-check`.
@@ -35,17 +36,7 @@ pub struct ImuCheckArgs {
 
 /// Runs the command.
 pub fn run(args: &ImuCheckArgs) -> Result<()> {
-    if let Some(l) = args.lat {
-        if !(l.is_finite() && l.abs() < 90.0) {
-            bail!("--lat {l}: expected a latitude in degrees within (-90, 90)");
-        }
-    }
-    if !(args.skip.is_finite() && args.skip >= 0.0) {
-        bail!("--skip {}: expected seconds >= 0", args.skip);
-    }
-    if !(args.seconds.is_finite() && args.seconds > 0.0) {
-        bail!("--seconds {}: expected seconds > 0", args.seconds);
-    }
+    check_args(args)?;
     if let Some(j) = &args.json {
         args.src
             .check_output("--json", j, Provenance::Json("imu-check"), args.force)?;
@@ -58,57 +49,8 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
         args.seconds,
         args.tilted,
     );
-    println!(
-        "{} samples over {:.3} s: {:.3} Hz (median interval {:.6} s; shortest {:.6} s, longest {:.6} s; jitter RMS {:.2e} s; {} gaps)",
-        c.samples,
-        c.duration_s,
-        c.rate_hz,
-        1.0 / c.rate_hz,
-        c.interval_min_s,
-        c.interval_max_s,
-        c.jitter_rms_s,
-        c.gaps
-    );
-    if c.f_spread_mps2.is_finite() {
-        println!(
-            "window {:.3}–{:.3} s: specific force FRD ({:.4}, {:.4}, {:.4}) m/s² (spread {:.3} m/s² RMS{}), |f| = {}× local gravity {:.4} m/s²",
-            c.window_s[0],
-            c.window_s[1],
-            c.f_mean_mps2[0],
-            c.f_mean_mps2[1],
-            c.f_mean_mps2[2],
-            c.f_spread_mps2,
-            if c.is_static { ", static" } else { ", moving" },
-            sinsmodel::explain::sig3(c.gravity_ratio),
-            c.gravity_mps2
-        );
-        let d = 180.0 / std::f64::consts::PI;
-        println!(
-            "angular rate FRD ({:.3e}, {:.3e}, {:.3e}) deg/h, |ω| = {}× Earth rate",
-            c.w_mean_radps[0] * d * 3600.0,
-            c.w_mean_radps[1] * d * 3600.0,
-            c.w_mean_radps[2] * d * 3600.0,
-            sinsmodel::explain::sig3(c.earth_rate_ratio)
-        );
-    } else {
-        println!(
-            "window {:.3}–{:.3} s: no samples in it",
-            c.window_s[0], c.window_s[1]
-        );
-    }
-    if c.is_static {
-        println!(
-            "static attitude: roll {:.3}°, pitch {:.3}°, heading {}",
-            c.roll_deg,
-            c.pitch_deg,
-            match c.heading_deg {
-                Some(h) => format!("{h:.1}° (gyrocompass, coarse)"),
-                None => "not resolved by these gyros".into(),
-            }
-        );
-    }
-    for n in &c.notes {
-        println!("note: {n}");
+    for line in report::lines(&c) {
+        println!("{line}");
     }
     if let Some(j) = &args.json {
         atomic_file::write_text(
@@ -124,20 +66,22 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
             c.problems.join("\n  - ")
         );
     }
-    if c.is_static {
-        println!(
-            "plausible: gravity and attitude as expected for a static IMU with these units and axes; {}",
-            if (0.5..2.0).contains(&c.earth_rate_ratio) {
-                "Earth rate as expected".to_string()
-            } else {
-                format!(
-                    "Earth rate not resolved (the gyro bias makes |ω| {}× Earth rate: gyro units checked only for gross errors)",
-                    sinsmodel::explain::sig3(c.earth_rate_ratio)
-                )
-            }
-        );
-    } else {
-        println!("sampling read; units and axes not checked (no static stretch in the window)");
+    println!("{}", report::verdict(&c));
+    Ok(())
+}
+
+/// Refuses a latitude, skip or window length out of range.
+fn check_args(args: &ImuCheckArgs) -> Result<()> {
+    if let Some(l) = args.lat {
+        if !(l.is_finite() && l.abs() < 90.0) {
+            bail!("--lat {l}: expected a latitude in degrees within (-90, 90)");
+        }
+    }
+    if !(args.skip.is_finite() && args.skip >= 0.0) {
+        bail!("--skip {}: expected seconds >= 0", args.skip);
+    }
+    if !(args.seconds.is_finite() && args.seconds > 0.0) {
+        bail!("--seconds {}: expected seconds > 0", args.seconds);
     }
     Ok(())
 }

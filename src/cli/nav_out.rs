@@ -10,6 +10,8 @@ use sinsmodel::nav::earth;
 use sinsmodel::nav::strapdown::NavState;
 use std::io::Write;
 
+pub use sinsmodel::nav::free_inertial::RowClock;
+
 /// Most points kept per plotted curve (older points thinned as the run grows).
 const PLOT_POINTS: usize = 4000;
 
@@ -37,57 +39,6 @@ impl Thinned {
             }
         }
         self.seen += 1;
-    }
-}
-
-/// When output rows are due at a rate, on the samples' own times (so a jittered clock keeps the
-/// rate): a row at the first sample at or after each multiple of the period from `t0`, within
-/// half a sample interval.
-pub struct RowClock {
-    t0: f64,
-    period: f64,
-    n: u64,
-    tol: f64,
-}
-
-impl RowClock {
-    /// Rows at `rate_hz` from `t0` [s]; every sample when `rate_hz` is None; `interval` [s] is
-    /// the median sample interval.
-    pub fn new(t0: f64, rate_hz: Option<f64>, interval: f64) -> RowClock {
-        RowClock {
-            t0,
-            period: rate_hz.map(|r| 1.0 / r).unwrap_or(0.0),
-            n: 1,
-            tol: 0.5 * interval,
-        }
-    }
-
-    /// Whether the sample at `t` [s] gets a row.
-    pub fn due(&mut self, t: f64) -> bool {
-        if self.period == 0.0 {
-            return true;
-        }
-        // a relative 1e-9 so that a sample exactly at a threshold counts on either rounding
-        let eps = 1e-9 * t.abs().max(1.0);
-        if t + eps < self.t0 + self.n as f64 * self.period - self.tol {
-            return false;
-        }
-        while self.t0 + self.n as f64 * self.period - self.tol <= t + eps {
-            self.n += 1;
-        }
-        true
-    }
-
-    /// The row spacing in words, for file headers.
-    pub fn words(&self) -> String {
-        if self.period == 0.0 {
-            "a row at every IMU sample".to_string()
-        } else {
-            format!(
-                "a row every {} s (at the first IMU sample at or after each)",
-                self.period
-            )
-        }
     }
 }
 

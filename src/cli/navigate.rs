@@ -2,11 +2,11 @@
 
 use anyhow::{bail, Result};
 use clap::Args;
-use nalgebra::{Rotation3, UnitQuaternion, Vector3};
-use sinsmodel::io::truth;
-use sinsmodel::io::truth::TruthRow;
-use sinsmodel::nav::attitude::dcm_from_euler;
-use sinsmodel::nav::strapdown::{NavState, Navigator, Vertical};
+use sinsmodel::io::imu::ImuData;
+use sinsmodel::io::imu_stream::ImuStream;
+use sinsmodel::io::truth::{self, TruthRow};
+use sinsmodel::nav::free_inertial::{self, RowClock};
+use sinsmodel::nav::strapdown::{NavState, Vertical};
 use sinsmodel::report::progress;
 use std::path::PathBuf;
 
@@ -56,6 +56,68 @@ pub struct NavigateArgs {
 
 /// Runs the command.
 pub fn run(args: &NavigateArgs) -> Result<()> {
+    check_args(args)?;
+    let check_out = || {
+        args.src.check_output(
+            "--out",
+            &args.out,
+            sinsmodel::io::atomic_file::Provenance::Text("navigate"),
+            args.force,
+        )
+    };
+    check_out()?;
+    // streamed: memory does not grow with the file; the output is written as it goes and
+    // appears only when complete
+    let mut data = args.src.open(&mut super::data::note)?;
+    if args.in_memory {
+        data = data.into_memory()?;
+    }
+    check_start(args, &data)?;
+    let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
+    let att = [args.att[0], args.att[1], args.att[2]];
+    let t0 = data.start_time();
+    let start = free_inertial::start_state(t0, args.lat, args.lon, args.h, att, [v[0], v[1], v[2]]);
+    let mut clock = RowClock::new(t0, Some(args.out_rate), data.interval());
+    let row = |s: &NavState| TruthRow {
+        t: s.t,
+        lat: s.lat,
+        lon: s.lon,
+        h: s.h,
+        v: s.v,
+        euler: s.euler(),
+    };
+    let mut out = truth::create(
+        &args.out,
+        &format!(
+            "{} (vertical {})",
+            super::command_line(),
+            args.vertical.word()
+        ),
+    )?;
+    let mut rows = 0u64;
+    let pb = progress::bar(1000, "navigate");
+    let end = free_inertial::run(
+        &mut data,
+        start,
+        args.vertical,
+        &mut clock,
+        &args.src.imu.display().to_string(),
+        &mut |s| {
+            rows += 1;
+            Ok(truth::write_row(out.writer(), &row(s))?)
+        },
+        &mut |f| pb.set_position((f * 1000.0) as u64),
+    )?;
+    pb.finish_and_clear();
+    // checked again: the file may have been replaced while the run worked
+    check_out()?;
+    out.commit()?;
+    print_summary(args, &data, rows, &start, &end);
+    Ok(())
+}
+
+/// Refuses a latitude, attitude, velocity, longitude, height or output rate out of range.
+fn check_args(args: &NavigateArgs) -> Result<()> {
     if args.lat.abs() >= 89.0 || !args.lat.is_finite() {
         bail!("--lat {} must be within ±89°", args.lat);
     }
@@ -87,44 +149,22 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             args.out_rate
         );
     }
-    let check_out = || {
-        args.src.check_output(
-            "--out",
-            &args.out,
-            sinsmodel::io::atomic_file::Provenance::Text("navigate"),
-            args.force,
-        )
-    };
-    check_out()?;
-    // streamed: memory does not grow with the file; the output is written as it goes and
-    // appears only when complete
-    let mut data = args.src.open(&mut super::data::note)?;
-    if args.in_memory {
-        data = data.into_memory()?;
-    }
-    // the same plausibility imu-check applies, on the first 10 s: warn, do not stop (a start
-    // that moves or a tilted mounting are legitimate here)
-    let head = sinsmodel::io::imu::ImuData {
+    Ok(())
+}
+
+/// The plausibility imu-check applies, on the first 10 s: warns (a start that moves or a tilted
+/// mounting are legitimate here); a unit, scale or clock slip, or an --att that contradicts the
+/// measured gravity, stops the run unless --force.
+fn check_start(args: &NavigateArgs, data: &ImuStream) -> Result<()> {
+    let head = ImuData {
         samples: data.head().to_vec(),
     };
-    let check =
-        sinsmodel::estimate::imu_check::check(&head, Some(args.lat.to_radians()), 0.0, 10.0, true);
-    for p in check
-        .problems
-        .iter()
-        .filter(|p| !check.unit_problems.contains(p))
-        .map(|p| {
-            if check.gyro_unit_problems.contains(p) {
-                format!("{p} (or an uncalibrated MEMS gyro's bias)")
-            } else {
-                p.clone()
-            }
-        })
-    {
+    let check = sinsmodel::estimate::imu_check::start_check(&head, args.lat.to_radians());
+    for p in &check.warnings {
         eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
     }
     // a unit, scale or clock slip is refused: navigating on it gives hours of nonsense
-    if let Some(p) = check.unit_problems.first() {
+    if let Some(p) = &check.unit_problem {
         if args.force {
             eprintln!("warning: {p} (--force given)");
         } else {
@@ -143,77 +183,11 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             bail!("--att: {p}");
         }
     }
-    drop(head);
-    let c = dcm_from_euler(args.att[0] * d, args.att[1] * d, args.att[2] * d);
-    let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
-    let t0 = data.start_time();
-    let start = NavState {
-        t: t0,
-        lat: args.lat * d,
-        lon: args.lon * d,
-        h: args.h,
-        v: Vector3::new(v[0], v[1], v[2]),
-        q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
-    };
-    let mut nav = Navigator::new(start, args.vertical);
-    let mut clock = super::nav_out::RowClock::new(t0, Some(args.out_rate), data.interval());
-    let row = |s: &NavState| TruthRow {
-        t: s.t,
-        lat: s.lat,
-        lon: s.lon,
-        h: s.h,
-        v: s.v,
-        euler: s.euler(),
-    };
-    let mut out = truth::create(
-        &args.out,
-        &format!(
-            "{} (vertical {})",
-            super::command_line(),
-            args.vertical.word()
-        ),
-    )?;
-    truth::write_row(out.writer(), &row(&nav.state))?;
-    let mut rows = 1u64;
-    let pb = progress::bar(1000, "navigate");
-    let mut prev_t = t0;
-    while let Some(s) = data.next()? {
-        if s.t <= t0 {
-            // a jittered clock starts at its first sample (`ImuStream::start_time`)
-            continue;
-        }
-        let k = data.count() - 1;
-        nav.step(&s.dtheta, &s.dv, s.t - prev_t);
-        nav.state.t = s.t;
-        let st = &nav.state;
-        if ![st.lat, st.lon, st.h, st.v.x, st.v.y, st.v.z, st.q.w, st.q.i]
-            .iter()
-            .all(|v| v.is_finite())
-            || st.h.abs() > 1e7
-            || st.lat.abs() >= 89.9f64.to_radians()
-            || st.v.norm() > 1e4
-        {
-            bail!(
-                "{}: the navigation diverged at t = {:.3} s (sample {}): a non-finite state, a pole (the NED frame is undefined there) or a speed over 1e4 m/s; the increments are not physical there \
-                 (check the IMU values, units and clock; `sinsmodel imu-check` shows what was read)",
-                args.src.imu.display(),
-                s.t,
-                k + 1
-            );
-        }
-        prev_t = s.t;
-        if clock.due(s.t) {
-            truth::write_row(out.writer(), &row(&nav.state))?;
-            rows += 1;
-        }
-        if k % 100_000 == 0 {
-            pb.set_position((data.fraction() * 1000.0) as u64);
-        }
-    }
-    pb.finish_and_clear();
-    // checked again: the file may have been replaced while the run worked
-    check_out()?;
-    out.commit()?;
+    Ok(())
+}
+
+/// Prints what was navigated and written, and how far the end is from the start.
+fn print_summary(args: &NavigateArgs, data: &ImuStream, rows: u64, s0: &NavState, s1: &NavState) {
     eprintln!(
         "navigated {} samples ({:.1} s), wrote {} rows to {}",
         data.count(),
@@ -221,10 +195,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         rows,
         args.out.display()
     );
-    let (s0, s1) = (&start, &nav.state);
-    let r = sinsmodel::nav::earth::A;
-    let dn = (s1.lat - s0.lat) * r;
-    let de = (s1.lon - s0.lon) * r * s0.lat.cos();
+    let [dn, de] = free_inertial::displacement_ne(s0, s1);
     eprintln!(
         "final position {:.3} km from the start ({:.3} km north, {:.3} km east): free-inertial \
          navigation, no aiding; its drift grows with the initial attitude and sensor errors (use \
@@ -233,5 +204,4 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
         dn / 1000.0,
         de / 1000.0
     );
-    Ok(())
 }

@@ -8,7 +8,9 @@
 //! small so the second differences keep full precision).
 //! The 1-σ uncertainty reported is σ/√(N + 1 − 2m) (as allantools' error estimate).
 
+use crate::io::imu::ImuData;
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// Allan deviation of one channel.
 #[derive(Debug, Clone, Serialize)]
@@ -192,6 +194,136 @@ pub fn fit(c: &AllanCurve) -> NoiseFit {
         bias_instability_upper_bound: last.is_none_or(|l| l == kmin),
         tau_supported_s: tau_ok,
     }
+}
+
+/// Names of the six channels, gyros then accelerometers (FRD body).
+pub const CHANNELS: [&str; 6] = [
+    "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+];
+
+/// Above this RMS clock jitter (a fraction of the interval) the increments are resampled to a
+/// uniform grid before the Allan deviation.
+pub const RESAMPLE_JITTER: f64 = 1e-6;
+
+/// The samples from `skip_s` [s] after the first sample, for at most `seconds` [s] (to the end
+/// when None).
+pub fn span(data: &ImuData, skip_s: f64, seconds: Option<f64>) -> ImuData {
+    let t0 = data.samples[0].t + skip_s;
+    let t1 = seconds.map(|s| t0 + s).unwrap_or(f64::INFINITY);
+    ImuData {
+        samples: data
+            .samples
+            .iter()
+            .filter(|s| s.t >= t0 && s.t < t1)
+            .copied()
+            .collect(),
+    }
+}
+
+/// What a span says before its Allan deviation: how many of its ten-second windows move, and
+/// how much its clock jitters.
+#[derive(Debug, Clone, Copy)]
+pub struct SpanCheck {
+    /// Whole ten-second windows of the span.
+    pub windows: usize,
+    /// Those not at rest (by the absolute tests of `align`).
+    pub moving: usize,
+    /// RMS clock jitter as a fraction of the interval (1 = 100 %).
+    pub jitter: f64,
+}
+
+impl SpanCheck {
+    /// True when the increments are resampled to a uniform grid (the clock jitters).
+    pub fn resamples(&self) -> bool {
+        self.jitter > RESAMPLE_JITTER
+    }
+}
+
+/// Checks `span` for motion (ten-second windows) and clock jitter, `dt` [s] being the interval
+/// of the whole data.
+pub fn check_span(span: &ImuData, dt: f64) -> SpanCheck {
+    // Allan deviation describes a sensor at rest (10-s windows by the absolute tests of `align`)
+    let win = ((10.0 / dt).round() as usize).max(2);
+    let g = span.mean_rates().0.norm();
+    let evidence = crate::estimate::align::rest_evidence(span, win, g);
+    SpanCheck {
+        windows: evidence.len(),
+        moving: evidence.iter().filter(|e| !e.at_rest()).count(),
+        jitter: span.jitter_rms() / dt,
+    }
+}
+
+/// The Allan deviation of the six channels of `span` (rates over the interval `dt` [s]). A
+/// jittered clock (`resample`): each increment keeps its own interval (cumulative integral
+/// resampled to a uniform grid); dividing by one interval would turn the jitter times the mean
+/// (gravity on an accelerometer) into noise.
+pub fn six_channels(span: &ImuData, dt: f64, resample: bool) -> Vec<AllanCurve> {
+    let samples = &span.samples;
+    let times: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    let channel = |c: usize| -> Vec<f64> {
+        samples
+            .iter()
+            .map(|s| if c < 3 { s.dtheta[c] } else { s.dv[c - 3] })
+            .collect()
+    };
+    (0..6)
+        .map(|c| {
+            let inc = channel(c);
+            if resample {
+                let (y, t) = uniform_rates(&times, &inc);
+                oadev(&y, t)
+            } else {
+                let y: Vec<f64> = inc.iter().map(|v| v / dt).collect();
+                oadev(&y, dt)
+            }
+        })
+        .collect()
+}
+
+/// The curves, their uncertainties, the noise fits and units of the six channels, as `allan
+/// --json` writes them.
+#[derive(Debug, Serialize)]
+pub struct AllanReport {
+    /// Sample rate [Hz].
+    pub rate_hz: f64,
+    /// Averaging times τ [s] (the same for every channel).
+    pub tau_s: Vec<f64>,
+    /// Allan deviation per channel (unit of the rate).
+    pub adev: BTreeMap<String, Vec<f64>>,
+    /// 1-σ uncertainty of each value, per channel.
+    pub adev_err: BTreeMap<String, Vec<f64>>,
+    /// Noise fit per channel.
+    pub fit: BTreeMap<String, NoiseFit>,
+    /// Units of each channel's values and fit.
+    pub units: BTreeMap<String, &'static str>,
+}
+
+/// The report of the six channels' `curves` (in [`CHANNELS`] order) at the interval `dt` [s],
+/// with the noise fitted to each.
+pub fn report(curves: &[AllanCurve], dt: f64) -> AllanReport {
+    let mut out = AllanReport {
+        rate_hz: 1.0 / dt,
+        tau_s: curves[0].tau_s.clone(),
+        adev: BTreeMap::new(),
+        adev_err: BTreeMap::new(),
+        fit: BTreeMap::new(),
+        units: BTreeMap::new(),
+    };
+    for (k, c) in curves.iter().enumerate() {
+        let name = CHANNELS[k];
+        out.adev.insert(name.into(), c.adev.clone());
+        out.adev_err.insert(name.into(), c.adev_err.clone());
+        out.fit.insert(name.into(), fit(c));
+        out.units.insert(
+            name.into(),
+            if k < 3 {
+                "rad/s (fit: white rad/sqrt(s), random_walk rad/s/sqrt(s))"
+            } else {
+                "m/s^2 (fit: white m/s/sqrt(s), random_walk m/s^2/sqrt(s))"
+            },
+        );
+    }
+    out
 }
 
 #[cfg(test)]

@@ -364,6 +364,39 @@ impl Said {
     }
 }
 
+/// What the first seconds of a log say before free-inertial navigation (`navigate`): warnings,
+/// and the unit, scale or clock slip that stops it.
+#[derive(Debug, Clone, Default)]
+pub struct StartCheck {
+    /// The problems that are only warnings here (a start that moves or a tilted mounting are
+    /// legitimate), a gyro unit problem with the MEMS-bias alternative said.
+    pub warnings: Vec<String>,
+    /// The first problem only a unit, scale or clock slip explains.
+    pub unit_problem: Option<String>,
+}
+
+/// Checks the first 10 s `head` as `imu-check` does (a tilted mounting accepted), `lat` [rad]
+/// giving local gravity.
+pub fn start_check(head: &ImuData, lat: f64) -> StartCheck {
+    let check = check(head, Some(lat), 0.0, 10.0, true);
+    let warnings = check
+        .problems
+        .iter()
+        .filter(|p| !check.unit_problems.contains(p))
+        .map(|p| {
+            if check.gyro_unit_problems.contains(p) {
+                format!("{p} (or an uncalibrated MEMS gyro's bias)")
+            } else {
+                p.clone()
+            }
+        })
+        .collect();
+    StartCheck {
+        warnings,
+        unit_problem: check.unit_problems.first().cloned(),
+    }
+}
+
 /// The likely slip behind a specific force `k` times too small (`k` = gravity / |f|), when it
 /// is one of the usual factors.
 fn unit_hint(k: f64) -> String {

@@ -2,6 +2,8 @@
 //! end to end (`hidden`) and explain's evaluation campaign (`explain_eval`). They use the
 //! estimators; the estimators never use them.
 
+pub mod bench;
+pub mod explain_data;
 pub mod explain_eval;
 pub mod hidden;
 pub mod reproduce;

@@ -3,5 +3,6 @@
 
 pub mod attitude;
 pub mod earth;
+pub mod free_inertial;
 pub mod nav_point;
 pub mod strapdown;

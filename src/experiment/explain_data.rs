@@ -1,0 +1,66 @@
+//! `explain` on the data the options name, as the command line runs it: the candidates a run
+//! without GNSS can test, explain's options from the data options (candidate priors, noise
+//! levels), the data of its passes (the IMU read again from the file on every pass) and the
+//! filter set-up of every model it tries.
+
+use crate::data::{DataOptions, PassInputs};
+use crate::estimate::filter::FilterConfig;
+use crate::explain::{ExplainData, ExplainOptions, FileIdentity, ImuInput};
+use crate::model::catalog::Sensor;
+use crate::model::generated::common;
+use crate::model::Model;
+use anyhow::Result;
+
+/// The names of the GNSS terms (entering the fixes of a GNSS receiver) among `cands`.
+pub fn gnss_terms(cands: &[usize]) -> Vec<&'static str> {
+    cands
+        .iter()
+        .filter(|&&t| common::TERMS[t].sensor == Sensor::Gnss)
+        .map(|&t| common::TERMS[t].name)
+        .collect()
+}
+
+/// Drops the GNSS terms from `cands` (a static aid or ZUPTs have no antenna and no receiver
+/// clock).
+pub fn drop_gnss(cands: &mut Vec<usize>) {
+    cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
+}
+
+/// `base` with the data options' candidate priors (`--prior`), testing noise levels only with
+/// GNSS aiding (a static aid's or a ZUPT's σ is a tuning choice, not a receiver's).
+pub fn options(data: &DataOptions, base: &ExplainOptions) -> Result<ExplainOptions> {
+    let mut opts = base.clone();
+    opts.candidate_sigma = data.term_priors()?;
+    opts.noise_levels = data.has_gnss();
+    Ok(opts)
+}
+
+/// The data of explain's passes over `inputs`: the IMU file read again on every pass (from just
+/// after the start), checked to be the file it was when the run began.
+pub fn explain_data(inputs: &PassInputs) -> Result<ExplainData<'_>> {
+    Ok(ExplainData {
+        imu: ImuInput::File {
+            path: &inputs.imu,
+            format: inputs.imu_format.as_deref(),
+            clock_offset: inputs.clock_offset,
+            skip_through: inputs.start.t + 1e-9,
+            identity: Some(FileIdentity::of(&inputs.imu)?),
+        },
+        aid: &inputs.aid,
+        truth: inputs.truth.as_deref(),
+        start: inputs.start,
+    })
+}
+
+/// The filter set-up of a model explain tries: the data options' configuration (priors of other
+/// models' terms passed over), with what opening the data found (`--init auto`'s σ, the step).
+pub fn config_for<'a>(
+    data: &'a DataOptions,
+    inputs: &'a PassInputs,
+) -> impl Fn(&Model) -> Result<FilterConfig> + 'a {
+    move |m: &Model| {
+        let mut c = data.config(m, true)?;
+        crate::data::apply_opened(&mut c, m, inputs.init_sigma, inputs.step_s);
+        Ok(c)
+    }
+}
