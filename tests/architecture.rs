@@ -136,3 +136,157 @@ fn the_io_files_form_no_import_cycle() {
         panic!("import cycle in src/io: {}", c.join(" → "));
     }
 }
+
+#[test]
+fn the_command_line_files_stay_thin() {
+    let cli = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/cli");
+    let files = rust_files(&cli);
+    assert!(files.len() >= 10, "cli files found: {files:?}");
+    let fat: Vec<String> = files
+        .iter()
+        .filter_map(|f| {
+            let n = std::fs::read_to_string(f).unwrap().lines().count();
+            (n > 400).then(|| format!("{} ({n} lines)", f.display()))
+        })
+        .collect();
+    assert!(fat.is_empty(), "src/cli is argument handling and printing only; move computation into the library: {fat:?}");
+}
+
+/// The length in lines of each function in `text` (before any `#[cfg(test)]`), with its name
+/// and first line, found by matching braces outside strings, characters and comments.
+fn function_lengths(text: &str) -> Vec<(usize, usize, String)> {
+    let lines: Vec<&str> = text
+        .split("#[cfg(test)]")
+        .next()
+        .unwrap_or("")
+        .lines()
+        .collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < lines.len() {
+        let Some(name) = fn_name(lines[i]) else {
+            i += 1;
+            continue;
+        };
+        let (mut depth, mut started, mut j) = (0i64, false, i);
+        while j < lines.len() {
+            let code = strip_literals(lines[j]);
+            for ch in code.chars() {
+                match ch {
+                    '{' => {
+                        depth += 1;
+                        started = true;
+                    }
+                    '}' => depth -= 1,
+                    _ => {}
+                }
+            }
+            if (started && depth == 0) || (!started && code.trim_end().ends_with(';')) {
+                break;
+            }
+            j += 1;
+        }
+        if started {
+            out.push((j - i + 1, i + 1, name));
+            i = j + 1;
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// The name of the function a line opens (`fn NAME`, with any `pub`, `const`, `unsafe`), if any.
+fn fn_name(line: &str) -> Option<String> {
+    let mut words = line.split_whitespace().peekable();
+    while let Some(w) = words.next() {
+        if w == "fn" {
+            let name: String = words
+                .next()?
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            return (!name.is_empty()).then_some(name);
+        }
+        let qualifier = w.starts_with("pub") || matches!(w, "const" | "async" | "unsafe");
+        if !qualifier {
+            return None;
+        }
+    }
+    None
+}
+
+/// A line with string and character literals emptied and any `//` comment removed.
+fn strip_literals(line: &str) -> String {
+    let mut out = String::new();
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => {
+                while let Some(d) = chars.next() {
+                    if d == '\\' {
+                        chars.next();
+                    } else if d == '"' {
+                        break;
+                    }
+                }
+            }
+            '\'' => {
+                // a char literal ('x', '\n', '{'), not a lifetime ('a)
+                let rest: String = chars.clone().take(3).collect();
+                let mut r = rest.chars();
+                match (r.next(), r.next(), r.next()) {
+                    (Some('\\'), _, _) => {
+                        chars.next();
+                        chars.next();
+                        for d in chars.by_ref() {
+                            if d == '\'' {
+                                break;
+                            }
+                        }
+                    }
+                    (Some(_), Some('\''), _) => {
+                        chars.next();
+                        chars.next();
+                    }
+                    _ => {}
+                }
+            }
+            '/' if chars.peek() == Some(&'/') => break,
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+#[test]
+fn the_function_length_check_measures_what_it_says() {
+    let text = "pub fn a() {\n    let s = \"{\";\n    let c = '}';\n}\nfn b<'x>(v: &'x str) {\n    // {\n}\n";
+    let got = function_lengths(text);
+    assert_eq!(got, vec![(4, 1, "a".to_string()), (3, 5, "b".to_string())]);
+}
+
+#[test]
+fn no_function_is_over_150_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut long = Vec::new();
+    let mut seen = 0;
+    for dir in ["src", "codegen/src"] {
+        for f in rust_files(&root.join(dir)) {
+            if f.components().any(|c| c.as_os_str() == "generated") {
+                continue;
+            }
+            for (n, line, name) in function_lengths(&std::fs::read_to_string(&f).unwrap()) {
+                seen += 1;
+                if n > 150 {
+                    long.push(format!("{}:{line} {name} ({n} lines)", f.display()));
+                }
+            }
+        }
+    }
+    assert!(
+        seen > 500,
+        "only {seen} functions found: the scanner is broken"
+    );
+    assert!(long.is_empty(), "split these functions: {long:?}");
+}
