@@ -95,6 +95,152 @@ fn check_found(kind: CaseKind, seed: u64) {
     );
 }
 
+/// A noise case: the misstated white noise is named as a noise finding whose scale (the data's
+/// level over the stated one) is within 10 % of the simulated ratio, with the true ratio inside
+/// its 95 % interval; a term hidden beside it is found within 10 %; the other sensor's noise and
+/// any other term are not named (an aiding σ only for the noise-free simulated heights).
+fn check_noise(group: &'static str, seed: u64) {
+    let (case, out) = run(CaseKind::One(group), seed);
+    let e = &out.explanation;
+    let (level, ratio) = &case.noise_ratio[0];
+    let shown: Vec<String> = e
+        .findings
+        .iter()
+        .map(|f| format!("{} {:?}: {}", f.term, f.scale, f.words))
+        .collect();
+    let f = e
+        .findings
+        .iter()
+        .find(|f| f.kind == "noise" && &f.term == level)
+        .unwrap_or_else(|| panic!("{}: {level} not named; named {shown:#?}", case.description));
+    let scale = f.scale.expect("a noise finding carries its scale");
+    assert!(
+        (scale / ratio - 1.0).abs() < 0.10,
+        "{}: {level} scale {scale:.3}, simulated {ratio:.3}",
+        case.description
+    );
+    let [lo, hi] = f
+        .scale_interval
+        .expect("a noise finding carries its interval");
+    assert!(
+        lo <= *ratio && *ratio <= hi,
+        "{}: {level} simulated {ratio:.3} outside the 95 % interval {lo:.3}–{hi:.3}",
+        case.description
+    );
+    assert!(
+        false_causes(&case, &out).is_empty(),
+        "{}: named {:?} as causes too",
+        case.description,
+        false_causes(&case, &out)
+    );
+    for (name, truth_si) in &case.hidden {
+        assert!(
+            out.found(name),
+            "{}: {name} not named; {shown:#?}",
+            case.description
+        );
+        let info = common::TERMS.iter().find(|t| t.name == name).unwrap();
+        let truth = truth_si / info.display_to_si;
+        let est = estimate_of(&out, name).unwrap();
+        assert!(
+            ((est - truth) / truth).abs() < 0.10,
+            "{}: {name} estimated {est}, true {truth}",
+            case.description
+        );
+    }
+}
+
+/// Findings presented as causes that are neither hidden (nor in a hidden term's class) nor the
+/// misstated noise level; a finding marked as a stand-in ("fitted, but not a cause") is not a
+/// cause, and an aiding σ below 1 for the noise-free simulated heights is true.
+fn false_causes(case: &HiddenCase, out: &HiddenOutcome) -> Vec<String> {
+    out.explanation
+        .findings
+        .iter()
+        .filter(|f| f.stand_in.is_none())
+        .filter(|f| {
+            if f.kind == "noise" {
+                let true_level = case.noise_ratio.iter().any(|(l, _)| l == &f.term);
+                !(true_level || (f.term == "sigma_pos_h" && f.scale.unwrap_or(1.0) < 1.0))
+            } else {
+                !case
+                    .hidden
+                    .iter()
+                    .any(|(h, _)| &f.term == h || f.equivalent.iter().any(|x| x == h))
+            }
+        })
+        .map(|f| format!("{} {:?}", f.term, f.scale))
+        .collect()
+}
+
+/// Seeds 1–5 of each noise group (a case takes about a second): how often the misstated level
+/// is named, with its scale within 10 % of the simulated ratio and the ratio inside its 95 %
+/// interval, and how often anything else is named as a cause. A white noise stated too small
+/// (2–10×) is named in at least 4 of 5 (measured 2026-11-24: gyro 5/5, accelerometer 4/5, the
+/// fifth fitted but called a stand-in); an accelerometer noise stated too large is invisible
+/// behind 0.01 m/s velocity fixes (the innovations stay consistent) and nothing may be named.
+#[test]
+fn noise_levels_across_seeds() {
+    use sinsmodel::sim::hidden::NOISE_GROUPS;
+    let mut table = String::new();
+    for group in NOISE_GROUPS {
+        let (mut named, mut close, mut covered, mut wrong) = (0, 0, 0, Vec::new());
+        for seed in 1..=5 {
+            let (case, out) = run(CaseKind::One(group), seed);
+            let (level, ratio) = &case.noise_ratio[0];
+            let f = out
+                .explanation
+                .findings
+                .iter()
+                .find(|f| f.kind == "noise" && &f.term == level && f.stand_in.is_none());
+            if let Some(f) = f {
+                named += 1;
+                let scale = f.scale.unwrap();
+                assert_eq!(
+                    scale > 1.0,
+                    *ratio > 1.0,
+                    "{}: scale {scale}",
+                    case.description
+                );
+                close += usize::from((scale / ratio - 1.0).abs() < 0.10);
+                let [lo, hi] = f.scale_interval.unwrap();
+                covered += usize::from(lo <= *ratio && *ratio <= hi);
+            }
+            let w = false_causes(&case, &out);
+            if !w.is_empty() {
+                wrong.push(format!("seed {seed}: {w:?}"));
+            }
+        }
+        table.push_str(&format!(
+            "{group}: named {named}/5, within 10 % {close}/5, ratio in the 95 % interval {covered}/5, false causes {wrong:?}\n"
+        ));
+        match group {
+            "noise_gyro" | "noise_accel" | "noise_accel_kgf" => {
+                assert!(named >= 4 && close >= 3 && covered >= 3, "{table}");
+                assert!(wrong.len() <= 1, "{table}");
+            }
+            "noise_gyro_large" => assert!(named >= 3 && wrong.is_empty(), "{table}"),
+            _ => assert!(wrong.is_empty(), "{table}"),
+        }
+    }
+    eprint!("{table}");
+}
+
+#[test]
+fn finds_gyro_noise_stated_too_small() {
+    check_noise("noise_gyro", 1);
+}
+
+#[test]
+fn finds_accelerometer_noise_stated_too_small() {
+    check_noise("noise_accel", 1);
+}
+
+#[test]
+fn finds_a_noise_level_and_a_sensor_term_together() {
+    check_noise("noise_accel_kgf", 1);
+}
+
 fn check_null(seed: u64) {
     let (case, out) = run(CaseKind::Null, seed);
     let named: Vec<&str> = out
@@ -361,6 +507,7 @@ fn probe() {
                 .iter()
                 .chain(sinsmodel::sim::hidden::GNSS_GROUPS.iter())
                 .chain(sinsmodel::sim::hidden::TURNTABLE_GROUPS.iter())
+                .chain(sinsmodel::sim::hidden::NOISE_GROUPS.iter())
                 .find(|x| **x == g)
                 .expect("a group, null or two"),
         ),
@@ -427,6 +574,12 @@ fn probe() {
                 );
             }
         }
+    }
+    for f in e.findings.iter().filter(|f| f.kind == "noise") {
+        eprintln!("  noise {} scale {:?}", f.term, f.scale);
+    }
+    for (l, r) in &case.noise_ratio {
+        eprintln!("  true {l} ratio {r:.3}");
     }
     for (h, (x, s)) in case.hidden.iter().zip(&out.oracle_estimates) {
         eprintln!("  true {} {:.4e}, oracle {:.4e} ± {:.1e}", h.0, h.1, x, s);

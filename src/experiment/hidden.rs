@@ -62,7 +62,12 @@ pub fn run_hidden_on(
         truth: Some(&sim.truth),
         start: sim.start,
     };
-    let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(FilterConfig::new(m)) };
+    // the filter is told the case's stated noise (a noise case states one level wrongly)
+    let stated = |m: &Model| match case.stated_noise {
+        Some([arw, vrw]) => FilterConfig::new(m).with_sensor_noise(m, arw, vrw),
+        None => FilterConfig::new(m),
+    };
+    let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(stated(m)) };
     let mut opts = opts.clone();
     opts.noise_levels &= !case.static_aid;
     for (name, sigma) in &case.priors {
@@ -74,7 +79,15 @@ pub fn run_hidden_on(
     let expl = explain(&baseline, &cands, &data, &config_for, &opts, &mut |_, _| {})?;
     let oracle = Model::parse(&case.oracle_model())?;
     // the oracle knows the terms and their size: a prior that holds the true value
-    let mut oracle_cfg = FilterConfig::new(&oracle);
+    let mut oracle_cfg = stated(&oracle);
+    // and the noise as simulated
+    let ratio = |l: &str| {
+        case.noise_ratio
+            .iter()
+            .find(|x| x.0 == l)
+            .map_or(1.0, |x| x.1)
+    };
+    oracle_cfg.scale_sensor_noise(&oracle, ratio("gyro_arw"), ratio("accel_vrw"));
     for (name, v) in &case.hidden {
         if let Some(i) = oracle.index_of(name) {
             let declared = case.priors.iter().find(|p| &p.0 == name).map(|p| p.1);

@@ -7,8 +7,9 @@
 //! fix states). The log-likelihood is searched in log₂ s around the current value: passes at
 //! half and twice, then successive parabolic interpolation (or steps of 4× while it keeps
 //! rising), within 1/16 … 64 of the start. Two sweeps over the levels in turn (white noise
-//! first, then the aiding σ), each given all the others. The 95 % interval is where the last
-//! parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns the significant
+//! first, then the aiding σ), each given all the others; a level's 2Δℓ is then the drop when it
+//! alone returns to its stated value, the others kept at their fits. The 95 % interval is
+//! where the last parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns the significant
 //! levels into findings.
 
 use super::{
@@ -62,7 +63,7 @@ pub(super) struct LevelFit {
     pub(super) scale: f64,
     /// Approximate 95 % interval of the scale.
     pub(super) interval: [f64; 2],
-    /// 2Δℓ the scale gained over its two sweeps (given the other levels).
+    /// 2Δℓ of the fitted scale over the stated value, the other levels at their fitted scales.
     pub(super) two_delta_loglik: f64,
     /// Holm-adjusted p-value over the levels.
     pub(super) p_holm: f64,
@@ -86,7 +87,7 @@ pub(super) fn fit(
     let mut l_cur = loglik0;
     let mut fits = Vec::new();
     let passes_per_level = MAX_EVALS as f64;
-    let total = 2.0 * passes_per_level * levels.len() as f64;
+    let total = (2.0 * passes_per_level + 1.0) * levels.len() as f64;
     let mut done = 0.0;
     // two sweeps: the second refits each level given all the others
     let order: Vec<Level> = levels.iter().chain(levels.iter()).copied().collect();
@@ -110,6 +111,20 @@ pub(super) fn fit(
             l_cur = l;
         }
         curvs[li] = curv;
+    }
+    // each level's evidence is the drop in ℓ when it alone goes back to its stated value, the
+    // others kept at their fitted scales: a level that in the first sweep took up another's
+    // misfit keeps no gain the second sweep gave back
+    for (li, &level) in levels.iter().enumerate() {
+        if scales[li] == 1.0 {
+            gains[li] = 0.0;
+            continue;
+        }
+        let mut c = cur.clone();
+        level.apply(model, &mut c, 1.0 / scales[li]);
+        let p = run_pass(model, &[], data, &c, &mut |f| progress((done + f) / total))?;
+        done += 1.0;
+        gains[li] = (2.0 * (l_cur - p.stats.loglik)).max(0.0);
     }
     for (li, &level) in levels.iter().enumerate() {
         let curv = curvs[li];
@@ -140,7 +155,45 @@ pub(super) fn fit(
             f.level.apply(model, &mut out, f.scale);
         }
     }
+    refit_named(model, data, &mut fits, &mut out)?;
     Ok((fits, out))
+}
+
+/// Refits each named (significant) level once more on `out`, where the levels not named are
+/// back at their stated values: a level the data do not need must not shift the value of one
+/// they do. Updates the fits' scales and intervals and `out`.
+fn refit_named(
+    model: &Model,
+    data: &ExplainData,
+    fits: &mut [LevelFit],
+    out: &mut FilterConfig,
+) -> anyhow::Result<()> {
+    let moved = fits.iter().any(|f| !f.significant && f.scale != 1.0);
+    if !moved || !fits.iter().any(|f| f.significant) {
+        return Ok(());
+    }
+    let mut l_out = run_pass(model, &[], data, out, &mut |_| {})?.stats.loglik;
+    for f in fits.iter_mut().filter(|f| f.significant) {
+        let level = f.level;
+        let base = out.clone();
+        let mut eval = |u: f64| -> anyhow::Result<f64> {
+            let mut c = base.clone();
+            level.apply(model, &mut c, 2f64.powf(u));
+            Ok(run_pass(model, &[], data, &c, &mut |_| {})?.stats.loglik)
+        };
+        let (u, l, curv) = search(&mut eval, l_out)?;
+        if l > l_out {
+            level.apply(model, out, 2f64.powf(u));
+            f.scale *= 2f64.powf(u);
+            l_out = l;
+        }
+        if curv < 0.0 {
+            let half = (stats::chi2_isf(0.05, 1.0) / (-2.0 * curv)).sqrt();
+            let c = f.scale.log2();
+            f.interval = [2f64.powf(c - half), 2f64.powf(c + half)];
+        }
+    }
+    Ok(())
 }
 
 /// Maximises ℓ(u) over u = log₂ s from u = 0 (where ℓ = `l0`) in at most [`MAX_EVALS`]

@@ -23,6 +23,23 @@ pub const GNSS_GROUPS: [&str; 3] = ["gnss_time", "gnss_time_kgf", "gnss_lever"];
 /// (`inner_lever_delay`: what a real unit's calibration sequence holds).
 pub const TURNTABLE_GROUPS: [&str; 3] = ["inner_lever", "accel_delay", "inner_lever_delay"];
 
+/// Groups in which one sensor's white noise is stated wrongly, on a drive with turns and speed
+/// changes aided by position and velocity fixes: the filter is told a MEMS grade's noise
+/// (0.5 deg/√h, 150 µg/√Hz) while the gyro's (`noise_gyro`) or the accelerometer's
+/// (`noise_accel`, and `noise_accel_kgf` with a gyro g-sensitivity kgf_yx beside it) is
+/// k = 1 + `effect` · (1 … 9) times larger, or 1/k of it (`*_large`: stated too large).
+pub const NOISE_GROUPS: [&str; 5] = [
+    "noise_gyro",
+    "noise_accel",
+    "noise_accel_kgf",
+    "noise_gyro_large",
+    "noise_accel_large",
+];
+
+/// The white noise a noise group's filter is told: the MEMS grade's 0.5 deg/√h [rad/√s] and
+/// 150 µg/√Hz [m/s/√s] (grades.toml).
+pub const STATED_NOISE: [f64; 2] = [0.5 * std::f64::consts::PI / 180.0 / 60.0, 150e-6 * G0];
+
 /// A system-level calibration sequence: 60 s at rest, then 18 rotations of ±90° in 5 s
 /// (about 20 deg/s) about x, y and z — four about each axis, then x, y, z, −z, −y, −x — with
 /// 20 s at rest after each.
@@ -105,6 +122,12 @@ pub struct HiddenCase {
     /// candidates (no antenna, no receiver clock) or noise levels (the aiding σ is a tuning
     /// choice).
     pub static_aid: bool,
+    /// The white noise the filter is told, gyro [rad/√s] and accelerometer [m/s/√s]; None:
+    /// the spec's, as simulated.
+    pub stated_noise: Option<[f64; 2]>,
+    /// Noise levels stated wrongly (`gyro_arw`, `accel_vrw`) and the ratio of the simulated
+    /// level to the stated one.
+    pub noise_ratio: Vec<(String, f64)>,
 }
 
 impl HiddenCase {
@@ -255,6 +278,8 @@ struct Parts {
     baseline: String,
     /// The baseline has its own d_x, d_y, d_z errors.
     with_d: bool,
+    /// Noise levels stated wrongly and the ratio simulated/stated (stated: [`STATED_NOISE`]).
+    noise_ratio: Vec<(String, f64)>,
 }
 
 /// Draws a case of `kind` from `seed`. Cases last `seconds` (≥ 300) of 2 kHz IMU data at rest
@@ -294,13 +319,19 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
         hidden: Vec::new(),
         baseline: "P31".to_string(),
         with_d: true,
+        noise_ratio: Vec::new(),
     };
     let (group, description): (String, String) = match kind {
         CaseKind::Null => ("null".into(), draw_null(&mut rng, &d, &mut p)),
         CaseKind::Two => ("two".into(), draw_two(&d, &mut p)),
         CaseKind::One(g) => {
             draw_one(g, &mut rng, &d, &mut p);
-            (g.into(), one_description(g, &p, effect))
+            let text = if NOISE_GROUPS.contains(&g) {
+                noise_description(&p)
+            } else {
+                one_description(g, &p, effect)
+            };
+            (g.into(), text)
         }
     };
     assemble(seed, group, description, lat, effect, &mut rng, p)
@@ -349,6 +380,7 @@ fn draw_one(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
         "kgf" => draw_kgf(rng, d, p),
         "gnss_time" | "gnss_time_kgf" | "gnss_lever" => draw_gnss(g, rng, d, p),
         "inner_lever" | "accel_delay" | "inner_lever_delay" => draw_turntable(g, rng, d, p),
+        g if NOISE_GROUPS.contains(&g) => draw_noise(g, rng, d, p),
         other => panic!("unknown group {other}"),
     }
 }
@@ -482,6 +514,27 @@ fn draw_gnss(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
     }
 }
 
+/// A white noise of group `g` stated wrongly on a drive (and kgf_yx beside it in
+/// `noise_accel_kgf`).
+fn draw_noise(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    p.segments = drive_segments(d.seconds);
+    p.baseline = "P13".into();
+    // 2–10 at effect 1; 1 (nothing misstated) at effect 0
+    let k = 1.0 + d.effect * (1.0 + 8.0 * rng.uniform());
+    let ratio = if g.ends_with("_large") { 1.0 / k } else { k };
+    let level = if g.starts_with("noise_gyro") {
+        "gyro_arw"
+    } else {
+        "accel_vrw"
+    };
+    p.noise_ratio.push((level.into(), ratio));
+    if g == "noise_accel_kgf" {
+        // a MEMS gyro's g-sensitivity (30 deg/h per m/s², 294 deg/h/g), visible beside
+        // the MEMS gyro noise
+        p.hidden.push(("kgf_yx".into(), 30.0 * d.effect_si_gyro));
+    }
+}
+
 /// An inner lever arm (20–60 mm times the effect) and/or an accelerometer delay (1–3 ms times
 /// the effect) of group `g`, on a turntable.
 fn draw_turntable(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
@@ -530,6 +583,20 @@ fn one_description(g: &str, p: &Parts, effect: f64) -> String {
     format!("{} hidden ({size}), baseline {}", hidden[0].0, p.baseline)
 }
 
+/// The description of a noise case: the level misstated, its ratio, and any term beside it.
+fn noise_description(p: &Parts) -> String {
+    let (level, r) = &p.noise_ratio[0];
+    let mut s = format!(
+        "{level} stated {} (simulated {r:.2}x the stated), baseline {}",
+        if *r > 1.0 { "too small" } else { "too large" },
+        p.baseline
+    );
+    for (name, _) in &p.hidden {
+        s.push_str(&format!("; {name} hidden beside it"));
+    }
+    s
+}
+
 /// The case from its drawn parts: the baseline's errors (drawn last), the scenario text at
 /// latitude `lat` [deg], the priors it declares.
 fn assemble(
@@ -547,6 +614,7 @@ fn assemble(
         hidden,
         baseline,
         with_d,
+        noise_ratio,
     } = p;
     let skip: Vec<String> = hidden.iter().map(|h| h.0.clone()).collect();
     let mut errors = baseline_errors(rng, with_d, &skip);
@@ -557,18 +625,38 @@ fn assemble(
     // (from the truth rows) at 10 Hz sees the kicks of each rotation
     let (imu_rate, truth_rate) = if TURNTABLE_GROUPS.contains(&group.as_str()) {
         ("200.0", "10.0")
+    } else if NOISE_GROUPS.contains(&group.as_str()) {
+        // a drive without vibration: 200 Hz samples its manoeuvres
+        ("200.0", "1.0")
     } else {
         ("2000.0", "1.0")
     };
+    let stated_noise = (!noise_ratio.is_empty()).then_some(STATED_NOISE);
+    let noise = match stated_noise {
+        None => "[noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n".to_string(),
+        Some(stated) => {
+            let ratio = |l: &str| noise_ratio.iter().find(|x| x.0 == l).map_or(1.0, |x| x.1);
+            format!(
+                "[noise]\narw = \"{:e} rad/sqrt(s)\"\nvrw = \"{:e} m/s/sqrt(s)\"\n",
+                stated[0] * ratio("gyro_arw"),
+                stated[1] * ratio("accel_vrw")
+            )
+        }
+    };
     let scenario = format!(
         "name = \"hidden-{group}-{seed}\"\nimu_rate_hz = {imu_rate}\ntruth_rate_hz = {truth_rate}\nseed = {seed}\n\
-         [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}\
-         [noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n"
+         [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}{noise}"
     );
     // g-sensitivities of several deg/h/g belong to a MEMS-class gyro, not to the spec's laser
     // gyro (0.01 deg/h/g): the case declares that class, as a user would with --prior
-    let priors = if group == "kgf" || group == "gnss_time_kgf" {
-        let sigma = 10.0 * std::f64::consts::PI / 180.0 / 3600.0 / G0; // 10 deg/h/g
+    let priors = if ["kgf", "gnss_time_kgf", "noise_accel_kgf"].contains(&group.as_str()) {
+        // 10 deg/h/g; a MEMS gyro's 200 deg/h/g beside MEMS noise
+        let dhg = if group == "noise_accel_kgf" {
+            200.0
+        } else {
+            10.0
+        };
+        let sigma = dhg * std::f64::consts::PI / 180.0 / 3600.0 / G0;
         common::TERMS
             .iter()
             .filter(|t| t.name.starts_with("kgf_"))
@@ -589,5 +677,7 @@ fn assemble(
         priors,
         withheld: Vec::new(),
         static_aid,
+        stated_noise,
+        noise_ratio,
     }
 }
