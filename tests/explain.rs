@@ -220,6 +220,7 @@ fn noise_levels_across_seeds() {
                 assert!(wrong.len() <= 1, "{table}");
             }
             "noise_gyro_large" => assert!(named >= 3 && wrong.is_empty(), "{table}"),
+            "noise_gyro_bias" | "noise_accel_bias" => assert!(named >= 3, "{table}"),
             _ => assert!(wrong.is_empty(), "{table}"),
         }
     }

@@ -128,6 +128,34 @@ impl FilterConfig {
         (first(WhiteNoise::GyroArw), first(WhiteNoise::AccelVrw))
     }
 
+    /// Bias random-walk densities in q: gyro [rad/s/√s] and accelerometer [m/s²/√s] of the
+    /// first gyro and accelerometer bias state (0 when the model has none or states none).
+    pub fn bias_random_walk(&self, model: &Model) -> (f64, f64) {
+        let first = |gyro: bool| {
+            bias_states(model)
+                .find(|&(_, g)| g == gyro)
+                .map_or(0.0, |(i, _)| self.q[i].sqrt())
+        };
+        (first(true), first(false))
+    }
+
+    /// Sets the bias random walk (bias instability) of the gyro [rad/s/√s] and accelerometer
+    /// [m/s²/√s] constant-bias states in q.
+    pub fn with_bias_random_walk(mut self, model: &Model, gyro: f64, accel: f64) -> FilterConfig {
+        for (i, g) in bias_states(model) {
+            self.q[i] = if g { gyro * gyro } else { accel * accel };
+        }
+        self
+    }
+
+    /// Multiplies the bias random-walk densities in q by `gyro_scale` and `accel_scale`.
+    pub fn scale_bias_random_walk(&mut self, model: &Model, gyro_scale: f64, accel_scale: f64) {
+        for (i, g) in bias_states(model) {
+            let s = if g { gyro_scale } else { accel_scale };
+            self.q[i] *= s * s;
+        }
+    }
+
     /// Sets the white sensor noise used in q: ARW [rad/√s] and VRW [m/s/√s].
     /// (which states each drives is the spec's `white_noise`).
     pub fn with_sensor_noise(mut self, model: &Model, arw: f64, vrw: f64) -> FilterConfig {
@@ -154,6 +182,23 @@ impl FilterConfig {
 
 /// The model's states driven by white sensor noise (spec `white_noise`): (model index, kind),
 /// `WhiteNoise::None` left out.
+/// The constant-bias states of `model` (the spec's `gyro bias` and `accel bias` groups) with
+/// true for a gyro bias: the states a bias random walk (bias instability) drives.
+fn bias_states(model: &Model) -> impl Iterator<Item = (usize, bool)> + '_ {
+    model
+        .states
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| match *s {
+            StateRef::Term(k) => match common::TERMS[k].group {
+                "gyro bias" => Some((i, true)),
+                "accel bias" => Some((i, false)),
+                _ => None,
+            },
+            StateRef::Nav(_) => None,
+        })
+}
+
 fn white_noise_states(model: &Model) -> impl Iterator<Item = (usize, WhiteNoise)> + '_ {
     model
         .states

@@ -64,7 +64,9 @@ pub fn run_hidden_on(
     };
     // the filter is told the case's stated noise (a noise case states one level wrongly)
     let stated = |m: &Model| match case.stated_noise {
-        Some([arw, vrw]) => FilterConfig::new(m).with_sensor_noise(m, arw, vrw),
+        Some([arw, vrw, grw, arw_bias]) => FilterConfig::new(m)
+            .with_sensor_noise(m, arw, vrw)
+            .with_bias_random_walk(m, grw, arw_bias),
         None => FilterConfig::new(m),
     };
     let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(stated(m)) };
@@ -88,6 +90,7 @@ pub fn run_hidden_on(
             .map_or(1.0, |x| x.1)
     };
     oracle_cfg.scale_sensor_noise(&oracle, ratio("gyro_arw"), ratio("accel_vrw"));
+    oracle_cfg.scale_bias_random_walk(&oracle, ratio("gyro_bias_rw"), ratio("accel_bias_rw"));
     for (name, v) in &case.hidden {
         if let Some(i) = oracle.index_of(name) {
             let declared = case.priors.iter().find(|p| &p.0 == name).map(|p| p.1);

@@ -27,6 +27,10 @@ pub(super) enum Level {
     GyroArw,
     /// Accelerometer white noise (velocity random walk).
     AccelVrw,
+    /// Gyro bias random walk (bias instability), offered when one is stated.
+    GyroBiasRw,
+    /// Accelerometer bias random walk, offered when one is stated.
+    AccelBiasRw,
     /// The aiding's stated 1-σ of one measurement.
     Sigma(&'static str),
 }
@@ -37,6 +41,8 @@ impl Level {
         match self {
             Level::GyroArw => "gyro_arw".into(),
             Level::AccelVrw => "accel_vrw".into(),
+            Level::GyroBiasRw => "gyro_bias_rw".into(),
+            Level::AccelBiasRw => "accel_bias_rw".into(),
             Level::Sigma(m) => format!("sigma_{m}"),
         }
     }
@@ -46,6 +52,8 @@ impl Level {
         match self {
             Level::GyroArw => cfg.scale_sensor_noise(model, s, 1.0),
             Level::AccelVrw => cfg.scale_sensor_noise(model, 1.0, s),
+            Level::GyroBiasRw => cfg.scale_bias_random_walk(model, s, 1.0),
+            Level::AccelBiasRw => cfg.scale_bias_random_walk(model, 1.0, s),
             Level::Sigma(m) => match cfg.sigma_scale.iter_mut().find(|x| x.0 == *m) {
                 Some(x) => x.1 *= s,
                 None => cfg.sigma_scale.push((m, s)),
@@ -262,12 +270,20 @@ pub(super) fn stage(
         return Ok((Vec::new(), None));
     }
     let mut levels = vec![Level::GyroArw, Level::AccelVrw];
+    let cfg = ctx.extended_config(&r.model, &r.widened)?;
+    // a bias random walk is a level only where one is stated (a scale of zero is zero)
+    let (gyro_rw, accel_rw) = cfg.bias_random_walk(&r.model);
+    if gyro_rw > 0.0 {
+        levels.push(Level::GyroBiasRw);
+    }
+    if accel_rw > 0.0 {
+        levels.push(Level::AccelBiasRw);
+    }
     for i in &r.pass.run.innovations {
         if !levels.contains(&Level::Sigma(i.meas)) {
             levels.push(Level::Sigma(i.meas));
         }
     }
-    let cfg = ctx.extended_config(&r.model, &r.widened)?;
     let round = r.rounds + 1;
     let (fits, cfg_noise) = fit(
         &r.model,
@@ -291,7 +307,10 @@ pub(super) fn stage(
         .filter(|f| f.significant)
         .map(|f| f.two_delta_loglik)
         .sum();
-    let (arw, vrw) = cfg.sensor_noise(&r.model);
+    let stated = Stated {
+        white: cfg.sensor_noise(&r.model),
+        bias_rw: cfg.bias_random_walk(&r.model),
+    };
     // a noise level is a constant of the sensor or the receiver: fitted on parts of the data
     // apart (while the body rotates or turns and otherwise; each half), it gives one scale
     let groups = innovation_groups(ctx.data, &pass)?;
@@ -300,8 +319,7 @@ pub(super) fn stage(
         let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
         let mut nf = noise_finding(
             f,
-            arw,
-            vrw,
+            &stated,
             excess.map(|e| removed * w / e),
             f.two_delta_loglik,
         );
@@ -464,18 +482,39 @@ fn split_scales(
     Ok(out)
 }
 
+/// The noise levels the filter was given (SI).
+struct Stated {
+    /// White noise: ARW [rad/√s], VRW [m/s/√s].
+    white: (f64, f64),
+    /// Bias random walk: gyro [rad/s/√s], accelerometer [m/s²/√s].
+    bias_rw: (f64, f64),
+}
+
 /// The finding of a significant noise level: the level the data show in the user's unit, its
 /// scale of the stated value and the interval.
 fn noise_finding(
     f: &LevelFit,
-    arw: f64,
-    vrw: f64,
+    stated: &Stated,
     misfit_share: Option<f64>,
     two_delta_loglik: f64,
 ) -> Finding {
     let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0; // rad/√s → deg/√h
     let ug_rt_hz = 1e6 / G0; // m/s/√s → µg/√Hz
+    let (arw, vrw) = stated.white;
+    let (grw, arw_bias) = stated.bias_rw;
     let (stated, unit, what) = match f.level {
+        Level::GyroBiasRw => (
+            // rad/s/√s → deg/h/√h
+            grw * 180.0 / std::f64::consts::PI * 3600.0 * 60.0,
+            "deg/h/sqrt(h)",
+            "a gyro bias random walk (bias instability)".to_string(),
+        ),
+        Level::AccelBiasRw => (
+            // m/s²/√s → µg/√s
+            arw_bias * 1e6 / G0,
+            "ug/sqrt(s)",
+            "an accelerometer bias random walk (bias instability)".to_string(),
+        ),
         Level::GyroArw => (
             arw * deg_rt_h,
             "deg/sqrt(h)",

@@ -27,18 +27,36 @@ pub const TURNTABLE_GROUPS: [&str; 3] = ["inner_lever", "accel_delay", "inner_le
 /// changes aided by position and velocity fixes: the filter is told a MEMS grade's noise
 /// (0.5 deg/√h, 150 µg/√Hz) while the gyro's (`noise_gyro`) or the accelerometer's
 /// (`noise_accel`, and `noise_accel_kgf` with a gyro g-sensitivity kgf_yx beside it) is
-/// k = 1 + `effect` · (1 … 9) times larger, or 1/k of it (`*_large`: stated too large).
-pub const NOISE_GROUPS: [&str; 5] = [
+/// k = 1 + `effect` · (1 … 9) times larger, or 1/k of it (`*_large`: stated too large). In
+/// `noise_gyro_bias` and `noise_accel_bias` the filter is also told a bias random walk (bias
+/// instability: 3 deg/h/√h, 30 µg/√s) and the gyro's or accelerometer's is k times larger.
+pub const NOISE_GROUPS: [&str; 7] = [
     "noise_gyro",
     "noise_accel",
     "noise_accel_kgf",
     "noise_gyro_large",
     "noise_accel_large",
+    "noise_gyro_bias",
+    "noise_accel_bias",
 ];
 
-/// The white noise a noise group's filter is told: the MEMS grade's 0.5 deg/√h [rad/√s] and
-/// 150 µg/√Hz [m/s/√s] (grades.toml).
-pub const STATED_NOISE: [f64; 2] = [0.5 * std::f64::consts::PI / 180.0 / 60.0, 150e-6 * G0];
+/// The noise a noise group's filter is told: the MEMS grade's white noise 0.5 deg/√h [rad/√s]
+/// and 150 µg/√Hz [m/s/√s] (grades.toml), and in the bias groups a bias random walk of
+/// 3 deg/h/√h [rad/s/√s] and 30 µg/√s [m/s²/√s] (none in the others).
+pub fn stated_noise(group: &str) -> [f64; 4] {
+    let d2r = std::f64::consts::PI / 180.0;
+    let bias = group.ends_with("_bias");
+    [
+        0.5 * d2r / 60.0,
+        150e-6 * G0,
+        if bias {
+            30.0 * d2r / 3600.0 / 60.0
+        } else {
+            0.0
+        },
+        if bias { 30e-6 * G0 } else { 0.0 },
+    ]
+}
 
 /// A system-level calibration sequence: 60 s at rest, then 18 rotations of ±90° in 5 s
 /// (about 20 deg/s) about x, y and z — four about each axis, then x, y, z, −z, −y, −x — with
@@ -122,10 +140,12 @@ pub struct HiddenCase {
     /// candidates (no antenna, no receiver clock) or noise levels (the aiding σ is a tuning
     /// choice).
     pub static_aid: bool,
-    /// The white noise the filter is told, gyro [rad/√s] and accelerometer [m/s/√s]; None:
-    /// the spec's, as simulated.
-    pub stated_noise: Option<[f64; 2]>,
-    /// Noise levels stated wrongly (`gyro_arw`, `accel_vrw`) and the ratio of the simulated
+    /// The noise the filter is told: white noise, gyro [rad/√s] and accelerometer [m/s/√s],
+    /// and bias random walk, gyro [rad/s/√s] and accelerometer [m/s²/√s]; None: the spec's, as
+    /// simulated.
+    pub stated_noise: Option<[f64; 4]>,
+    /// Noise levels stated wrongly (`gyro_arw`, `accel_vrw`, `gyro_bias_rw`, `accel_bias_rw`)
+    /// and the ratio of the simulated
     /// level to the stated one.
     pub noise_ratio: Vec<(String, f64)>,
 }
@@ -278,7 +298,7 @@ struct Parts {
     baseline: String,
     /// The baseline has its own d_x, d_y, d_z errors.
     with_d: bool,
-    /// Noise levels stated wrongly and the ratio simulated/stated (stated: [`STATED_NOISE`]).
+    /// Noise levels stated wrongly and the ratio simulated/stated (stated: [`stated_noise`]).
     noise_ratio: Vec<(String, f64)>,
 }
 
@@ -522,10 +542,11 @@ fn draw_noise(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
     // 2–10 at effect 1; 1 (nothing misstated) at effect 0
     let k = 1.0 + d.effect * (1.0 + 8.0 * rng.uniform());
     let ratio = if g.ends_with("_large") { 1.0 / k } else { k };
-    let level = if g.starts_with("noise_gyro") {
-        "gyro_arw"
-    } else {
-        "accel_vrw"
+    let level = match (g.starts_with("noise_gyro"), g.ends_with("_bias")) {
+        (true, false) => "gyro_arw",
+        (false, false) => "accel_vrw",
+        (true, true) => "gyro_bias_rw",
+        (false, true) => "accel_bias_rw",
     };
     p.noise_ratio.push((level.into(), ratio));
     if g == "noise_accel_kgf" {
@@ -631,15 +652,18 @@ fn assemble(
     } else {
         ("2000.0", "1.0")
     };
-    let stated_noise = (!noise_ratio.is_empty()).then_some(STATED_NOISE);
+    let stated_noise = (!noise_ratio.is_empty()).then(|| stated_noise(&group));
     let noise = match stated_noise {
         None => "[noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n".to_string(),
         Some(stated) => {
             let ratio = |l: &str| noise_ratio.iter().find(|x| x.0 == l).map_or(1.0, |x| x.1);
             format!(
-                "[noise]\narw = \"{:e} rad/sqrt(s)\"\nvrw = \"{:e} m/s/sqrt(s)\"\n",
+                "[noise]\narw = \"{:e} rad/sqrt(s)\"\nvrw = \"{:e} m/s/sqrt(s)\"\n\
+                 gyro_bias_rw = \"{:e} rad/s/sqrt(s)\"\naccel_bias_rw = \"{:e} m/s^2/sqrt(s)\"\n",
                 stated[0] * ratio("gyro_arw"),
-                stated[1] * ratio("accel_vrw")
+                stated[1] * ratio("accel_vrw"),
+                stated[2] * ratio("gyro_bias_rw"),
+                stated[3] * ratio("accel_bias_rw")
             )
         }
     };
