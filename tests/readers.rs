@@ -241,3 +241,24 @@ fn matlab_file_reads_like_the_text_it_came_from() {
     let (ok, _, err) = navigate_to(&named);
     assert!(!ok && err.contains("selects a MATLAB variable"), "{err}");
 }
+
+/// A solution written in UTC (or JST) is refused with the line and the leap seconds, not read as
+/// GPST 18 s early; the GPST header of the shared drive is accepted.
+#[test]
+fn rtklib_times_in_utc_are_refused() {
+    let src = data("gnss-imu-drive/gnss_1934_sf.pos");
+    let text = std::fs::read_to_string(&src).unwrap();
+    assert!(text.contains("%  GPST"), "the shared file states GPST");
+    assert!(rtklib::read(&src).is_ok());
+    let dir = std::env::temp_dir().join(format!("sinsmodel-utc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (sys, early) in [("UTC", "18 s early"), ("JST", "9 h 18 s early")] {
+        let p = dir.join(format!("{sys}.pos"));
+        std::fs::write(&p, text.replacen("%  GPST", &format!("%  {sys} "), 1)).unwrap();
+        let e = rtklib::read(&p).unwrap_err().to_string();
+        let line = text.lines().position(|l| l.starts_with("%  GPST")).unwrap() + 1;
+        assert!(e.contains(&format!("{sys}.pos:{line}:")), "{e}");
+        assert!(e.contains(early) && e.contains("GPST = UTC + 18 s"), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

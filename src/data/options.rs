@@ -122,7 +122,9 @@ pub struct DataOptions {
     pub prior: Vec<String>,
     /// Sensor white noise instead of the spec defaults: a `sinsmodel allan --json` file (mean
     /// ARW of the gyros, VRW of the accelerometers), or inline with units:
-    /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`.
+    /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`; inline may add a bias random walk (bias
+    /// instability) `gyro_bias_rw=10 deg/h/sqrt(h), accel_bias_rw=30 ug/sqrt(s)`, which explain
+    /// then tests as noise levels too.
     #[cfg_attr(feature = "cli", arg(long))]
     pub noise: Option<PathBuf>,
     /// Truth file (t lat lon h vn ve vd roll pitch yaw), or a PSINS reference FILE.mat:avp: adds

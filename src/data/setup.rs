@@ -152,6 +152,17 @@ impl DataOptions {
                 vrw,
                 vrw / crate::io::units::STANDARD_GRAVITY * 1e6
             ));
+            let (g, a) = bias_rw_from_noise(path)?;
+            if g > 0.0 || a > 0.0 {
+                // rad/s/√s → deg/h/√h: × 180/π × 3600 × 60; m/s²/√s → µg/√s: ÷ g × 1e6
+                lines.push(format!(
+                    "bias random walk from --noise: gyro {:.3e} rad/s/sqrt(s) = {:.3} deg/h/sqrt(h), accelerometer {:.3e} m/s^2/sqrt(s) = {:.1} ug/sqrt(s)",
+                    g,
+                    g.to_degrees() * 3600.0 * 60.0,
+                    a,
+                    a / crate::io::units::STANDARD_GRAVITY * 1e6
+                ));
+            }
         }
         Ok(lines)
     }
@@ -283,6 +294,10 @@ impl DataOptions {
         if let Some(path) = &args.noise {
             let (arw, vrw) = noise_from_allan(path)?;
             cfg = cfg.with_sensor_noise(model, arw, vrw);
+            let (g, a) = bias_rw_from_noise(path)?;
+            if g > 0.0 || a > 0.0 {
+                cfg = cfg.with_bias_random_walk(model, g, a);
+            }
         }
         Ok(cfg)
     }
@@ -332,8 +347,30 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
 }
 
 /// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's.
+/// The bias random walk (bias instability) `--noise` states inline: gyro [rad/s/√s] and
+/// accelerometer [m/s²/√s] (`gyro_bias_rw=Q, accel_bias_rw=Q`; 0 where not given, and for an
+/// `allan --json` file).
+pub fn bias_rw_from_noise(path: &std::path::Path) -> Result<(f64, f64)> {
+    let text = path.to_string_lossy();
+    if text.contains('=') && !path.exists() {
+        let [_, _, g, a] = noise_inline_all(&text)?;
+        return Ok((g.unwrap_or(0.0), a.unwrap_or(0.0)));
+    }
+    Ok((0.0, 0.0))
+}
+
 fn noise_inline(text: &str) -> Result<(f64, f64)> {
-    let (mut arw, mut vrw) = (None, None);
+    let [arw, vrw, _, _] = noise_inline_all(text)?;
+    match (arw, vrw) {
+        (Some(a), Some(v)) => Ok((a, v)),
+        _ => bail!("--noise `{text}`: give both arw and vrw, e.g. 'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'"),
+    }
+}
+
+/// The inline `--noise` values (SI): arw, vrw, gyro_bias_rw, accel_bias_rw, each checked for
+/// its unit and a plausible size.
+fn noise_inline_all(text: &str) -> Result<[Option<f64>; 4]> {
+    let (mut arw, mut vrw, mut grw, mut abrw) = (None, None, None, None);
     for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (k, v) = part
             .split_once('=')
@@ -341,7 +378,13 @@ fn noise_inline(text: &str) -> Result<(f64, f64)> {
         let (slot, unit, (min, max)) = match k.trim() {
             "arw" => (&mut arw, "rad/sqrt(s)", noise_range(true)),
             "vrw" => (&mut vrw, "m/s/sqrt(s)", noise_range(false)),
-            other => bail!("--noise: unknown key `{other}` (arw, vrw)"),
+            // 1e-12 rad/s/√s (0.0002 deg/h/√h) ..= 1e-3 (200000 deg/h/√h)
+            "gyro_bias_rw" => (&mut grw, "rad/s/sqrt(s)", (1e-12, 1e-3)),
+            // 1e-9 m/s²/√s (0.1 µg/√s) ..= 0.1 (10 mg/√s)
+            "accel_bias_rw" => (&mut abrw, "m/s^2/sqrt(s)", (1e-9, 0.1)),
+            other => {
+                bail!("--noise: unknown key `{other}` (arw, vrw, gyro_bias_rw, accel_bias_rw)")
+            }
         };
         let q = crate::io::units::parse_quantity_as(v, unit)
             .map_err(|e| anyhow::anyhow!("--noise {}: {}", k.trim(), e.0))?;
@@ -354,10 +397,7 @@ fn noise_inline(text: &str) -> Result<(f64, f64)> {
         }
         *slot = Some(q);
     }
-    match (arw, vrw) {
-        (Some(a), Some(v)) => Ok((a, v)),
-        _ => bail!("--noise `{text}`: give both arw and vrw, e.g. 'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'"),
-    }
+    Ok([arw, vrw, grw, abrw])
 }
 
 /// Plausible white-noise densities (SI): gyro ARW 1e-9 ..= 1 rad/√s (the best ring-laser gyros

@@ -29,7 +29,7 @@ pub const TURNTABLE_GROUPS: [&str; 3] = ["inner_lever", "accel_delay", "inner_le
 /// (`noise_accel`, and `noise_accel_kgf` with a gyro g-sensitivity kgf_yx beside it) is
 /// k = 1 + `effect` · (1 … 9) times larger, or 1/k of it (`*_large`: stated too large). In
 /// `noise_gyro_bias` and `noise_accel_bias` the filter is also told a bias random walk (bias
-/// instability: 3 deg/h/√h, 30 µg/√s) and the gyro's or accelerometer's is k times larger.
+/// instability: 30 deg/h/√h, 30 µg/√s) and the gyro's or accelerometer's is k times larger.
 pub const NOISE_GROUPS: [&str; 7] = [
     "noise_gyro",
     "noise_accel",
@@ -42,7 +42,7 @@ pub const NOISE_GROUPS: [&str; 7] = [
 
 /// The noise a noise group's filter is told: the MEMS grade's white noise 0.5 deg/√h [rad/√s]
 /// and 150 µg/√Hz [m/s/√s] (grades.toml), and in the bias groups a bias random walk of
-/// 3 deg/h/√h [rad/s/√s] and 30 µg/√s [m/s²/√s] (none in the others).
+/// 30 deg/h/√h [rad/s/√s] and 30 µg/√s [m/s²/√s] (none in the others).
 pub fn stated_noise(group: &str) -> [f64; 4] {
     let d2r = std::f64::consts::PI / 180.0;
     let bias = group.ends_with("_bias");

@@ -48,13 +48,45 @@ pub fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
     era * 146_097 + doe - 719_468
 }
 
+/// Refuses a `.pos` whose column header (`%  UTC  latitude(deg) …`) says its times are not
+/// GPST: RTKLIB writes UTC or JST (UTC+9) when its time-format option asks for them, and read
+/// as GPST they would put every fix 18 s (or 9 h) early against the IMU.
+fn check_time_system(header: &str, file: &str, no: usize) -> Result<()> {
+    let mut words = header.split_whitespace();
+    let (Some(first), rest) = (words.next(), words.collect::<Vec<_>>().join(" ")) else {
+        return Ok(());
+    };
+    if !(rest.contains("latitude") || rest.contains("ecef") || rest.contains("week")) {
+        return Ok(());
+    }
+    match first {
+        "GPST" => Ok(()),
+        "UTC" | "JST" => bail!(
+            "{file}:{no}: the solution's times are {first} (its column header), sinsmodel reads GPST: \
+             read as GPST every fix would sit {} against the IMU. Write the solution in GPST \
+             (RTKLIB's time system option; no `-u` in rnx2rtkp) or convert it (GPST = UTC + 18 s \
+             since 2017-01-01{})",
+            if first == "UTC" { "18 s early" } else { "9 h 18 s early" },
+            if first == "JST" { "; JST = UTC + 9 h" } else { "" }
+        ),
+        other if other.chars().all(|c| c.is_ascii_uppercase()) && other.len() <= 5 => bail!(
+            "{file}:{no}: unknown time system `{other}` in the column header (expected GPST)"
+        ),
+        _ => Ok(()),
+    }
+}
+
 /// Reads a `.pos` file.
 pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
     let mut lines = Lines::open(path, "RTKLIB solution")?;
     let mut out: Vec<PosEpoch> = Vec::new();
     while let Some(line) = lines.next_line()? {
         let l = line.text.trim();
-        if l.is_empty() || l.starts_with('%') {
+        if let Some(header) = l.strip_prefix('%') {
+            check_time_system(header, line.file, line.no)?;
+            continue;
+        }
+        if l.is_empty() {
             continue;
         }
         let (file, no) = (line.file, line.no);
