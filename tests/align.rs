@@ -211,3 +211,28 @@ fn a_jittered_clock_gives_the_uniform_mean_rates() {
     .unwrap();
     assert!((au.roll_deg - aj.roll_deg).abs() < 0.01 && (au.pitch_deg - aj.pitch_deg).abs() < 0.01);
 }
+
+/// A latitude the data at rest contradict is refused (radians given as degrees, a lost
+/// hemisphere sign); the true one and one a degree off are accepted.
+#[test]
+fn a_given_latitude_the_data_contradict_is_refused() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/psins-lasergyro/lasergyro.imu");
+    let log = sinsmodel::io::imu_stream::read_psins(&path).unwrap();
+    let run = |lat_deg: f64| {
+        align(
+            &log.imu,
+            Some(lat_deg * D),
+            None,
+            log.lon_deg * D,
+            log.h_m,
+            0.2 * D / 3600.0,
+        )
+    };
+    assert!(run(34.246).is_ok());
+    assert!(run(33.3).is_ok());
+    for wrong in [34.246f64.to_radians(), -34.246] {
+        let e = run(wrong).unwrap_err().to_string();
+        assert!(e.contains("--lat") && e.contains("σ away"), "{e}");
+    }
+}

@@ -234,6 +234,9 @@ pub fn align(
     }
     let (q0, used) = samples_at_rest(data, dt, lat, h, seconds)?;
     let (c, windows, lat_sigma) = coarse_on_quiet(&used, dt);
+    if let Some(given) = lat {
+        check_given_latitude(given, &c, lat_sigma, gyro_bias_sigma)?;
+    }
     let lat_used = lat.unwrap_or(c.lat);
     let north = north_seen(&c, lat, lat_used, gyro_bias_sigma);
     let (bias_sigma, no_heading) = (north.bias_sigma, north.no_heading);
@@ -404,6 +407,35 @@ struct North {
 
 /// What the gyros can say about north at latitude `lat_used` [rad] (`lat`: given) from the
 /// coarse alignment `c`, against the gyro-bias prior `gyro_bias_sigma` [rad/s].
+/// Refuses a given latitude [rad] that the data at rest contradict: where the gyros see the
+/// Earth rate's direction, the latitude they show (σ from the windows' scatter and the gyro
+/// bias) must be within 5 σ + 1° of it (radians given as degrees, a hemisphere's sign lost).
+fn check_given_latitude(
+    given: f64,
+    c: &Coarse,
+    lat_sigma: f64,
+    gyro_bias_sigma: f64,
+) -> anyhow::Result<()> {
+    let own = north_seen(c, None, c.lat, gyro_bias_sigma);
+    if own.no_heading {
+        return Ok(());
+    }
+    let sigma = lat_sigma.hypot(own.bias_sigma / crate::nav::earth::OMEGA);
+    let off = (given - c.lat).abs();
+    if off > 5.0 * sigma + 1f64.to_radians() {
+        anyhow::bail!(
+            "--lat {:.4} deg: the data at rest show a latitude of {:.4} ± {:.4} deg (the Earth-rate \
+             and gravity directions), {:.0} σ away: radians given as degrees, or the hemisphere's \
+             sign lost? (omit --lat to use the estimate)",
+            given.to_degrees(),
+            c.lat.to_degrees(),
+            sigma.to_degrees(),
+            off / sigma.max(f64::MIN_POSITIVE)
+        );
+    }
+    Ok(())
+}
+
 fn north_seen(c: &Coarse, lat: Option<f64>, lat_used: f64, gyro_bias_sigma: f64) -> North {
     // what the gyros can say about north: the horizontal Earth rate against the gyro bias. At
     // rest |ω̄| = |Ω + b|: above 2 Ω the bias is at least |ω̄| − Ω (≥ Ω) and the prior is
