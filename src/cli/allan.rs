@@ -52,6 +52,18 @@ pub fn run(args: &AllanArgs) -> Result<()> {
             args.src.imu.display()
         );
     }
+    if let Some(p) = allan::gravity_problem(&span) {
+        if !args.force {
+            anyhow::bail!(
+                "--imu {}: {p}; `sinsmodel imu-check` shows what was read; --force runs anyway",
+                args.src.imu.display()
+            );
+        }
+        eprintln!(
+            "warning: --imu {}: {p} (--force given)",
+            args.src.imu.display()
+        );
+    }
     let seen = allan::check_span(&span, dt);
     print_span_check(&seen, dt);
     let curves = allan::six_channels(&span, dt, seen.resamples());

@@ -205,6 +205,31 @@ pub const CHANNELS: [&str; 6] = [
 /// uniform grid before the Allan deviation.
 pub const RESAMPLE_JITTER: f64 = 1e-6;
 
+/// Why the specific force of `span` cannot be a sensor's on Earth: its mean over the span
+/// (Σ Δv / Σ Δt) beyond 0.7–1.3 g, which gravity alone gives at rest and a vehicle's
+/// accelerations barely move on average (an accelerometer unit or scale read wrongly, ms read
+/// as s). None when plausible or the span has no duration.
+pub fn gravity_problem(span: &ImuData) -> Option<String> {
+    let first = span.samples.first()?;
+    let last = span.samples.last()?;
+    // the first sample's increment spans the time before it: from its time on, sum the rest
+    let dv: nalgebra::Vector3<f64> = span.samples.iter().skip(1).map(|s| s.dv).sum();
+    let dt = last.t - first.t;
+    if dt.is_nan() || dt <= 0.0 {
+        return None;
+    }
+    let g = crate::io::units::STANDARD_GRAVITY;
+    let f = dv.norm() / dt / g;
+    (!(0.7..=1.3).contains(&f)).then(|| {
+        format!(
+            "the mean specific force over the span is {} g (gravity gives 1 g at rest): an \
+             accelerometer unit or scale read wrongly (g as m/s², a header's scale), or the clock \
+             (ms read as s)",
+            crate::io::units::sig3(f)
+        )
+    })
+}
+
 /// The samples from `skip_s` [s] after the first sample, for at most `seconds` [s] (to the end
 /// when None).
 pub fn span(data: &ImuData, skip_s: f64, seconds: Option<f64>) -> ImuData {
@@ -330,6 +355,25 @@ pub fn report(curves: &[AllanCurve], dt: f64) -> AllanReport {
 mod tests {
     use super::*;
     use crate::sim::rng::Rng;
+
+    #[test]
+    fn a_specific_force_far_from_gravity_is_a_unit_slip() {
+        let at_rest = |scale: f64, dt: f64| ImuData {
+            samples: (0..200)
+                .map(|k| crate::io::imu::ImuSample {
+                    t: k as f64 * dt,
+                    dtheta: nalgebra::Vector3::zeros(),
+                    dv: nalgebra::Vector3::new(0.0, 0.0, -9.80665 * 0.01 * scale),
+                })
+                .collect(),
+        };
+        assert!(gravity_problem(&at_rest(1.0, 0.01)).is_none());
+        // the increments read in g instead of m/s², and the clock in ms read as s
+        let e = gravity_problem(&at_rest(1.0 / 9.80665, 0.01)).unwrap();
+        assert!(e.contains("0.102 g"), "{e}");
+        let e = gravity_problem(&at_rest(1.0, 10.0)).unwrap();
+        assert!(e.contains("0.001 g") && e.contains("ms read as s"), "{e}");
+    }
 
     #[test]
     fn white_noise_and_random_walk_of_known_level_are_recovered() {
