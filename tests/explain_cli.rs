@@ -540,3 +540,64 @@ fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// On the shared drive with the time offset withheld (`--candidates 'lever_*'`), the antenna
+/// lever arm that takes up speed × offset in the turns is not presented as a cause: a withheld
+/// GNSS term tried in its place (dt_gnss) fits the data at least as well, and the finding says
+/// so with the offset.
+#[test]
+fn a_lever_arm_standing_in_for_a_withheld_time_offset_says_so() {
+    let d = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/gnss-imu-drive");
+    let out = tmp("mems-lever");
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P28+vertical",
+        "--imu",
+        &format!("{d}/imu_1934.csv"),
+        "--aid",
+        &format!("{d}/gnss_1934_sf.pos"),
+        "--init",
+        "40.0966268,-105.1474483,1601.476,-178.192,6.687,-181.028",
+        "--mode",
+        "closed",
+        "--noise",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/docs/real-data/mems_static_allan.json"
+        ),
+        "--prior",
+        "eps_*=0.5 deg/s",
+        "--prior",
+        "nabla_*=0.5 m/s^2",
+        "--prior",
+        "phi_n=2 deg",
+        "--prior",
+        "phi_e=2 deg",
+        "--prior",
+        "phi_d=10 deg",
+        "--candidates",
+        "lever_*",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let v = json(&out.join("explain.json"));
+    let findings = v["findings"].as_array().unwrap();
+    let lever_x = findings
+        .iter()
+        .find(|f| f["term"] == "lever_x")
+        .unwrap_or_else(|| panic!("lever_x not fitted: {stderr}"));
+    let why = lever_x["stand_in"].as_str().unwrap_or_else(|| {
+        panic!("lever_x presented as a cause: {lever_x}");
+    });
+    assert!(why.contains("dt_gnss") && why.contains(" ms "), "{why}");
+    for f in findings.iter().filter(|f| f["kind"] != "noise") {
+        assert!(
+            !f["stand_in"].is_null(),
+            "{} named as a cause: {stderr}",
+            f["term"]
+        );
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}

@@ -419,7 +419,14 @@ pub fn explain(
     // which findings are causes, judged on the rounds' extended pass; the causes' values then
     // come from the model they recommend, without the stand-ins (a stand-in beside a cause
     // takes part of its value)
-    let judged = complete_findings(ctx, &r, excess, None)?;
+    let mut judged = complete_findings(ctx, &r, excess, None)?;
+    // a GNSS cause that a GNSS term withheld from the candidates fits as well may stand in for it
+    let rivals = withheld_rivals(ctx, &r, &judged, &cands, progress)?;
+    for (f, rival) in judged.iter_mut().zip(&rivals) {
+        if let Some(why) = rival {
+            f.stand_in = Some(joined(f.stand_in.take(), Some(why.clone())).unwrap_or_default());
+        }
+    }
     let r = without_stand_ins(ctx, r, &judged, progress)?;
     let (noise_findings, noise_pass) = noise::stage(ctx, &r, &base_stats, progress)?;
     // the extended pass is the last one run (the baseline itself when nothing was found)
@@ -428,14 +435,14 @@ pub fn explain(
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
     // (complete_findings gives one finding per named term, in order)
-    for ((f, j), n) in findings.iter_mut().zip(judged).zip(&r.named) {
+    for (((f, j), n), rival) in findings.iter_mut().zip(judged).zip(&r.named).zip(rivals) {
         if !j.is_cause() {
             // a stand-in keeps the value it was fitted with; its words say what is left now
             *f = j;
-            f.stand_in = f
-                .stand_in
-                .as_ref()
-                .and(stand_in_reason(f, misfit_unexplained, ctx.opts));
+            f.stand_in = f.stand_in.as_ref().and(joined(
+                stand_in_reason(f, misfit_unexplained, ctx.opts),
+                rival,
+            ));
             let t = n.term;
             let info = &common::TERMS[t];
             f.words = finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
@@ -483,6 +490,71 @@ pub fn explain(
     };
     expl.summary = summary(&expl);
     Ok(expl)
+}
+
+/// Two optional reasons as one (joined by "; ").
+fn joined(a: Option<String>, b: Option<String>) -> Option<String> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    }
+}
+
+/// For each cause among `judged` (one per named term of `r`) that is a GNSS term, the GNSS
+/// library terms withheld from the candidates `cands` are tried in its place, one filter pass
+/// each: when one fits the data as well (log-likelihood within 2 of the rounds' model), the
+/// finding may stand in for it (a body-x lever arm moves the fixes in turns as speed × a time
+/// offset does), and its reason says which, with the value. None where no rival fits.
+fn withheld_rivals(
+    ctx: &Context,
+    r: &Rounds,
+    judged: &[Finding],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Vec<Option<String>>> {
+    let l_named = r.pass.stats.loglik;
+    let mut out = vec![None; judged.len()];
+    for (k, (f, n)) in judged.iter().zip(&r.named).enumerate() {
+        let info = &common::TERMS[n.term];
+        if !f.is_cause() || info.sensor != Sensor::Gnss {
+            continue;
+        }
+        let rivals = (0..common::TERMS.len()).filter(|&w| {
+            common::TERMS[w].sensor == Sensor::Gnss
+                && !cands.contains(&w)
+                && !r.model.states.contains(&StateRef::Term(w))
+        });
+        for w in rivals {
+            let rival = &common::TERMS[w];
+            let name: Vec<&str> = r
+                .model
+                .name
+                .split('+')
+                .map(|p| if p == info.name { rival.name } else { p })
+                .collect();
+            let m = Model::parse(&name.join("+"))?;
+            let cfg = ctx.extended_config(&m, &r.widened)?;
+            let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
+            let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {
+                continue;
+            };
+            if p.stats.loglik >= l_named - 2.0 {
+                out[k] = Some(format!(
+                    "{} ({}; not a candidate here) in its place fits the data {}: {} = {} {} gives a log-likelihood {} against {}; offer it as a candidate to tell them apart",
+                    rival.name,
+                    rival.doc,
+                    if p.stats.loglik > l_named + 2.0 { "better" } else { "as well" },
+                    rival.name,
+                    sig3(last.x[i] / rival.display_to_si),
+                    rival.display,
+                    sig3(p.stats.loglik),
+                    sig3(l_named)
+                ));
+                break;
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The instrument terms of `baseline` whose final estimate in `run` (a pass of `model`, the
