@@ -383,10 +383,26 @@ fn rlg_static_explain(out: &std::path::Path) -> Vec<String> {
     .to_vec()
 }
 
+/// explain on the shared MEMS drive as `docs/explain.md` §2 runs it, with `extra` options, into
+/// `out`: (success, stdout, stderr).
+fn mems_drive_explain(out: &std::path::Path, extra: &[&str]) -> (bool, String, String) {
+    let d = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/gnss-imu-drive");
+    let (imu, pos) = (format!("{d}/imu_1934.csv"), format!("{d}/gnss_1934_sf.pos"));
+    let noise = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/docs/real-data/mems_static_allan.json"
+    );
+    let mut args = vec!["explain", "--model", "P28+vertical", "--imu", &imu];
+    args.extend(["--aid", &pos, "--noise", noise]);
+    args.extend(common::MEMS_DRIVE_START_AND_PRIORS);
+    args.extend(extra);
+    args.extend(["--out", out.to_str().unwrap()]);
+    sinsmodel(&args)
+}
+
 /// Both measured sets (docs/explain.md): only what is stable is asserted.
 #[test]
 fn measured_data() {
-    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
     let out = tmp("rlg");
     let mut args = rlg_static_explain(&out);
     args.extend([
@@ -407,38 +423,8 @@ fn measured_data() {
     }
     std::fs::remove_dir_all(&out).unwrap();
 
-    let d = format!("{shared}/gnss-imu-drive");
     let out = tmp("mems");
-    let (ok, _, stderr) = sinsmodel(&[
-        "explain",
-        "--model",
-        "P28+vertical",
-        "--imu",
-        &format!("{d}/imu_1934.csv"),
-        "--aid",
-        &format!("{d}/gnss_1934_sf.pos"),
-        "--init",
-        "40.0966268,-105.1474483,1601.476,-178.192,6.687,-181.028",
-        "--mode",
-        "closed",
-        "--noise",
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/docs/real-data/mems_static_allan.json"
-        ),
-        "--prior",
-        "eps_*=0.5 deg/s",
-        "--prior",
-        "nabla_*=0.5 m/s^2",
-        "--prior",
-        "phi_n=2 deg",
-        "--prior",
-        "phi_e=2 deg",
-        "--prior",
-        "phi_d=10 deg",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, _, stderr) = mems_drive_explain(&out, &[]);
     assert!(ok, "{stderr}");
     let v = json(&out.join("explain.json"));
     // the MEMS baseline does not explain the drive (NIS well above 1) and whatever explain
@@ -547,40 +533,8 @@ fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
 /// so with the offset.
 #[test]
 fn a_lever_arm_standing_in_for_a_withheld_time_offset_says_so() {
-    let d = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/gnss-imu-drive");
     let out = tmp("mems-lever");
-    let (ok, _, stderr) = sinsmodel(&[
-        "explain",
-        "--model",
-        "P28+vertical",
-        "--imu",
-        &format!("{d}/imu_1934.csv"),
-        "--aid",
-        &format!("{d}/gnss_1934_sf.pos"),
-        "--init",
-        "40.0966268,-105.1474483,1601.476,-178.192,6.687,-181.028",
-        "--mode",
-        "closed",
-        "--noise",
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/docs/real-data/mems_static_allan.json"
-        ),
-        "--prior",
-        "eps_*=0.5 deg/s",
-        "--prior",
-        "nabla_*=0.5 m/s^2",
-        "--prior",
-        "phi_n=2 deg",
-        "--prior",
-        "phi_e=2 deg",
-        "--prior",
-        "phi_d=10 deg",
-        "--candidates",
-        "lever_*",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, _, stderr) = mems_drive_explain(&out, &["--candidates", "lever_*"]);
     assert!(ok, "{stderr}");
     let v = json(&out.join("explain.json"));
     let findings = v["findings"].as_array().unwrap();

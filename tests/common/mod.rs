@@ -48,3 +48,24 @@ pub fn check_golden(name: &str, actual: &str) {
         );
     }
 }
+
+#[allow(dead_code)]
+/// The options `docs/explain.md` §2 gives explain on the shared MEMS drive after the files: the
+/// start from the drive-off, closed loop, and the MEMS priors (the caller adds `--model`,
+/// `--imu`, `--aid`, `--noise` and `--out`).
+pub const MEMS_DRIVE_START_AND_PRIORS: [&str; 14] = [
+    "--init",
+    "40.0966268,-105.1474483,1601.476,-178.192,6.687,-181.028",
+    "--mode",
+    "closed",
+    "--prior",
+    "eps_*=0.5 deg/s",
+    "--prior",
+    "nabla_*=0.5 m/s^2",
+    "--prior",
+    "phi_n=2 deg",
+    "--prior",
+    "phi_e=2 deg",
+    "--prior",
+    "phi_d=10 deg",
+];
