@@ -262,3 +262,25 @@ fn rtklib_times_in_utc_are_refused() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A time-tag file cut short is refused (its early records alone put the clock seconds late),
+/// naming how much of the log it covers.
+#[test]
+fn a_truncated_time_tag_file_is_refused() {
+    let dir = std::env::temp_dir().join(format!("sinsmodel-tag-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("imu_1934.csv");
+    std::fs::copy(data("gnss-imu-drive/imu_1934.csv"), &csv).unwrap();
+    let tag = std::fs::read(data("gnss-imu-drive/imu_1934.csv.tag")).unwrap();
+    // the 76-byte header and the first half of the 8-byte records
+    let half = 76 + (tag.len() - 76) / 16 * 8;
+    std::fs::write(dir.join("imu_1934.csv.tag"), &tag[..half]).unwrap();
+    let e = format!("{:#}", gnss_imu::read(&csv).unwrap_err());
+    assert!(
+        e.contains("truncated time-tag file") && e.contains("--clock-offset"),
+        "{e}"
+    );
+    std::fs::write(dir.join("imu_1934.csv.tag"), &tag).unwrap();
+    assert!(gnss_imu::read(&csv).is_ok());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -206,5 +206,21 @@ fn clock_offset(tag: &Tag, path: &Path, rows: &[([f64; 7], usize)]) -> Result<f6
     if !best.is_finite() {
         bail!("{}: no record covers a complete IMU line", path.display());
     }
+    // the logger tags the file as it grows: records that stop well before the log's end are a
+    // truncated tag file, whose least-latency bound comes from its early part only (a clock
+    // seconds late)
+    let (last_tagged, log_end) = (
+        tag.records.last().map_or(0, |r| r.1),
+        rows.last().map_or(0, |r| r.1),
+    );
+    if (last_tagged as f64) < 0.95 * log_end as f64 {
+        bail!(
+            "{}: its records end at byte {last_tagged} of the {log_end}-byte log ({:.0} %): a \
+             truncated time-tag file gives a clock offset from the log's start only; use the whole \
+             .tag, or give --clock-offset SECONDS (GPST - IMU clock)",
+            path.display(),
+            100.0 * last_tagged as f64 / log_end.max(1) as f64
+        );
+    }
     Ok(best)
 }
