@@ -1,7 +1,7 @@
 //! No output path removes or replaces a file the run cannot prove it wrote: run directories
 //! need a marker that lists their files, the sweep of killed runs' leftovers takes only this
 //! crate's temporaries, single-file outputs replace only their own command's earlier output
-//! (else `--force`), and a SIGINT/SIGTERM or a file-size limit leaves no half-written output.
+//! (else `--overwrite`), and a SIGINT/SIGTERM or a file-size limit leaves no half-written output.
 
 mod common;
 
@@ -47,7 +47,7 @@ fn navigate(imu: &str, out: &Path, force: bool) -> (bool, String) {
     let out = out.to_str().unwrap();
     a.push(out);
     if force {
-        a.push("--force");
+        a.push("--overwrite");
     }
     run(&a)
 }
@@ -194,7 +194,7 @@ fn the_sweep_of_leftovers_never_takes_a_users_file() {
 
 /// Single-file outputs: another run's listed result or a file not provably this command's
 /// earlier output is refused (nothing changed); the command's own earlier output is replaced;
-/// --force replaces anything.
+/// --overwrite replaces anything.
 #[test]
 fn single_file_outputs_replace_only_their_own_earlier_output() {
     let dir = tempfile::tempdir().unwrap();
@@ -211,7 +211,7 @@ fn single_file_outputs_replace_only_their_own_earlier_output() {
         "{err}"
     );
     assert_eq!(std::fs::read(o.join("truth.txt")).unwrap(), truth_before);
-    // onto a user's file; then its own earlier output; then --force
+    // onto a user's file; then its own earlier output; then --overwrite
     let mine = d.join("nav.txt");
     std::fs::write(&mine, "my trajectory\n").unwrap();
     let (ok, err) = nav(&mine, false);
@@ -219,6 +219,14 @@ fn single_file_outputs_replace_only_their_own_earlier_output() {
         !ok && err.contains("not provably an earlier output"),
         "{err}"
     );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my trajectory\n");
+    // --force runs past the data checks only: it replaces no file
+    let out = mine.to_str().unwrap();
+    let (ok, err) = run(&[
+        "navigate", "--imu", imu, "--lat", "30", "--lon", "110", "--att", "0,0,0", "--out", out,
+        "--force",
+    ]);
+    assert!(!ok && err.contains("give --overwrite"), "{err}");
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my trajectory\n");
     let (ok, err) = nav(&mine, true);
     assert!(ok, "{err}");
@@ -274,7 +282,7 @@ fn single_file_outputs_replace_only_their_own_earlier_output() {
             prefix.to_str().unwrap(),
         ];
         if force {
-            a.push("--force");
+            a.push("--overwrite");
         }
         run(&a)
     };
@@ -457,7 +465,7 @@ fn a_run_directory_is_replaced_only_by_its_own_command_and_as_it_was() {
 }
 
 /// What a reader opens beside the IMU file (a GNSS_IMU csv's `.tag`) is an input: no output
-/// replaces it, not even with --force.
+/// replaces it, not even with --overwrite.
 #[test]
 fn the_clock_file_beside_a_csv_is_an_input() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
@@ -482,7 +490,7 @@ fn the_clock_file_beside_a_csv_is_an_input() {
         d.join("imu_1934.csv").to_str().unwrap(),
         "--json",
         tag.to_str().unwrap(),
-        "--force",
+        "--overwrite",
     ]);
     assert!(!ok && err.contains("is an input of this run"), "{err}");
     assert_eq!(std::fs::read(&tag).unwrap(), before);

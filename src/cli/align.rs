@@ -32,8 +32,8 @@ pub struct AlignArgs {
     json: Option<PathBuf>,
     /// Replace an existing output file that is not provably this command's earlier output (or
     /// that a sinsmodel run directory lists as its result).
-    #[arg(long)]
-    force: bool,
+    #[arg(long, alias = "force")]
+    overwrite: bool,
 }
 
 /// Runs the command.
@@ -41,7 +41,7 @@ pub fn run(args: &AlignArgs) -> Result<()> {
     check_args(args)?;
     if let Some(j) = &args.json {
         args.src
-            .check_output("--json", j, Provenance::Json("align"), args.force)?;
+            .check_output("--json", j, Provenance::Json("align"), args.overwrite)?;
     }
     let data = args.src.read(&mut super::data::note)?;
     let d = std::f64::consts::PI / 180.0;

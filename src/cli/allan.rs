@@ -29,6 +29,9 @@ pub struct AllanArgs {
     /// Replace an existing output file that is not provably this command's earlier output (or
     /// that a sinsmodel run directory lists as its result).
     #[arg(long)]
+    overwrite: bool,
+    /// Run even when the span's mean specific force is not near 1 g (a unit or clock slip).
+    #[arg(long)]
     force: bool,
 }
 
@@ -90,7 +93,7 @@ pub fn run(args: &AllanArgs) -> Result<()> {
 fn check_outputs(args: &AllanArgs) -> Result<()> {
     if let Some(j) = &args.json {
         args.src
-            .check_output("--json", j, Provenance::Json("allan"), args.force)?;
+            .check_output("--json", j, Provenance::Json("allan"), args.overwrite)?;
     }
     if let Some(p) = prefix_shown(args) {
         // the prefix names files in a directory: not a device or a special path
@@ -108,7 +111,7 @@ fn check_outputs(args: &AllanArgs) -> Result<()> {
         for suffix in ["gyro", "accel"] {
             let png = plot_path(&p, suffix);
             args.src
-                .check_output("--plot", &png, Provenance::Png, args.force)?;
+                .check_output("--plot", &png, Provenance::Png, args.overwrite)?;
         }
     }
     Ok(())

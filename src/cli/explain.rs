@@ -22,6 +22,9 @@ pub struct ExplainArgs {
     model: Option<String>,
     #[command(flatten)]
     data: DataArgs,
+    /// Replace a --json file that is not provably an earlier explain output.
+    #[arg(long)]
+    overwrite: bool,
     /// Candidate terms: names and prefix groups (`kaq_*,kas_y,d_*`); default every spec term
     /// the baseline lacks. `!name` or `!prefix*` withholds (`!size_*,!tau_*`: every term but
     /// those).
@@ -90,7 +93,7 @@ fn check_json_option(args: &ExplainArgs, j: &Path) -> Result<()> {
             );
         }
     }
-    check_json(j, args.data.force)
+    check_json(j, args.overwrite)
 }
 
 /// explain on the data the options name: the candidates checked against the aiding, every
@@ -164,14 +167,14 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// Refuses a `--json` file that is not provably an earlier explain output (unless `force`).
-fn check_json(j: &Path, force: bool) -> Result<()> {
+/// Refuses a `--json` file that is not provably an earlier explain output (unless `overwrite`).
+fn check_json(j: &Path, overwrite: bool) -> Result<()> {
     atomic_file::check_output_file(
         "--json",
         j,
         &[],
         atomic_file::Provenance::Json("explain"),
-        force,
+        overwrite,
     )
 }
 
@@ -259,7 +262,7 @@ fn finish(
     out.commit()?;
     if let Some(j) = &args.json {
         // checked again: the file may have been replaced while the run worked
-        check_json(j, args.data.force)?;
+        check_json(j, args.overwrite)?;
         atomic_file::write_text(j, &text)?;
     }
     for line in &e.summary {

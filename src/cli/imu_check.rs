@@ -30,8 +30,8 @@ pub struct ImuCheckArgs {
     json: Option<PathBuf>,
     /// Replace an existing output file that is not provably this command's earlier output (or
     /// that a sinsmodel run directory lists as its result).
-    #[arg(long)]
-    force: bool,
+    #[arg(long, alias = "force")]
+    overwrite: bool,
 }
 
 /// Runs the command.
@@ -39,7 +39,7 @@ pub fn run(args: &ImuCheckArgs) -> Result<()> {
     check_args(args)?;
     if let Some(j) = &args.json {
         args.src
-            .check_output("--json", j, Provenance::Json("imu-check"), args.force)?;
+            .check_output("--json", j, Provenance::Json("imu-check"), args.overwrite)?;
     }
     let data = args.src.read(&mut super::data::note)?;
     let c = imu_check::check(

@@ -44,10 +44,13 @@ pub struct NavigateArgs {
     /// Output file (truth layout of DESIGN §9).
     #[arg(long)]
     out: PathBuf,
-    /// Run even when --att's roll and pitch contradict the measured gravity direction, and
-    /// replace an --out file that is not provably an earlier `navigate` output.
+    /// Run even when --att's roll and pitch contradict the measured gravity direction, or the
+    /// first seconds' magnitudes look like a unit slip.
     #[arg(long)]
     force: bool,
+    /// Replace an --out file that is not provably an earlier `navigate` output.
+    #[arg(long)]
+    overwrite: bool,
     /// Read the whole IMU file before navigating (the pre-streaming path, kept as the baseline
     /// `sinsmodel bench` measures the stream against).
     #[arg(long, hide = true)]
@@ -62,7 +65,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
             "--out",
             &args.out,
             sinsmodel::io::atomic_file::Provenance::Text("navigate"),
-            args.force,
+            args.overwrite,
         )
     };
     check_out()?;

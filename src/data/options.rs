@@ -58,17 +58,17 @@ impl ImuSource {
     }
 
     /// Refuses an output file that is one of the inputs or not a regular file, and (unless
-    /// `force`) one that is another run's result or not provably this command's earlier output.
+    /// `overwrite`) one that is another run's result or not provably this command's earlier output.
     pub fn check_output(
         &self,
         option: &str,
         path: &Path,
         provenance: crate::io::atomic_file::Provenance,
-        force: bool,
+        overwrite: bool,
     ) -> Result<()> {
         let inputs = self.paths();
         let refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-        crate::io::atomic_file::check_output_file(option, path, &refs, provenance, force)
+        crate::io::atomic_file::check_output_file(option, path, &refs, provenance, overwrite)
     }
 }
 
@@ -150,8 +150,9 @@ pub struct DataOptions {
     /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
     #[cfg_attr(feature = "cli", arg(long))]
     pub zupt: Option<f64>,
-    /// Run even when the initial roll and pitch contradict the measured gravity direction; with
-    /// explain, also replace a --json file that is not provably an earlier explain output.
+    /// Run even when the initial roll and pitch contradict the measured gravity direction or the
+    /// first seconds' magnitudes look like a unit slip (outputs are replaced only with
+    /// `--overwrite`).
     #[cfg_attr(feature = "cli", arg(long))]
     pub force: bool,
     /// Sensor grade the priors and noise assume: navigation (the spec's defaults), tactical or

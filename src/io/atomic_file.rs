@@ -663,7 +663,7 @@ fn refuse_mat_variable_name(option: &str, path: &Path) -> Result<()> {
 }
 
 /// What proves that an existing single-file output is this command's earlier result, so that a
-/// run may replace it: anything else is refused without `--force`.
+/// run may replace it: anything else is refused without `--overwrite`.
 #[derive(Debug, Clone, Copy)]
 pub enum Provenance {
     /// A JSON object whose `written_by` is `sinsmodel COMMAND` (see [`with_written_by`]).
@@ -805,7 +805,8 @@ pub fn png_with_text(bytes: &[u8], keyword: &str, text: &str) -> Option<Vec<u8>>
 }
 
 /// Refuses an output file `path` (named by `option` in the message) that is one of `inputs`
-/// (also through a link) or exists as something other than a regular file; and, unless `force`,
+/// (also through a link) or exists as something other than a regular file; and, unless
+/// `overwrite` (the `--overwrite` option),
 /// one that a sinsmodel run directory's [`RUN_MARKER`] lists (another run's result) or that is
 /// not provably this command's earlier output (`provenance`; an empty file holds nothing to
 /// lose). Call it before the computation.
@@ -814,13 +815,13 @@ pub fn check_output_file(
     path: &Path,
     inputs: &[&Path],
     provenance: Provenance,
-    force: bool,
+    overwrite: bool,
 ) -> Result<()> {
     check_output_path(option, path, inputs)?;
     let Ok(meta) = std::fs::metadata(path) else {
         return Ok(());
     };
-    if force {
+    if overwrite {
         return Ok(());
     }
     let dir = match path.parent() {
@@ -830,7 +831,7 @@ pub fn check_output_file(
     if let (Ok(listed), Some(name)) = (run_listing(dir), path.file_name()) {
         if listed.iter().any(|l| std::ffi::OsStr::new(l) == name) {
             anyhow::bail!(
-                "{option} {}: is a result of the sinsmodel run in {} (its {RUN_MARKER} lists it); replacing it would change that run's outputs. Choose another path, or give --force to replace it",
+                "{option} {}: is a result of the sinsmodel run in {} (its {RUN_MARKER} lists it); replacing it would change that run's outputs. Choose another path, or give --overwrite to replace it",
                 path.display(),
                 dir.display()
             );
@@ -839,7 +840,7 @@ pub fn check_output_file(
     if meta.len() > 0 {
         if let Some(why) = provenance.lacking(path) {
             anyhow::bail!(
-                "{option} {}: exists and is not provably an earlier output of this command ({why}); nothing is overwritten: choose another path, or give --force to replace it",
+                "{option} {}: exists and is not provably an earlier output of this command ({why}); nothing is overwritten: choose another path, or give --overwrite to replace it",
                 path.display()
             );
         }
