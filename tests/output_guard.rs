@@ -228,6 +228,14 @@ fn single_file_outputs_replace_only_their_own_earlier_output() {
     ]);
     assert!(!ok && err.contains("give --overwrite"), "{err}");
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my trajectory\n");
+    // align's and imu-check's --force used to mean --overwrite: refused, naming it
+    let j0 = d.join("user.json");
+    std::fs::write(&j0, "{\"mine\": 0}").unwrap();
+    for cmd in ["align", "imu-check"] {
+        let (ok, err) = run(&[cmd, "--imu", imu, "--json", j0.to_str().unwrap(), "--force"]);
+        assert!(!ok && err.contains("give --overwrite"), "{cmd}: {err}");
+        assert_eq!(std::fs::read_to_string(&j0).unwrap(), "{\"mine\": 0}");
+    }
     let (ok, err) = nav(&mine, true);
     assert!(ok, "{err}");
     let (ok, err) = nav(&mine, false);

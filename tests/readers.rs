@@ -252,7 +252,11 @@ fn rtklib_times_in_utc_are_refused() {
     assert!(rtklib::read(&src).is_ok());
     let dir = std::env::temp_dir().join(format!("sinsmodel-utc-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for (sys, early) in [("UTC", "18 s early"), ("JST", "9 h 18 s early")] {
+    for (sys, early) in [
+        ("UTC", "18 s early"),
+        ("JST", "9 h 18 s early"),
+        ("utc", "18 s early"),
+    ] {
         let p = dir.join(format!("{sys}.pos"));
         std::fs::write(&p, text.replacen("%  GPST", &format!("%  {sys} "), 1)).unwrap();
         let e = rtklib::read(&p).unwrap_err().to_string();
@@ -281,6 +285,11 @@ fn a_truncated_time_tag_file_is_refused() {
         "{e}"
     );
     std::fs::write(dir.join("imu_1934.csv.tag"), &tag).unwrap();
+    assert!(gnss_imu::read(&csv).is_ok());
+    // zero padding after the records is no truncation
+    let mut padded = tag.clone();
+    padded.extend([0u8; 800]);
+    std::fs::write(dir.join("imu_1934.csv.tag"), &padded).unwrap();
     assert!(gnss_imu::read(&csv).is_ok());
     std::fs::remove_dir_all(&dir).ok();
 }

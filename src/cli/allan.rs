@@ -68,6 +68,15 @@ pub fn run(args: &AllanArgs) -> Result<()> {
         );
     }
     let seen = allan::check_span(&span, dt);
+    // at rest |f| is local gravity, within 0.5 % of 1 g anywhere on Earth
+    match allan::mean_specific_force_g(&span) {
+        Some(f) if seen.moving == 0 && (f - 1.0).abs() > 0.03 => eprintln!(
+            "warning: --imu {}: at rest the mean specific force is {f:.4} g: an accelerometer scale {:+.1} % off (a header's scale?); the VRW and bias figures scale with it",
+            args.src.imu.display(),
+            100.0 * (f - 1.0)
+        ),
+        _ => {}
+    }
     print_span_check(&seen, dt);
     let curves = allan::six_channels(&span, dt, seen.resamples());
     let out = allan::report(&curves, dt);

@@ -30,12 +30,20 @@ pub struct ImuCheckArgs {
     json: Option<PathBuf>,
     /// Replace an existing output file that is not provably this command's earlier output (or
     /// that a sinsmodel run directory lists as its result).
-    #[arg(long, alias = "force")]
+    #[arg(long)]
     overwrite: bool,
+    /// The old name of --overwrite, refused: --force runs past data checks and replaces no file.
+    #[arg(long, hide = true)]
+    force: bool,
 }
 
 /// Runs the command.
 pub fn run(args: &ImuCheckArgs) -> Result<()> {
+    if args.force {
+        anyhow::bail!(
+            "--force replaces no file any more (it only runs past data checks): give --overwrite to replace --json"
+        );
+    }
     check_args(args)?;
     if let Some(j) = &args.json {
         args.src

@@ -65,6 +65,11 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("accel_bias_rw"), "{e}");
+        // a key given twice is refused, not the last one taken
+        let twice =
+            std::path::Path::new("arw=0.3 deg/sqrt(h), arw=3 deg/sqrt(h), vrw=1 ug/sqrt(Hz)");
+        let e = noise_from_allan(twice).unwrap_err().to_string();
+        assert!(e.contains("`arw` given twice"), "{e}");
     }
 
     #[test]

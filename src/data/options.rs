@@ -151,8 +151,7 @@ pub struct DataOptions {
     #[cfg_attr(feature = "cli", arg(long))]
     pub zupt: Option<f64>,
     /// Run even when the initial roll and pitch contradict the measured gravity direction or the
-    /// first seconds' magnitudes look like a unit slip (outputs are replaced only with
-    /// `--overwrite`).
+    /// first seconds' magnitudes look like a unit slip; it never replaces an output file.
     #[cfg_attr(feature = "cli", arg(long))]
     pub force: bool,
     /// Sensor grade the priors and noise assume: navigation (the spec's defaults), tactical or

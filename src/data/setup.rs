@@ -153,13 +153,16 @@ impl DataOptions {
                 vrw / crate::io::units::STANDARD_GRAVITY * 1e6
             ));
             let (g, a) = bias_rw_from_noise(path)?;
-            if g > 0.0 || a > 0.0 {
-                // rad/s/√s → deg/h/√h: × 180/π × 3600 × 60; m/s²/√s → µg/√s: ÷ g × 1e6
+            // rad/s/√s → deg/h/√h: × 180/π × 3600 × 60; m/s²/√s → µg/√s: ÷ g × 1e6
+            if g > 0.0 {
                 lines.push(format!(
-                    "bias random walk from --noise: gyro {:.3e} rad/s/sqrt(s) = {:.3} deg/h/sqrt(h), accelerometer {:.3e} m/s^2/sqrt(s) = {:.1} ug/sqrt(s)",
-                    g,
-                    g.to_degrees() * 3600.0 * 60.0,
-                    a,
+                    "gyro bias random walk from --noise: {g:.3e} rad/s/sqrt(s) = {:.3} deg/h/sqrt(h)",
+                    g.to_degrees() * 3600.0 * 60.0
+                ));
+            }
+            if a > 0.0 {
+                lines.push(format!(
+                    "accelerometer bias random walk from --noise: {a:.3e} m/s^2/sqrt(s) = {:.1} ug/sqrt(s)",
                     a / crate::io::units::STANDARD_GRAVITY * 1e6
                 ));
             }
@@ -395,7 +398,9 @@ fn noise_inline_all(text: &str) -> Result<[Option<f64>; 4]> {
                 v.trim()
             );
         }
-        *slot = Some(q);
+        if slot.replace(q).is_some() {
+            bail!("--noise: `{}` given twice", k.trim());
+        }
     }
     Ok([arw, vrw, grw, abrw])
 }

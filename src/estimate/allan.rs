@@ -210,16 +210,7 @@ pub const RESAMPLE_JITTER: f64 = 1e-6;
 /// accelerations barely move on average (an accelerometer unit or scale read wrongly, ms read
 /// as s). None when plausible or the span has no duration.
 pub fn gravity_problem(span: &ImuData) -> Option<String> {
-    let first = span.samples.first()?;
-    let last = span.samples.last()?;
-    // the first sample's increment spans the time before it: from its time on, sum the rest
-    let dv: nalgebra::Vector3<f64> = span.samples.iter().skip(1).map(|s| s.dv).sum();
-    let dt = last.t - first.t;
-    if dt.is_nan() || dt <= 0.0 {
-        return None;
-    }
-    let g = crate::io::units::STANDARD_GRAVITY;
-    let f = dv.norm() / dt / g;
+    let f = mean_specific_force_g(span)?;
     (!(0.7..=1.3).contains(&f)).then(|| {
         format!(
             "the mean specific force over the span is {} g (gravity gives 1 g at rest): an \
@@ -228,6 +219,20 @@ pub fn gravity_problem(span: &ImuData) -> Option<String> {
             crate::io::units::sig3(f)
         )
     })
+}
+
+/// The magnitude of the mean specific force over `span` (Σ Δv / Σ Δt) in standard gravities;
+/// None when the span has no duration.
+pub fn mean_specific_force_g(span: &ImuData) -> Option<f64> {
+    let first = span.samples.first()?;
+    let last = span.samples.last()?;
+    // the first sample's increment spans the time before it: from its time on, sum the rest
+    let dv: nalgebra::Vector3<f64> = span.samples.iter().skip(1).map(|s| s.dv).sum();
+    let dt = last.t - first.t;
+    if dt.is_nan() || dt <= 0.0 {
+        return None;
+    }
+    Some(dv.norm() / dt / crate::io::units::STANDARD_GRAVITY)
 }
 
 /// The samples from `skip_s` [s] after the first sample, for at most `seconds` [s] (to the end

@@ -210,7 +210,7 @@ fn clock_offset(tag: &Tag, path: &Path, rows: &[([f64; 7], usize)]) -> Result<f6
     // truncated tag file, whose least-latency bound comes from its early part only (a clock
     // seconds late)
     let (last_tagged, log_end) = (
-        tag.records.last().map_or(0, |r| r.1),
+        tag.records.iter().map(|r| r.1).max().unwrap_or(0),
         rows.last().map_or(0, |r| r.1),
     );
     if (last_tagged as f64) < 0.95 * log_end as f64 {

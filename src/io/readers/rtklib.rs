@@ -59,6 +59,8 @@ fn check_time_system(header: &str, file: &str, no: usize) -> Result<()> {
     if !(rest.contains("latitude") || rest.contains("ecef") || rest.contains("week")) {
         return Ok(());
     }
+    let upper = first.to_ascii_uppercase();
+    let first = upper.as_str();
     match first {
         "GPST" => Ok(()),
         "UTC" | "JST" => bail!(
@@ -69,7 +71,7 @@ fn check_time_system(header: &str, file: &str, no: usize) -> Result<()> {
             if first == "UTC" { "18 s early" } else { "9 h 18 s early" },
             if first == "JST" { "; JST = UTC + 9 h" } else { "" }
         ),
-        other if other.chars().all(|c| c.is_ascii_uppercase()) && other.len() <= 5 => bail!(
+        other if other.chars().all(|c| c.is_ascii_alphabetic()) && other.len() <= 5 => bail!(
             "{file}:{no}: unknown time system `{other}` in the column header (expected GPST)"
         ),
         _ => Ok(()),
