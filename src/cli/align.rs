@@ -41,11 +41,7 @@ pub struct AlignArgs {
 
 /// Runs the command.
 pub fn run(args: &AlignArgs) -> Result<()> {
-    if args.force {
-        anyhow::bail!(
-            "--force replaces no file any more (it only runs past data checks): give --overwrite to replace --json"
-        );
-    }
+    super::data::refuse_force_for_outputs(args.force)?;
     check_args(args)?;
     if let Some(j) = &args.json {
         args.src

@@ -55,7 +55,8 @@ pub fn run(args: &AllanArgs) -> Result<()> {
             args.src.imu.display()
         );
     }
-    if let Some(p) = allan::gravity_problem(&span) {
+    let f_g = allan::mean_specific_force_g(&span);
+    if let Some(p) = f_g.and_then(allan::gravity_problem) {
         if !args.force {
             anyhow::bail!(
                 "--imu {}: {p}; `sinsmodel imu-check` shows what was read; --force runs anyway",
@@ -68,14 +69,8 @@ pub fn run(args: &AllanArgs) -> Result<()> {
         );
     }
     let seen = allan::check_span(&span, dt);
-    // at rest |f| is local gravity, within 0.5 % of 1 g anywhere on Earth
-    match allan::mean_specific_force_g(&span) {
-        Some(f) if seen.moving == 0 && (f - 1.0).abs() > 0.03 => eprintln!(
-            "warning: --imu {}: at rest the mean specific force is {f:.4} g: an accelerometer scale {:+.1} % off (a header's scale?); the VRW and bias figures scale with it",
-            args.src.imu.display(),
-            100.0 * (f - 1.0)
-        ),
-        _ => {}
+    if let Some(w) = f_g.and_then(|f| allan::scale_off_at_rest(f, seen.moving == 0)) {
+        eprintln!("warning: --imu {}: {w}", args.src.imu.display());
     }
     print_span_check(&seen, dt);
     let curves = allan::six_channels(&span, dt, seen.resamples());

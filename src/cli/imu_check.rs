@@ -39,11 +39,7 @@ pub struct ImuCheckArgs {
 
 /// Runs the command.
 pub fn run(args: &ImuCheckArgs) -> Result<()> {
-    if args.force {
-        anyhow::bail!(
-            "--force replaces no file any more (it only runs past data checks): give --overwrite to replace --json"
-        );
-    }
+    super::data::refuse_force_for_outputs(args.force)?;
     check_args(args)?;
     if let Some(j) = &args.json {
         args.src

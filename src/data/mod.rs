@@ -12,7 +12,7 @@ mod start;
 pub use aid::{AidPlan, Outage};
 pub use dataset::{check_inside, Dataset, PassInputs, DEFAULT_STEP_S};
 pub use options::{open_imu, DataOptions, ImuSource};
-pub use setup::{apply_opened, bias_rw_from_noise, noise_from_allan};
+pub use setup::{apply_opened, noise_given, NoiseGiven};
 
 #[cfg(test)]
 mod tests {
@@ -48,18 +48,21 @@ mod tests {
         let p = std::path::Path::new(
             "arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz), gyro_bias_rw=10 deg/h/sqrt(h)",
         );
-        let (g, a) = bias_rw_from_noise(p).unwrap();
+        let n = noise_given(p).unwrap();
         let want = 10.0f64.to_radians() / 3600.0 / 60.0;
-        assert!((g / want - 1.0).abs() < 1e-12, "{g} vs {want}");
-        assert_eq!(a, 0.0);
-        assert_eq!(noise_from_allan(p).unwrap().0, 0.3f64.to_radians() / 60.0);
+        assert!(
+            (n.gyro_bias_rw / want - 1.0).abs() < 1e-12,
+            "{n:?} vs {want}"
+        );
+        assert_eq!(n.accel_bias_rw, 0.0);
+        assert_eq!(n.arw, 0.3f64.to_radians() / 60.0);
         // 10 rad/s/√s is a unit slip (deg/h read as rad/s): refused, naming the option
         let bad = std::path::Path::new(
             "arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz), gyro_bias_rw=10 rad/s/sqrt(s)",
         );
-        let e = bias_rw_from_noise(bad).unwrap_err().to_string();
+        let e = noise_given(bad).unwrap_err().to_string();
         assert!(e.contains("--noise gyro_bias_rw"), "{e}");
-        let e = bias_rw_from_noise(std::path::Path::new(
+        let e = noise_given(std::path::Path::new(
             "arw=1 deg/sqrt(h), vrw=1 ug/sqrt(Hz), accel_bias_rw=3 deg",
         ))
         .unwrap_err()
@@ -68,7 +71,7 @@ mod tests {
         // a key given twice is refused, not the last one taken
         let twice =
             std::path::Path::new("arw=0.3 deg/sqrt(h), arw=3 deg/sqrt(h), vrw=1 ug/sqrt(Hz)");
-        let e = noise_from_allan(twice).unwrap_err().to_string();
+        let e = noise_given(twice).unwrap_err().to_string();
         assert!(e.contains("`arw` given twice"), "{e}");
     }
 

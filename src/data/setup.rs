@@ -141,7 +141,12 @@ impl DataOptions {
             ));
         }
         if let Some(path) = &self.noise {
-            let (arw, vrw) = noise_from_allan(path)?;
+            let NoiseGiven {
+                arw,
+                vrw,
+                gyro_bias_rw: g,
+                accel_bias_rw: a,
+            } = noise_given(path)?;
             // rad/√s → deg/√h: × 180/π × 60; m/s/√s → µg/√Hz: ÷ g × 1e6
             lines.push(format!(
                 "noise from {} (used{}): ARW {:.3e} rad/sqrt(s) = {:.3} deg/sqrt(h), VRW {:.3e} m/s/sqrt(s) = {:.0} ug/sqrt(Hz)",
@@ -152,7 +157,6 @@ impl DataOptions {
                 vrw,
                 vrw / crate::io::units::STANDARD_GRAVITY * 1e6
             ));
-            let (g, a) = bias_rw_from_noise(path)?;
             // rad/s/√s → deg/h/√h: × 180/π × 3600 × 60; m/s²/√s → µg/√s: ÷ g × 1e6
             if g > 0.0 {
                 lines.push(format!(
@@ -295,24 +299,48 @@ impl DataOptions {
             }
         }
         if let Some(path) = &args.noise {
-            let (arw, vrw) = noise_from_allan(path)?;
-            cfg = cfg.with_sensor_noise(model, arw, vrw);
-            let (g, a) = bias_rw_from_noise(path)?;
-            if g > 0.0 || a > 0.0 {
-                cfg = cfg.with_bias_random_walk(model, g, a);
+            let n = noise_given(path)?;
+            cfg = cfg.with_sensor_noise(model, n.arw, n.vrw);
+            if n.gyro_bias_rw > 0.0 || n.accel_bias_rw > 0.0 {
+                cfg = cfg.with_bias_random_walk(model, n.gyro_bias_rw, n.accel_bias_rw);
             }
         }
         Ok(cfg)
     }
 }
 
-/// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] from `--noise`: inline
-/// `arw=Q, vrw=Q` with units, or an `allan --json` file (the mean over the three axes).
-pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
+/// The noise `--noise` gives (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoiseGiven {
+    /// Gyro white noise (angle random walk) [rad/√s].
+    pub arw: f64,
+    /// Accelerometer white noise (velocity random walk) [m/s/√s].
+    pub vrw: f64,
+    /// Gyro bias random walk (bias instability) [rad/s/√s]; 0 when not given (inline only).
+    pub gyro_bias_rw: f64,
+    /// Accelerometer bias random walk [m/s²/√s]; 0 when not given (inline only).
+    pub accel_bias_rw: f64,
+}
+
+/// The noise `--noise` gives: inline `arw=Q, vrw=Q[, gyro_bias_rw=Q, accel_bias_rw=Q]` with
+/// units, or an `allan --json` file (its white noise, the mean over the three axes).
+pub fn noise_given(path: &std::path::Path) -> Result<NoiseGiven> {
     let text = path.to_string_lossy();
     if text.contains('=') && !path.exists() {
         return noise_inline(&text);
     }
+    let (arw, vrw) = white_noise_of_allan_json(path)?;
+    Ok(NoiseGiven {
+        arw,
+        vrw,
+        gyro_bias_rw: 0.0,
+        accel_bias_rw: 0.0,
+    })
+}
+
+/// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] of an `allan --json` file (the mean over
+/// the three axes), each checked for a plausible size.
+fn white_noise_of_allan_json(path: &std::path::Path) -> Result<(f64, f64)> {
     let text = crate::io::lines::read_small_text(path, "--noise")
         .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
@@ -349,23 +377,17 @@ pub fn noise_from_allan(path: &std::path::Path) -> Result<(f64, f64)> {
     ))
 }
 
-/// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's.
-/// The bias random walk (bias instability) `--noise` states inline: gyro [rad/s/√s] and
-/// accelerometer [m/s²/√s] (`gyro_bias_rw=Q, accel_bias_rw=Q`; 0 where not given, and for an
-/// `allan --json` file).
-pub fn bias_rw_from_noise(path: &std::path::Path) -> Result<(f64, f64)> {
-    let text = path.to_string_lossy();
-    if text.contains('=') && !path.exists() {
-        let [_, _, g, a] = noise_inline_all(&text)?;
-        return Ok((g.unwrap_or(0.0), a.unwrap_or(0.0)));
-    }
-    Ok((0.0, 0.0))
-}
-
-fn noise_inline(text: &str) -> Result<(f64, f64)> {
-    let [arw, vrw, _, _] = noise_inline_all(text)?;
+/// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's;
+/// `gyro_bias_rw`, `accel_bias_rw` optional.
+fn noise_inline(text: &str) -> Result<NoiseGiven> {
+    let [arw, vrw, g, a] = noise_inline_all(text)?;
     match (arw, vrw) {
-        (Some(a), Some(v)) => Ok((a, v)),
+        (Some(arw), Some(vrw)) => Ok(NoiseGiven {
+            arw,
+            vrw,
+            gyro_bias_rw: g.unwrap_or(0.0),
+            accel_bias_rw: a.unwrap_or(0.0),
+        }),
         _ => bail!("--noise `{text}`: give both arw and vrw, e.g. 'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'"),
     }
 }

@@ -205,18 +205,28 @@ pub const CHANNELS: [&str; 6] = [
 /// uniform grid before the Allan deviation.
 pub const RESAMPLE_JITTER: f64 = 1e-6;
 
-/// Why the specific force of `span` cannot be a sensor's on Earth: its mean over the span
-/// (Σ Δv / Σ Δt) beyond 0.7–1.3 g, which gravity alone gives at rest and a vehicle's
-/// accelerations barely move on average (an accelerometer unit or scale read wrongly, ms read
-/// as s). None when plausible or the span has no duration.
-pub fn gravity_problem(span: &ImuData) -> Option<String> {
-    let f = mean_specific_force_g(span)?;
+/// Why a mean specific force of `f` standard gravities (over a span, [`mean_specific_force_g`])
+/// cannot be a sensor's on Earth: beyond 0.7–1.3 g, which gravity alone gives at rest and a
+/// vehicle's accelerations barely move on average (an accelerometer unit or scale read wrongly,
+/// ms read as s). None when plausible.
+pub fn gravity_problem(f: f64) -> Option<String> {
     (!(0.7..=1.3).contains(&f)).then(|| {
         format!(
             "the mean specific force over the span is {} g (gravity gives 1 g at rest): an \
              accelerometer unit or scale read wrongly (g as m/s², a header's scale), or the clock \
              (ms read as s)",
             crate::io::units::sig3(f)
+        )
+    })
+}
+
+/// A warning when a span `at_rest` has a mean specific force of `f` g more than 3 % from 1 g
+/// (local gravity is within 0.5 % of it anywhere on Earth): an accelerometer scale off.
+pub fn scale_off_at_rest(f: f64, at_rest: bool) -> Option<String> {
+    (at_rest && (f - 1.0).abs() > 0.03).then(|| {
+        format!(
+            "at rest the mean specific force is {f:.4} g: an accelerometer scale {:+.1} % off (a header's scale?); the VRW and bias figures scale with it",
+            100.0 * (f - 1.0)
         )
     })
 }
@@ -372,12 +382,18 @@ mod tests {
                 })
                 .collect(),
         };
-        assert!(gravity_problem(&at_rest(1.0, 0.01)).is_none());
+        let problem = |d: ImuData| gravity_problem(mean_specific_force_g(&d).unwrap());
+        assert!(problem(at_rest(1.0, 0.01)).is_none());
         // the increments read in g instead of m/s², and the clock in ms read as s
-        let e = gravity_problem(&at_rest(1.0 / 9.80665, 0.01)).unwrap();
+        let e = problem(at_rest(1.0 / 9.80665, 0.01)).unwrap();
         assert!(e.contains("0.102 g"), "{e}");
-        let e = gravity_problem(&at_rest(1.0, 10.0)).unwrap();
+        let e = problem(at_rest(1.0, 10.0)).unwrap();
         assert!(e.contains("0.001 g") && e.contains("ms read as s"), "{e}");
+        // a 15 % scale passes the gross check but is warned of at rest only
+        let f = mean_specific_force_g(&at_rest(1.15, 0.01)).unwrap();
+        assert!(gravity_problem(f).is_none());
+        assert!(scale_off_at_rest(f, true).unwrap().contains("+15.0 %"));
+        assert!(scale_off_at_rest(f, false).is_none());
     }
 
     #[test]

@@ -180,8 +180,6 @@ impl FilterConfig {
     }
 }
 
-/// The model's states driven by white sensor noise (spec `white_noise`): (model index, kind),
-/// `WhiteNoise::None` left out.
 /// The constant-bias states of `model` (the spec's `gyro bias` and `accel bias` groups) with
 /// true for a gyro bias: the states a bias random walk (bias instability) drives.
 fn bias_states(model: &Model) -> impl Iterator<Item = (usize, bool)> + '_ {
@@ -199,6 +197,8 @@ fn bias_states(model: &Model) -> impl Iterator<Item = (usize, bool)> + '_ {
         })
 }
 
+/// The model's states driven by white sensor noise (spec `white_noise`): (model index, kind),
+/// `WhiteNoise::None` left out.
 fn white_noise_states(model: &Model) -> impl Iterator<Item = (usize, WhiteNoise)> + '_ {
     model
         .states

@@ -83,12 +83,7 @@ pub fn run_hidden_on(
     // the oracle knows the terms and their size: a prior that holds the true value
     let mut oracle_cfg = stated(&oracle);
     // and the noise as simulated
-    let ratio = |l: &str| {
-        case.noise_ratio
-            .iter()
-            .find(|x| x.0 == l)
-            .map_or(1.0, |x| x.1)
-    };
+    let ratio = |l: &str| crate::sim::hidden::ratio_of(&case.noise_ratio, l);
     oracle_cfg.scale_sensor_noise(&oracle, ratio("gyro_arw"), ratio("accel_vrw"));
     oracle_cfg.scale_bias_random_walk(&oracle, ratio("gyro_bias_rw"), ratio("accel_bias_rw"));
     for (name, v) in &case.hidden {

@@ -424,7 +424,7 @@ pub fn explain(
     let rivals = withheld_rivals(ctx, &r, &judged, &cands, progress)?;
     for (f, rival) in judged.iter_mut().zip(&rivals) {
         if let Some(why) = rival {
-            f.stand_in = Some(joined(f.stand_in.take(), Some(why.clone())).unwrap_or_default());
+            f.stand_in = joined(f.stand_in.take(), Some(why.clone()));
         }
     }
     let r = without_stand_ins(ctx, r, &judged, progress)?;
@@ -526,13 +526,14 @@ fn withheld_rivals(
         });
         for w in rivals {
             let rival = &common::TERMS[w];
-            let name: Vec<&str> = r
-                .model
-                .name
-                .split('+')
-                .map(|p| if p == info.name { rival.name } else { p })
-                .collect();
-            let m = Model::parse(&name.join("+"))?;
+            // the rounds' terms beyond the baseline, the finding's replaced by the rival
+            let terms = r.model.states.iter().filter_map(|s| match *s {
+                StateRef::Term(t) if !ctx.baseline.states.contains(s) => {
+                    Some(if t == n.term { w } else { t })
+                }
+                _ => None,
+            });
+            let m = model_with(&ctx.baseline.name, terms)?;
             let cfg = ctx.extended_config(&m, &r.widened)?;
             let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
             let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {

@@ -9,8 +9,8 @@
 //! rising), within 1/16 … 64 of the start. Two sweeps over the levels in turn (white noise
 //! first, then the aiding σ), each given all the others; a level's 2Δℓ is then the drop when it
 //! alone returns to its stated value, the others kept at their fits. The 95 % interval is
-//! where the last parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns the significant
-//! levels into findings.
+//! where the last parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns
+//! the significant levels into findings.
 
 use super::{
     baseline_excess, run_pass, sig3, Context, ExplainData, ExplainOptions, Finding, Pass,
@@ -135,17 +135,10 @@ pub(super) fn fit(
         gains[li] = (2.0 * (l_cur - p.stats.loglik)).max(0.0);
     }
     for (li, &level) in levels.iter().enumerate() {
-        let curv = curvs[li];
-        let half = if curv < 0.0 {
-            (stats::chi2_isf(0.05, 1.0) / (-2.0 * curv)).sqrt()
-        } else {
-            f64::INFINITY
-        };
-        let u = scales[li].log2();
         fits.push(LevelFit {
             level,
             scale: scales[li],
-            interval: [2f64.powf(u - half), 2f64.powf(u + half)],
+            interval: interval(scales[li], curvs[li]),
             two_delta_loglik: gains[li],
             p_holm: stats::chi2_sf(gains[li], 1.0),
             significant: false,
@@ -196,12 +189,22 @@ fn refit_named(
             l_out = l;
         }
         if curv < 0.0 {
-            let half = (stats::chi2_isf(0.05, 1.0) / (-2.0 * curv)).sqrt();
-            let c = f.scale.log2();
-            f.interval = [2f64.powf(c - half), 2f64.powf(c + half)];
+            f.interval = interval(f.scale, curv);
         }
     }
     Ok(())
+}
+
+/// The 95 % interval of a scale fitted at `scale` where ℓ(log₂ s) has curvature `curv` (ℓ ≈
+/// curv · u² + …): where the parabola falls by χ²₁(0.95)/2; unbounded without curvature.
+fn interval(scale: f64, curv: f64) -> [f64; 2] {
+    let half = if curv < 0.0 {
+        (stats::chi2_isf(0.05, 1.0) / (-2.0 * curv)).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    let u = scale.log2();
+    [2f64.powf(u - half), 2f64.powf(u + half)]
 }
 
 /// Maximises ℓ(u) over u = log₂ s from u = 0 (where ℓ = `l0`) in at most [`MAX_EVALS`]

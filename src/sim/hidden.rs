@@ -145,8 +145,7 @@ pub struct HiddenCase {
     /// simulated.
     pub stated_noise: Option<[f64; 4]>,
     /// Noise levels stated wrongly (`gyro_arw`, `accel_vrw`, `gyro_bias_rw`, `accel_bias_rw`)
-    /// and the ratio of the simulated
-    /// level to the stated one.
+    /// and the ratio of the simulated level to the stated one.
     pub noise_ratio: Vec<(String, f64)>,
 }
 
@@ -192,6 +191,14 @@ impl HiddenCase {
         c.effect *= k;
         c
     }
+}
+
+/// The ratio simulated/stated of noise `level` in `noise_ratio` (1 when it is stated right).
+pub fn ratio_of(noise_ratio: &[(String, f64)], level: &str) -> f64 {
+    noise_ratio
+        .iter()
+        .find(|x| x.0 == level)
+        .map_or(1.0, |x| x.1)
 }
 
 fn unit_of(name: &str) -> &'static str {
@@ -534,8 +541,8 @@ fn draw_gnss(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
     }
 }
 
-/// A white noise of group `g` stated wrongly on a drive (and kgf_yx beside it in
-/// `noise_accel_kgf`).
+/// A noise level of group `g` (white noise or bias random walk) stated wrongly on a drive (and
+/// kgf_yx beside it in `noise_accel_kgf`).
 fn draw_noise(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
     p.segments = drive_segments(d.seconds);
     p.baseline = "P13".into();
@@ -656,7 +663,7 @@ fn assemble(
     let noise = match stated_noise {
         None => "[noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n".to_string(),
         Some(stated) => {
-            let ratio = |l: &str| noise_ratio.iter().find(|x| x.0 == l).map_or(1.0, |x| x.1);
+            let ratio = |l: &str| ratio_of(&noise_ratio, l);
             format!(
                 "[noise]\narw = \"{:e} rad/sqrt(s)\"\nvrw = \"{:e} m/s/sqrt(s)\"\n\
                  gyro_bias_rw = \"{:e} rad/s/sqrt(s)\"\naccel_bias_rw = \"{:e} m/s^2/sqrt(s)\"\n",
