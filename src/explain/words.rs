@@ -377,6 +377,16 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
     }
 }
 
+/// A p-value for the words: three significant digits, "< 1e-16" below double precision's
+/// resolution of 1 − p (where it is 0 or a rounding residue).
+fn p_text(p: f64) -> String {
+    if p < 1e-16 {
+        "< 1e-16".into()
+    } else {
+        sig3(p)
+    }
+}
+
 /// The time [s] the summary counts data times from: the first update's whole second when the
 /// times are large (GPS seconds on real data), else 0.
 fn time_reference(e: &Explanation) -> f64 {
@@ -393,11 +403,13 @@ fn time_reference(e: &Explanation) -> f64 {
 fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
     let mut consistent = true;
     for ch in &e.baseline.channels {
-        let inconsistent = ch.nis_mean > ch.nis_band[1] * 1.5
-            || ch
-                .whiteness_p
-                .is_some_and(|p| p * e.baseline.channels.len() as f64 <= 0.01);
-        if !inconsistent {
+        let too_large = ch.nis_mean > ch.nis_band[1] * 1.5;
+        // Ljung–Box p after Bonferroni over the channels, when it fails at 0.01
+        let correlated = ch
+            .whiteness_p
+            .map(|p| (p * e.baseline.channels.len() as f64).min(1.0))
+            .filter(|p| *p <= 0.01);
+        if !too_large && correlated.is_none() {
             continue;
         }
         consistent = false;
@@ -405,21 +417,43 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
             .segments
             .iter()
             .max_by(|a, b| a.nis_mean.total_cmp(&b.nis_mean));
-        match worst {
-            Some(sg) if sg.nis_mean > ch.nis_band[1] => out.push(format!(
-                "{} innovations are {}× larger than the model predicts during {:.0}–{:.0} s{} (mean NIS {}), biased by {:+.1}σ; the model does not explain the data there.",
+        let also = correlated
+            .map(|p| {
+                format!(
+                    "; they are also correlated in time (Ljung–Box p {} after Bonferroni)",
+                    sig3(p)
+                )
+            })
+            .unwrap_or_default();
+        let from = if t_ref != 0.0 {
+            " from the first update"
+        } else {
+            ""
+        };
+        match (too_large, worst) {
+            (true, Some(sg)) if sg.nis_mean > ch.nis_band[1] => out.push(format!(
+                "{} innovations are {}× larger than the model predicts during {:.0}–{:.0} s{from} (mean NIS {}), biased by {:+.1}σ{also}; the model does not explain the data there.",
                 channel_word(&ch.channel),
                 sig3(sg.nis_mean.sqrt()),
                 sg.t0 - t_ref,
                 sg.t1 - t_ref,
-                if t_ref != 0.0 { " from the first update" } else { "" },
                 sig3(sg.nis_mean),
                 sg.bias_sigma
             )),
-            _ => out.push(format!(
-                "{} innovations are correlated in time (Ljung–Box p {}): the model misses a slow effect.",
+            (true, _) => out.push(format!(
+                "{} innovations are {}× larger than the model predicts over the run (mean NIS {}){also}.",
                 channel_word(&ch.channel),
-                ch.whiteness_p.map(sig3).unwrap_or_default()
+                sig3(ch.nis_mean.sqrt()),
+                sig3(ch.nis_mean)
+            )),
+            // only the whiteness test failed: the size is as predicted, the sequence is not
+            (false, _) => out.push(format!(
+                "{} innovations are correlated in time (Ljung–Box p {} after Bonferroni over the channels) while their size is close to what the model predicts (mean NIS {}, 95 % band {}–{}): the model misses a slow effect.",
+                channel_word(&ch.channel),
+                correlated.map(p_text).unwrap_or_default(),
+                sig3(ch.nis_mean),
+                sig3(ch.nis_band[0]),
+                sig3(ch.nis_band[1])
             )),
         }
     }

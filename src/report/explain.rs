@@ -165,20 +165,222 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     ));
     s.push_str("## In words\n\n");
     for line in &e.summary {
-        s.push_str(&format!("- {line}\n"));
+        let short = e
+            .findings
+            .iter()
+            .find(|f| f.words == *line)
+            .map(short_words);
+        s.push_str(&format!(
+            "- {}\n",
+            notation(short.as_deref().unwrap_or(line))
+        ));
     }
+    at_a_glance(e, &mut s);
+    let mut placed = vec![false; figures.len()];
+    let mut place = |s: &mut String, files: &[&str]| {
+        for (k, (file, caption)) in figures.iter().enumerate() {
+            if !placed[k] && files.iter().any(|f| file == f) {
+                placed[k] = true;
+                s.push_str(&figure(k + 1, file, caption));
+            }
+        }
+    };
     baseline_section(e, &mut s);
+    place(&mut s, &["innovations_before.png"]);
     candidates_section(e, &mut s);
+    place(&mut s, &["candidates.png"]);
     findings_section(e, &mut s);
+    place(&mut s, &["estimates.png"]);
     gain_section(e, &mut s);
-    notes_section(&mut s);
-    if !figures.is_empty() {
-        s.push_str("\n## Figures\n\n");
-        for (file, caption) in figures {
-            s.push_str(&format!("![{caption}]({file})\n\n*{caption}*\n\n"));
+    place(
+        &mut s,
+        &[
+            "innovations_after.png",
+            "model_error.png",
+            "model_error_after.png",
+        ],
+    );
+    let rest: Vec<usize> = (0..figures.len()).filter(|&k| !placed[k]).collect();
+    if !rest.is_empty() {
+        s.push_str("\n## Further figures\n\n");
+        for k in rest {
+            s.push_str(&figure(k + 1, &figures[k].0, &figures[k].1));
         }
     }
+    notes_section(&mut s);
     s
+}
+
+/// A finding in one sentence for the report's summary: its words up to the value (the rest is
+/// in section 3), the share of the misfit it explains, and whether it is a stand-in.
+fn short_words(f: &crate::explain::Finding) -> String {
+    let cuts = [
+        " (extended filter",
+        "; the data cannot",
+        ": with the data's",
+        "; it explains",
+        ". It probably",
+        ": it acts",
+        ". It is not one level",
+    ];
+    let end = cuts
+        .iter()
+        .filter_map(|c| f.words.find(c))
+        .min()
+        .unwrap_or(f.words.len());
+    let mut s = f.words[..end].trim_end_matches('.').to_string();
+    if let Some(x) = f.misfit_share {
+        s.push_str(&format!(
+            "; explains {} % of the baseline's excess misfit",
+            sig3(100.0 * x)
+        ));
+    }
+    if f.stand_in.is_some() {
+        s.push_str(
+            " — probably a stand-in for an effect the candidates do not describe (section 3)",
+        );
+    } else if f.not_attributed.is_some() {
+        s.push_str(" — its class cannot be told apart on these data (section 3)");
+    }
+    s.push('.');
+    s
+}
+
+/// A figure as an HTML block in the Markdown (rendered by Markdown viewers and embedded by the
+/// HTML page): the image `file` with its numbered caption.
+fn figure(n: usize, file: &str, caption: &str) -> String {
+    let cap = super::html_text(caption);
+    format!(
+        "\n<figure>\n<img src=\"{file}\" alt=\"{cap}\">\n<figcaption>Figure {n}. {cap}</figcaption>\n</figure>\n\n"
+    )
+}
+
+/// The findings at a glance: one row each with its value ± σ, its kind, the share of the
+/// baseline's excess misfit it removes and whether it is named as a cause; nothing without
+/// findings.
+fn at_a_glance(e: &Explanation, s: &mut String) {
+    if e.findings.is_empty() {
+        return;
+    }
+    s.push_str(
+        "\n## Findings at a glance\n\n| term | kind | value ± σ | explains of the excess misfit | verdict |\n|---|---|---|---|---|\n",
+    );
+    for f in &e.findings {
+        let verdict = if f.stand_in.is_some() {
+            "fitted, but not a cause (a stand-in)"
+        } else if f.not_attributed.is_some() {
+            "fitted, not attributed (class not separable)"
+        } else if f.kind == "noise" {
+            "**found: a noise level**"
+        } else {
+            "**found: a cause**"
+        };
+        let value = match f.scale {
+            Some(_) if f.unit == "x stated" => {
+                format!("{} ± {} × the stated σ", num(f.estimate), num(f.sigma))
+            }
+            Some(k) => format!(
+                "{} ± {} {} ({}× the stated)",
+                num(f.estimate),
+                num(f.sigma),
+                notation(&f.unit),
+                sig3(k)
+            ),
+            None => format!(
+                "{} ± {} {}",
+                num(f.estimate),
+                num(f.sigma),
+                notation(&f.unit)
+            ),
+        };
+        let share = f
+            .misfit_share
+            .map(|x| format!("{} % (2Δℓ {})", sig3(100.0 * x), sig3(f.two_delta_loglik)))
+            .unwrap_or_else(|| format!("— (2Δℓ {})", sig3(f.two_delta_loglik)));
+        s.push_str(&format!(
+            "| {} | {} | {value} | {share} | {verdict} |\n",
+            f.term, f.kind
+        ));
+    }
+    if let Some(u) = e.misfit_unexplained {
+        s.push_str(&format!(
+            "\nLeft unexplained by the model explain recommends: {} % of the baseline's excess misfit.\n",
+            sig3(100.0 * u)
+        ));
+    }
+}
+
+/// Text with the regressors and units in mathematical notation for a reader: `f.z.powi(2)` →
+/// f_z², `f.x.abs()` → |f_x|, `w.y` → ω_y, `dw.x` → ω̇_x, `df.x` → ḟ_x, ` * ` between signals →
+/// ·, `ug` → µg, `^2` → ², `sqrt(Hz)` → √Hz.
+pub fn notation(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    let boundary = |k: usize| k == 0 || !(b[k - 1].is_ascii_alphanumeric() || b[k - 1] == b'_');
+    while i < b.len() {
+        // a signal: (dw|df|w|f).(x|y|z), not inside a longer word
+        let sig = [("dw.", "ω̇_"), ("df.", "ḟ_"), ("w.", "ω_"), ("f.", "f_")]
+            .iter()
+            .find(|(p, _)| {
+                boundary(i)
+                    && text[i..].starts_with(p)
+                    && matches!(b.get(i + p.len()), Some(b'x' | b'y' | b'z'))
+                    && !b
+                        .get(i + p.len() + 1)
+                        .is_some_and(|c| c.is_ascii_alphanumeric())
+            });
+        if let Some((p, q)) = sig {
+            let axis = b[i + p.len()] as char;
+            let mut j = i + p.len() + 1;
+            let sym = format!("{q}{axis}");
+            if text[j..].starts_with(".powi(2)") {
+                out.push_str(&format!("{sym}²"));
+                j += 8;
+            } else if text[j..].starts_with(".powi(3)") {
+                out.push_str(&format!("{sym}³"));
+                j += 8;
+            } else if text[j..].starts_with(".abs()") {
+                out.push_str(&format!("|{sym}|"));
+                j += 6;
+            } else {
+                out.push_str(&sym);
+            }
+            // a product of signals: ` * ` becomes a centred dot
+            if text[j..].starts_with(" * ")
+                && ["dw.", "df.", "w.", "f."]
+                    .iter()
+                    .any(|p| text[j + 3..].starts_with(p))
+            {
+                out.push('·');
+                j += 3;
+            }
+            i = j;
+            continue;
+        }
+        let units = [
+            ("ug", "µg"),
+            ("sqrt(Hz)", "√Hz"),
+            ("sqrt(h)", "√h"),
+            ("sqrt(s)", "√s"),
+            ("^2", "²"),
+            ("^3", "³"),
+        ];
+        if let Some((p, q)) = units.iter().find(|(p, _)| {
+            text[i..].starts_with(p)
+                && (!p.starts_with('u')
+                    || (boundary(i)
+                        && !b.get(i + p.len()).is_some_and(|c| c.is_ascii_alphabetic())))
+        }) {
+            out.push_str(q);
+            i += p.len();
+            continue;
+        }
+        let c = text[i..].chars().next().expect("in the text");
+        out.push(c);
+        i += c.len_utf8();
+    }
+    out
 }
 
 /// Section 1 of the Markdown report: the baseline's fit, channel by channel, and against truth.
@@ -242,13 +444,7 @@ fn candidates_section(e: &Explanation, s: &mut String) {
         e.alpha
     ));
     for c in &e.candidates {
-        let note = if !c.testable {
-            "not testable (no information)".to_string()
-        } else if let Some(b) = &c.confounded_with {
-            format!("not separable from {b}")
-        } else {
-            String::new()
-        };
+        let note = candidate_note(e, c);
         if c.testable {
             s.push_str(&format!(
                 "| {} | {} | {:.1} | {} | {} | {} | {} | {} |\n",
@@ -258,16 +454,75 @@ fn candidates_section(e: &Explanation, s: &mut String) {
                 num(c.p_holm),
                 num(c.glr_estimate),
                 num(c.glr_sigma),
-                c.unit,
+                notation(&c.unit),
                 note
             ));
         } else {
             s.push_str(&format!(
                 "| {} | {} | — | — | — | — | {} | {} |\n",
-                c.term, c.group, c.unit, note
+                c.term,
+                c.group,
+                notation(&c.unit),
+                note
             ));
         }
     }
+}
+
+/// The candidates table's note on `c`: why a candidate is not testable, not separable, or
+/// significant alone yet not named (the later rounds' reason), or that it was named.
+fn candidate_note(e: &Explanation, c: &crate::explain::CandidateTest) -> String {
+    if !c.testable {
+        return "not testable (no information)".into();
+    }
+    if let Some(b) = &c.confounded_with {
+        return format!("not separable from {b}");
+    }
+    if let Some(f) = e.findings.iter().find(|f| f.term == c.term) {
+        return if f.is_cause() {
+            format!("named in round {} (section 3)", f.round)
+        } else {
+            format!(
+                "fitted in round {}, not named as a cause (section 3)",
+                f.round
+            )
+        };
+    }
+    if let Some(f) = e.findings.iter().find(|f| f.equivalent.contains(&c.term)) {
+        return format!(
+            "not separable from {} on these data (its equivalence class, section 3)",
+            f.term
+        );
+    }
+    if let Some(i) = e.implausible.iter().find(|i| i.term == c.term) {
+        return format!(
+            "significant, but it would need {} prior σ: implausible, not named",
+            sig3(i.prior_sigmas)
+        );
+    }
+    if let Some((_, gain, penalty)) = e.unconfirmed.iter().find(|u| u.0 == c.term) {
+        return format!(
+            "selected, but the extended filter did not confirm it (2Δℓ {} below k ln N {})",
+            sig3(*gain),
+            sig3(*penalty)
+        );
+    }
+    if c.p_holm <= e.alpha {
+        return if e.findings.is_empty() {
+            "significant alone, but not once tested with the others in the selection rounds".into()
+        } else {
+            let named: Vec<&str> = e.findings.iter().map(|f| f.term.as_str()).collect();
+            format!(
+                "significant alone, but not once {} in the model: they take up its signature",
+                if named.len() == 1 {
+                    format!("{} is", named[0])
+                } else {
+                    format!("{} are", named.join(", "))
+                }
+            )
+        };
+    }
+    String::new()
 }
 
 /// Section 3 of the Markdown report: the findings and the extended model.
@@ -277,23 +532,27 @@ fn findings_section(e: &Explanation, s: &mut String) {
         s.push_str("Nothing is significant; the model stays as it is.\n");
     }
     for f in &e.findings {
+        let verdict = if f.stand_in.is_some() {
+            "fitted, but not a cause"
+        } else if f.not_attributed.is_some() {
+            "fitted, not attributed"
+        } else {
+            "found"
+        };
+        let share = f
+            .misfit_share
+            .map(|x| format!("; explains {} % of the excess misfit", sig3(100.0 * x)))
+            .unwrap_or_default();
         s.push_str(&format!(
-            "- {}**{}** = {} ± {} {} (llr {:.1}, p {}; pass {}). {}\n",
-            if f.stand_in.is_some() {
-                "*fitted, not a cause:* "
-            } else if f.not_attributed.is_some() {
-                "*fitted, not attributed:* "
-            } else {
-                ""
-            },
+            "- **{}** = {} ± {} {}: {verdict}{share} (llr {:.1}, p {}; round {}).\n\n  <details><summary>In full</summary>{}</details>\n\n",
             f.term,
             num(f.estimate),
             num(f.sigma),
-            f.unit,
+            notation(&f.unit),
             f.llr,
             num(f.p_value),
             f.round,
-            f.words
+            super::html_text(&notation(&f.words))
         ));
     }
     s.push_str(&format!("\nExtended model: `{}`", e.extended_model));
@@ -365,38 +624,6 @@ pub fn base64(bytes: &[u8]) -> String {
         }
     }
     out
-}
-
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-}
-
-/// A self-contained HTML page of the Markdown report: the text preformatted (tables stay
-/// legible), figures embedded as base64 PNGs (`figures`: caption and PNG bytes).
-pub fn html(title: &str, markdown: &str, figures: &[(String, Vec<u8>)]) -> String {
-    let mut s = format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{}</title>\
-         <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}}\
-         pre{{white-space:pre-wrap;font-size:14px}}img{{max-width:100%}}</style></head><body>\n",
-        html_escape(title)
-    );
-    let text: String = markdown
-        .lines()
-        .filter(|l| !l.starts_with("!["))
-        .collect::<Vec<_>>()
-        .join("\n");
-    s.push_str(&format!("<pre>{}</pre>\n", html_escape(&text)));
-    for (caption, png) in figures {
-        s.push_str(&format!(
-            "<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"><figcaption>{0}</figcaption></figure>\n",
-            html_escape(caption),
-            base64(png)
-        ));
-    }
-    s.push_str("</body></html>\n");
-    s
 }
 
 #[cfg(test)]

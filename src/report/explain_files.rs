@@ -25,12 +25,20 @@ pub fn write(out: &OutputDir, e: &Explanation, data: &str) -> Result<String> {
     let md = words::markdown(e, data, &figures);
     atomic_file::write_text(&out.file("report.md"), &md)?;
     let mut embedded = Vec::new();
-    for (file, caption) in &figures {
+    for (file, _) in &figures {
         let bytes = std::fs::read(out.file(file))
             .with_context(|| format!("cannot read the figure {file}"))?;
-        embedded.push((caption.clone(), bytes));
+        embedded.push(super::html::Embedded {
+            file: file.clone(),
+            mime: if file.ends_with(".svg") {
+                "image/svg+xml"
+            } else {
+                "image/png"
+            },
+            bytes,
+        });
     }
-    let html = words::html(
+    let html = super::html::page(
         &format!("sinsmodel explain: {}", e.baseline_model),
         &md,
         &embedded,
