@@ -144,7 +144,17 @@ impl NavWriter {
             }],
             Scale::Linear,
         )?;
-        let [sn, se, sh] = self.sigma;
+        let [mut sn, mut se, mut sh] = self.sigma;
+        // times from the first sample; the absolute start goes into the title
+        let t0 = sn.points.first().map(|p| p.0).unwrap_or(0.0);
+        for p in sn
+            .points
+            .iter_mut()
+            .chain(se.points.iter_mut())
+            .chain(sh.points.iter_mut())
+        {
+            p.0 -= t0;
+        }
         let mut series = vec![
             Series {
                 label: "sigma north".into(),
@@ -163,8 +173,8 @@ impl NavWriter {
         }
         line_plot(
             &dir.join(format!("{stem}_sigma.png")),
-            "filter: 1-sigma of the position (envelopes)",
-            "time [s]",
+            &format!("filter: 1-sigma of the position (envelopes); first sample at t = {t0:.3} s"),
+            "time from the first sample [s]",
             "1-sigma [m] (log scale)",
             &series,
             Scale::LogY,

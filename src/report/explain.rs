@@ -160,16 +160,19 @@ fn num(v: f64) -> String {
 pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> String {
     let mut s = String::new();
     s.push_str(&format!(
-        "# sinsmodel explain: {}\n\nData: {data}\n\n",
-        e.baseline_model
+        "# sinsmodel explain: {}\n\nData: {}\n\n",
+        e.baseline_model,
+        notation(data)
     ));
     s.push_str("## In words\n\n");
     for line in &e.summary {
-        let short = e
-            .findings
-            .iter()
-            .find(|f| f.words == *line)
-            .map(short_words);
+        // a finding's line is "Found: WORDS." (or "Fitted, …: WORDS."): its verdict and one sentence
+        let short = e.findings.iter().find_map(|f| {
+            let body = line.strip_suffix('.').unwrap_or(line);
+            body.strip_suffix(f.words.as_str())
+                .filter(|verdict| verdict.ends_with(": "))
+                .map(|verdict| format!("{verdict}{}", short_words(f)))
+        });
         s.push_str(&format!(
             "- {}\n",
             notation(short.as_deref().unwrap_or(line))

@@ -39,7 +39,57 @@ pub enum Scale {
     LogY,
 }
 
-/// Draws `series` into a 1000×600 PNG at `path`.
+/// A tick label: at most four significant decimals, trailing zeros dropped, exponent form
+/// outside 1e-3..1e5.
+pub fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !v.is_finite() {
+        return "0".into();
+    }
+    if !(1e-3..1e5).contains(&a) {
+        return format!("{v:.1e}");
+    }
+    let decimals = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Tick values for a log axis over `lo..hi` (both > 0): 1, 2 and 5 times each power of ten
+/// inside; every integer multiple when that gives fewer than four.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let pick = |mult: &[f64]| -> Vec<f64> {
+        let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (k0..=k1)
+            .flat_map(|k| mult.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9))
+            .collect()
+    };
+    let t = pick(&[1.0, 2.0, 5.0]);
+    if t.len() >= 4 {
+        t
+    } else {
+        pick(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
+/// The plot's palette (matplotlib's first six), one colour per series in turn.
+const COLORS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Draws `series` into a 1000×600 PNG at `path`: the legend in a strip right of the axes (it
+/// never covers data), points the scale cannot show (non-finite, ≤ 0 on a log axis) breaking
+/// the line, ticks labelled by [`tick`]. An x axis of large values over a short span (absolute
+/// GPS times) is drawn from its whole-number start, which the axis label then names.
 pub fn line_plot(
     path: &Path,
     title: &str,
@@ -49,108 +99,187 @@ pub fn line_plot(
     scale: Scale,
 ) -> Result<()> {
     register_font();
-    let tmp = crate::io::atomic_file::temporary_beside(path, ".png");
-    {
-        let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
-        root.fill(&WHITE)
-            .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
-        let pts = series.iter().flat_map(|s| s.points.iter());
-        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for &(x, y) in pts {
-            let ok = match scale {
+    let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
+    let shown = |&(x, y): &(f64, f64)| {
+        x.is_finite()
+            && y.is_finite()
+            && match scale {
                 Scale::Linear => true,
                 Scale::LogLog => x > 0.0 && y > 0.0,
                 Scale::LogX => x > 0.0,
                 Scale::LogY => y > 0.0,
-            };
-            if x.is_finite() && y.is_finite() && ok {
-                x0 = x0.min(x);
-                x1 = x1.max(x);
-                y0 = y0.min(y);
-                y1 = y1.max(y);
             }
+    };
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| shown(p))
+    {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+        if matches!(scale, Scale::LogLog | Scale::LogX) {
+            (x0, x1) = (1.0, 10.0);
         }
-        if x0 > x1 {
-            (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+        if matches!(scale, Scale::LogLog | Scale::LogY) {
+            (y0, y1) = (1.0, 10.0);
         }
-        if y1 - y0 <= 0.0 {
-            y1 = if scale == Scale::LogY || scale == Scale::LogLog {
-                y0 * 10.0
-            } else {
-                y0 + 1.0
-            };
-        }
-        let colors = [
-            RGBColor(31, 119, 180),
-            RGBColor(214, 39, 40),
-            RGBColor(44, 160, 44),
-            RGBColor(148, 103, 189),
-            RGBColor(255, 127, 14),
-            RGBColor(23, 190, 207),
-        ];
-        let mut builder = ChartBuilder::on(&root);
+    }
+    if x1 - x0 <= 0.0 {
+        x1 = if matches!(scale, Scale::LogLog | Scale::LogX) {
+            x0 * 10.0
+        } else {
+            x0 + 1.0
+        };
+    }
+    if y1 - y0 <= 0.0 {
+        y1 = if matches!(scale, Scale::LogLog | Scale::LogY) {
+            y0 * 10.0
+        } else {
+            y0 + 1.0
+        };
+    }
+    // absolute times (GPS seconds) over a short span: counted from their whole-second start
+    let x_off = if matches!(scale, Scale::Linear | Scale::LogY)
+        && x0.abs() >= 1e5
+        && x0.abs() > 100.0 * (x1 - x0)
+    {
+        x0.floor()
+    } else {
+        0.0
+    };
+    let x_desc = if x_off != 0.0 {
+        format!("{x_label}, from {x_off:.0}")
+    } else {
+        x_label.to_string()
+    };
+    let (x0, x1) = (x0 - x_off, x1 - x_off);
+    let labelled = series.iter().any(|s| !s.label.is_empty());
+    let legend_w: u32 = if labelled {
+        let chars = series
+            .iter()
+            .map(|s| s.label.chars().count())
+            .max()
+            .unwrap_or(0);
+        (44 + 9 * chars as u32).clamp(120, 330)
+    } else {
+        0
+    };
+    let tmp = crate::io::atomic_file::temporary_beside(path, ".png");
+    {
+        let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let (area, legend) = root.split_horizontally(1000 - legend_w);
+        let mut builder = ChartBuilder::on(&area);
         builder
-            .caption(title, ("sans-serif", 24))
+            .caption(title, ("sans-serif", 22))
             .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(80);
+            .margin_right(30)
+            .x_label_area_size(50)
+            .y_label_area_size(85);
+        let x_fmt = |v: &f64| tick(*v);
+        let y_fmt = |v: &f64| tick(*v);
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
                 chart
                     .configure_mesh()
-                    .x_desc(x_label)
+                    .x_desc(x_desc.as_str())
                     .y_desc(y_label)
+                    .x_labels(9)
+                    .y_labels(9)
+                    .x_label_formatter(&x_fmt)
+                    .y_label_formatter(&y_fmt)
                     .label_style(("sans-serif", 15))
                     .draw()
-                    .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
+                    .map_err(|e| err(&e))?;
                 for (k, s) in series.iter().enumerate() {
-                    let c = colors[k % colors.len()];
-                    chart
-                        .draw_series(LineSeries::new(
-                            s.points
-                                .iter()
-                                .copied()
-                                .filter(|p| p.0.is_finite() && p.1.is_finite()),
-                            c.stroke_width(2),
-                        ))
-                        .map_err(|e| anyhow!("plot {}: {e}", path.display()))?
-                        .label(s.label.clone())
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-                        });
+                    let c = COLORS[k % COLORS.len()];
+                    // earlier series wider, so one a later series overlaps still shows
+                    let width = if k == 0 && series.len() > 1 { 3 } else { 2 };
+                    // each run of points the scale can show is one line
+                    let mut run: Vec<(f64, f64)> = Vec::new();
+                    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+                    for p in &s.points {
+                        if shown(p) {
+                            run.push((p.0 - x_off, p.1));
+                        } else if !run.is_empty() {
+                            runs.push(std::mem::take(&mut run));
+                        }
+                    }
+                    runs.push(run);
+                    // segment by segment: a wide polyline's mitred joins at the sharp turns
+                    // of a dense envelope would spike far outside the axes
+                    for r in runs.into_iter().filter(|r| !r.is_empty()) {
+                        if r.len() == 1 {
+                            chart
+                                .draw_series(std::iter::once(Circle::new(r[0], 2, c.filled())))
+                                .map_err(|e| err(&e))?;
+                            continue;
+                        }
+                        chart
+                            .draw_series(
+                                r.windows(2).map(|w| {
+                                    PathElement::new(vec![w[0], w[1]], c.stroke_width(width))
+                                }),
+                            )
+                            .map_err(|e| err(&e))?;
+                    }
                 }
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 15))
-                    .draw()
-                    .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
             }};
         }
+        let ypad = |lo: f64, hi: f64| 0.05 * (hi - lo);
         match scale {
             Scale::Linear => {
-                let pad = 0.05 * (y1 - y0);
+                let pad = ypad(y0, y1);
                 draw!(builder
                     .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
-                    .map_err(|e| anyhow!("plot {}: {e}", path.display()))?)
+                    .map_err(|e| err(&e))?)
             }
             Scale::LogLog => draw!(builder
-                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-                .map_err(|e| anyhow!("plot {}: {e}", path.display()))?),
+                .build_cartesian_2d(
+                    (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                    (y0..y1).log_scale().with_key_points(log_ticks(y0, y1))
+                )
+                .map_err(|e| err(&e))?),
             Scale::LogX => {
-                let pad = 0.05 * (y1 - y0);
+                let pad = ypad(y0, y1);
                 draw!(builder
-                    .build_cartesian_2d((x0..x1).log_scale(), (y0 - pad)..(y1 + pad))
-                    .map_err(|e| anyhow!("plot {}: {e}", path.display()))?)
+                    .build_cartesian_2d(
+                        (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                        (y0 - pad)..(y1 + pad)
+                    )
+                    .map_err(|e| err(&e))?)
             }
             Scale::LogY => draw!(builder
-                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-                .map_err(|e| anyhow!("plot {}: {e}", path.display()))?),
+                .build_cartesian_2d(
+                    x0..x1,
+                    (y0..y1).log_scale().with_key_points(log_ticks(y0, y1))
+                )
+                .map_err(|e| err(&e))?),
         }
-        root.present()
-            .map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
+        if labelled {
+            for (k, s) in series.iter().enumerate() {
+                let c = COLORS[k % COLORS.len()];
+                let y = 70 + 26 * k as i32;
+                legend
+                    .draw(&PathElement::new(vec![(6, y), (32, y)], c.stroke_width(3)))
+                    .map_err(|e| err(&e))?;
+                legend
+                    .draw(&Text::new(
+                        s.label.clone(),
+                        (38, y - 9),
+                        ("sans-serif", 15).into_font().color(&BLACK),
+                    ))
+                    .map_err(|e| err(&e))?;
+            }
+        }
+        root.present().map_err(|e| err(&e))?;
     }
     finish(&tmp, path)
 }
@@ -196,9 +325,10 @@ pub fn bar_plot(
         let row = |k: usize| (n - 1 - k) as f64;
         let labels: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 24))
+            .caption(title, ("sans-serif", 22))
             .margin(15)
-            .x_label_area_size(45)
+            .margin_right(30)
+            .x_label_area_size(50)
             .y_label_area_size(170)
             .build_cartesian_2d((lo - pad)..(hi + pad), -0.5..(n as f64 - 0.5))
             .map_err(|e| err(&e))?;
@@ -215,6 +345,7 @@ pub fn bar_plot(
                 }
             })
             .x_desc(value_label)
+            .x_label_formatter(&|v| tick(*v))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| err(&e))?;
@@ -256,7 +387,7 @@ pub fn bar_plot(
             chart
                 .configure_series_labels()
                 .position(SeriesLabelPosition::LowerRight)
-                .background_style(WHITE.mix(0.8))
+                .background_style(WHITE.mix(0.0))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 15))
                 .draw()
