@@ -23,8 +23,8 @@ use std::process::Command;
 /// README command (exact) → the quick variant the test runs instead, and why.
 const QUICK: &[(&str, &str, &str)] = &[
     (
-        "sinsmodel reproduce --out docs/reproduce --priors-grid",
-        "sinsmodel reproduce --quick --out docs/reproduce --priors-grid",
+        "sinsmodel reproduce --out out/reproduce --priors-grid",
+        "sinsmodel reproduce --quick --out out/reproduce --priors-grid",
         "the full run takes ~10 min; --quick runs the same cases for 10 minutes each",
     ),
     (
@@ -251,4 +251,24 @@ fn comments_and_continuations_are_parsed() {
     let text = "x\n```sh\nsinsmodel a --p 'b # c' \\\n    --d e   # note\n# only a comment\n```\n```\nsinsmodel not-sh\n```\n";
     let c = readme_commands(text);
     assert_eq!(c, vec![(3, "sinsmodel a --p 'b # c' --d e".to_string())]);
+}
+
+/// Run verbatim, no README command writes into the shipped `docs/` (the full `reproduce` once
+/// wrote `docs/reproduce/`, replacing the results the README shows); refreshing them is named in
+/// prose, not given as a command to copy (#25).
+#[test]
+fn readme_commands_write_nothing_into_docs() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    for (line, cmd) in readme_commands(&text) {
+        let words: Vec<&str> = cmd.split_whitespace().collect();
+        for w in words.windows(2) {
+            let output = matches!(w[0], "--out" | "--json" | "--plot");
+            assert!(
+                !(output && w[1].trim_matches(['\'', '"']).starts_with("docs/")),
+                "README.md line {}: `{cmd}` writes into the shipped docs/",
+                line + 1
+            );
+        }
+    }
 }

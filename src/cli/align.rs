@@ -1,4 +1,4 @@
-//! `sinsmodel align --imu FILE [--lat DEG] [--seconds N] [--json OUT]`.
+//! `sinsmodel align --imu FILE [--lat DEG] [--skip S] [--seconds N] [--json OUT]`.
 
 use anyhow::Result;
 use clap::Args;
@@ -24,6 +24,11 @@ pub struct AlignArgs {
     /// Prior 1-σ of the gyro biases in the fine alignment [deg/h] (bounds the heading σ).
     #[arg(long, default_value_t = 0.2)]
     gyro_bias_sigma: f64,
+    /// Skip this many seconds after the first sample (e.g. a disturbed start), as allan and
+    /// imu-check do; the stretch at rest is searched in what follows, and the times printed
+    /// still count from the first sample.
+    #[arg(long, default_value_t = 0.0)]
+    skip: f64,
     /// Use at most this many seconds of the stretch at rest.
     #[arg(long)]
     seconds: Option<f64>,
@@ -47,9 +52,18 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         args.src
             .check_output("--json", j, Provenance::Json("align"), args.overwrite)?;
     }
-    let data = args.src.read(&mut super::data::note)?;
+    let whole = args.src.read(&mut super::data::note)?;
+    // the samples from --skip on (as allan takes them); the rest is searched there
+    let data = sinsmodel::estimate::allan::span(&whole, args.skip, None);
+    if data.samples.is_empty() {
+        anyhow::bail!(
+            "--skip {}: the data last only {:.3} s",
+            args.skip,
+            whole.samples.last().map(|s| s.t).unwrap_or(0.0) - whole.samples[0].t
+        );
+    }
     let d = std::f64::consts::PI / 180.0;
-    let a = align::align(
+    let mut a = align::align(
         &data,
         args.lat.map(|l| l * d),
         args.seconds,
@@ -57,6 +71,8 @@ pub fn run(args: &AlignArgs) -> Result<()> {
         args.h,
         args.gyro_bias_sigma * d / 3600.0,
     )?;
+    // the start of the rest from the first sample of the file, not of the span after --skip
+    a.skipped_s = ((a.skipped_s + data.samples[0].t - whole.samples[0].t) * 1e6).round() / 1e6;
     for line in report::lines(&a, args.lat.is_some()) {
         println!("{line}");
     }
@@ -70,7 +86,7 @@ pub fn run(args: &AlignArgs) -> Result<()> {
     Ok(())
 }
 
-/// Refuses a latitude, longitude, height, gyro-bias σ or length out of range.
+/// Refuses a latitude, longitude, height, gyro-bias σ, skip or length out of range.
 fn check_args(args: &AlignArgs) -> Result<()> {
     if let Some(l) = args.lat {
         if !(l.is_finite() && (-89.0..=89.0).contains(&l)) {
@@ -92,6 +108,9 @@ fn check_args(args: &AlignArgs) -> Result<()> {
             "--gyro-bias-sigma {}: expected a positive gyro-bias sigma in deg/h (at most 3.6e6, i.e. 1000 deg/s)",
             args.gyro_bias_sigma
         );
+    }
+    if !(args.skip.is_finite() && args.skip >= 0.0) {
+        anyhow::bail!("--skip {}: expected seconds >= 0", args.skip);
     }
     if let Some(s) = args.seconds {
         if !(s.is_finite() && s > 0.0) {

@@ -33,7 +33,8 @@ pub struct ExplainArgs {
     /// Family-wise false-alarm level of the candidate tests (Holm-corrected), in (0, 0.5].
     #[arg(long, default_value_t = 0.01)]
     alpha: f64,
-    /// Output directory: report.md, report.html, explain.json, extended.toml, figures.
+    /// Output DIRECTORY (not a file; navigate's --out is a file): report.md, report.html,
+    /// explain.json, extended.toml, figures.
     #[arg(long, default_value = "out/explain")]
     out: PathBuf,
     /// Also write the explain JSON (DESIGN §9) here.

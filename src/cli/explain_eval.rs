@@ -41,7 +41,8 @@ pub struct EvalArgs {
     /// Merge the `cases.json` of these evaluation directories instead of running cases.
     #[arg(long, num_args = 1..)]
     merge: Vec<PathBuf>,
-    /// Output directory: eval.json, eval.md, cases.json, power_curve.png.
+    /// Output DIRECTORY (not a file; navigate's --out is a file): eval.json, eval.md,
+    /// cases.json, power_curve.png.
     #[arg(long)]
     out: PathBuf,
     /// Test only: a deliberately broken selector (names a pseudo-random candidate).

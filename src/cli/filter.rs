@@ -23,13 +23,15 @@ pub struct FilterArgs {
     model: String,
     #[command(flatten)]
     data: DataArgs,
-    /// Output directory: states.txt, innovations.txt, nav.txt (the navigation solution with
-    /// 1-σ) and its plots, model_error.txt (with truth), outages.json (with --outage); written
-    /// complete or not at all, replacing only an earlier sinsmodel run's directory.
+    /// Output DIRECTORY (not a file; navigate's --out is a file): states.txt, innovations.txt,
+    /// nav.txt (the navigation solution with 1-σ) and its plots, model_error.txt (with truth),
+    /// outages.json (with --outage); written complete or not at all, replacing only an earlier
+    /// sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
-    /// Rate of the navigation solution nav.txt [Hz] (default: every IMU sample).
-    #[arg(long)]
+    /// Rate of the navigation solution nav.txt [Hz] (default: every IMU sample); --out-rate,
+    /// navigate's older name, is accepted too.
+    #[arg(long, alias = "out-rate")]
     nav_rate: Option<f64>,
     /// Read the whole IMU file before filtering (the pre-streaming path, kept as the baseline
     /// `sinsmodel bench` measures the stream against).

@@ -1,4 +1,5 @@
-//! `sinsmodel navigate --imu FILE --lat --lon --h --att R,P,Y [--vel N,E,D] [--vertical] --out FILE`.
+//! `sinsmodel navigate --imu FILE (--init LAT,LON,H,R,P,Y[,VN,VE,VD] | --lat --lon --h --att R,P,Y
+//! [--vel N,E,D]) [--vertical] [--nav-rate HZ] --out FILE`.
 
 use anyhow::{bail, Result};
 use clap::Args;
@@ -15,36 +16,44 @@ use std::path::PathBuf;
 pub struct NavigateArgs {
     #[command(flatten)]
     src: super::data::ImuSource,
-    /// Initial latitude [deg].
+    /// Initial state as filter and explain take it: lat,lon [deg],h [m],roll,pitch,yaw
+    /// [deg][,vn,ve,vd m/s] (NED/FRD); instead of --lat --lon --h --att --vel, which stay as
+    /// its parts.
+    #[arg(long, allow_hyphen_values = true, conflicts_with_all = ["lat", "lon", "h", "att", "vel"])]
+    init: Option<String>,
+    /// Initial latitude [deg] (or give --init).
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "init")]
+    lat: Option<f64>,
+    /// Initial longitude [deg] (or give --init).
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "init")]
+    lon: Option<f64>,
+    /// Initial height [m] [default: 0].
     #[arg(long, allow_hyphen_values = true)]
-    lat: f64,
-    /// Initial longitude [deg].
-    #[arg(long, allow_hyphen_values = true)]
-    lon: f64,
-    /// Initial height [m].
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    h: f64,
-    /// Initial roll,pitch,yaw [deg] (NED/FRD), e.g. from `sinsmodel align`.
+    h: Option<f64>,
+    /// Initial roll,pitch,yaw [deg] (NED/FRD), e.g. from `sinsmodel align`: the attitude part
+    /// of --init (filter and explain take the whole initial state as --init).
     #[arg(
         long,
         value_delimiter = ',',
         allow_hyphen_values = true,
-        required = true
+        required_unless_present = "init"
     )]
-    att: Vec<f64>,
-    /// Initial NED velocity N,E,D [m/s].
+    att: Option<Vec<f64>>,
+    /// Initial NED velocity N,E,D [m/s] [default: 0,0,0].
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     vel: Option<Vec<f64>>,
     /// Vertical channel: fixed (default), damped, free.
     #[arg(long, default_value = "fixed")]
     vertical: Vertical,
-    /// Output rate [Hz].
-    #[arg(long, default_value_t = 10.0)]
-    out_rate: f64,
-    /// Output file (truth layout of DESIGN §9).
+    /// Rate of the navigation solution written to --out [Hz] (the name filter uses for its
+    /// nav.txt; --out-rate, the older name, is still accepted).
+    #[arg(long, alias = "out-rate", default_value_t = 10.0)]
+    nav_rate: f64,
+    /// Output FILE (a single file, not a directory, unlike the --out of filter, explain,
+    /// simulate and reproduce): the navigation solution in the truth layout of DESIGN §9.
     #[arg(long)]
     out: PathBuf,
-    /// Run even when --att's roll and pitch contradict the measured gravity direction, or the
+    /// Run even when the initial roll and pitch contradict the measured gravity direction, or the
     /// first seconds' magnitudes look like a unit slip.
     #[arg(long)]
     force: bool,
@@ -59,7 +68,7 @@ pub struct NavigateArgs {
 
 /// Runs the command.
 pub fn run(args: &NavigateArgs) -> Result<()> {
-    check_args(args)?;
+    let init = initial(args)?;
     let check_out = || {
         args.src.check_output(
             "--out",
@@ -75,12 +84,10 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.in_memory {
         data = data.into_memory()?;
     }
-    check_start(args, &data)?;
-    let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
-    let att = [args.att[0], args.att[1], args.att[2]];
+    check_start(args, &init, &data)?;
     let t0 = data.start_time();
-    let start = free_inertial::start_state(t0, args.lat, args.lon, args.h, att, [v[0], v[1], v[2]]);
-    let mut clock = RowClock::new(t0, Some(args.out_rate), data.interval());
+    let start = free_inertial::start_state(t0, init.lat, init.lon, init.h, init.att, init.vel);
+    let mut clock = RowClock::new(t0, Some(args.nav_rate), data.interval());
     let row = |s: &NavState| TruthRow {
         t: s.t,
         lat: s.lat,
@@ -115,42 +122,123 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     // checked again: the file may have been replaced while the run worked
     check_out()?;
     out.commit()?;
-    print_summary(args, &data, rows, &start, &end);
+    let vertical_moves = !matches!(args.vertical, Vertical::Fixed);
+    print_summary(args, &data, rows, &start, &end, vertical_moves);
     Ok(())
 }
 
-/// Refuses a latitude, attitude, velocity, longitude, height or output rate out of range.
-fn check_args(args: &NavigateArgs) -> Result<()> {
-    if args.lat.abs() >= 89.0 || !args.lat.is_finite() {
-        bail!("--lat {} must be within ±89°", args.lat);
+/// The initial state of the run, from --init or from --lat --lon --h --att --vel (deg, m, m/s).
+struct Initial {
+    lat: f64,
+    lon: f64,
+    h: f64,
+    att: [f64; 3],
+    vel: [f64; 3],
+    /// The option the attitude came from (`--init` or `--att`), for messages.
+    att_option: &'static str,
+}
+
+/// The initial state the options give, each value checked; the output rate checked too.
+fn initial(args: &NavigateArgs) -> Result<Initial> {
+    let init = match &args.init {
+        Some(text) => from_init(text)?,
+        None => {
+            // clap requires these without --init
+            let (Some(lat), Some(lon), Some(att)) = (args.lat, args.lon, &args.att) else {
+                bail!("give --init LAT,LON,H,ROLL,PITCH,YAW, or --lat, --lon and --att");
+            };
+            if att.len() != 3 {
+                bail!("--att: expected roll,pitch,yaw in degrees (three numbers)");
+            }
+            let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
+            if v.len() != 3 {
+                bail!("--vel: expected N,E,D in m/s (three finite comma-separated numbers within ±1e4)");
+            }
+            Initial {
+                lat,
+                lon,
+                h: args.h.unwrap_or(0.0),
+                att: [att[0], att[1], att[2]],
+                vel: [v[0], v[1], v[2]],
+                att_option: "--att",
+            }
+        }
+    };
+    check_initial(&init)?;
+    if !(args.nav_rate.is_finite() && args.nav_rate > 0.0 && args.nav_rate <= 1e5) {
+        bail!(
+            "--nav-rate {}: expected a rate in (0, 1e5] Hz",
+            args.nav_rate
+        );
+    }
+    Ok(init)
+}
+
+/// `--init LAT,LON,H,ROLL,PITCH,YAW[,VN,VE,VD]` as filter and explain take it (no `auto`:
+/// navigate has no GNSS to head by).
+fn from_init(text: &str) -> Result<Initial> {
+    let expected = "expected lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (numbers, deg, m, deg, m/s)";
+    if text.trim() == "auto" {
+        bail!("--init auto: navigate has no aiding to start from; {expected}, e.g. the attitude from `sinsmodel align`");
+    }
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| {
+            anyhow::anyhow!("--init `{}`: {expected}", sinsmodel::io::lines::shown(text))
+        })?;
+    if v.len() != 6 && v.len() != 9 {
+        bail!(
+            "--init takes lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (6 or 9 numbers), got {}",
+            v.len()
+        );
+    }
+    Ok(Initial {
+        lat: v[0],
+        lon: v[1],
+        h: v[2],
+        att: [v[3], v[4], v[5]],
+        vel: if v.len() == 9 {
+            [v[6], v[7], v[8]]
+        } else {
+            [0.0; 3]
+        },
+        att_option: "--init",
+    })
+}
+
+/// Refuses a latitude, attitude, velocity, longitude or height out of range.
+fn check_initial(i: &Initial) -> Result<()> {
+    let (lat_o, lon_o, h_o, vel_o) = if i.att_option == "--init" {
+        (
+            "--init: lat",
+            "--init: lon",
+            "--init: h",
+            "--init: velocity",
+        )
+    } else {
+        ("--lat", "--lon", "--h", "--vel")
+    };
+    if i.lat.abs() >= 89.0 || !i.lat.is_finite() {
+        bail!("{lat_o} {} must be within ±89°", i.lat);
     }
     use sinsmodel::io::bounds;
-    if args.att.len() != 3
-        || bounds::attitude_deg([args.att[0], args.att[1], args.att[2]]).is_some()
-    {
+    if bounds::attitude_deg(i.att).is_some() {
         bail!(
-            "--att {}: expected roll,pitch,yaw in degrees (roll within ±180, pitch within ±90, yaw within ±360)",
-            args.att.iter().map(|a| a.to_string()).collect::<Vec<_>>().join(",")
+            "{}{}: expected roll,pitch,yaw in degrees (roll within ±180, pitch within ±90, yaw within ±360)",
+            if i.att_option == "--init" { "--init: attitude " } else { "--att " },
+            i.att.iter().map(|a| a.to_string()).collect::<Vec<_>>().join(",")
         );
     }
-    if args
-        .vel
-        .as_ref()
-        .is_some_and(|v| v.len() != 3 || v.iter().any(|x| !x.is_finite() || x.abs() > 1e4))
-    {
-        bail!("--vel: expected N,E,D in m/s (three finite comma-separated numbers within ±1e4)");
+    if i.vel.iter().any(|x| !x.is_finite() || x.abs() > 1e4) {
+        bail!("{vel_o}: expected N,E,D in m/s (three finite numbers within ±1e4)");
     }
-    if let Some(p) = bounds::lon_deg(args.lon) {
-        bail!("--lon: {p}");
+    if let Some(p) = bounds::lon_deg(i.lon) {
+        bail!("{lon_o}: {p}");
     }
-    if let Some(p) = bounds::height_m(args.h) {
-        bail!("--h: {p}");
-    }
-    if !(args.out_rate.is_finite() && args.out_rate > 0.0 && args.out_rate <= 1e5) {
-        bail!(
-            "--out-rate {}: expected a rate in (0, 1e5] Hz",
-            args.out_rate
-        );
+    if let Some(p) = bounds::height_m(i.h) {
+        bail!("{h_o}: {p}");
     }
     Ok(())
 }
@@ -158,11 +246,11 @@ fn check_args(args: &NavigateArgs) -> Result<()> {
 /// The plausibility imu-check applies, on the first 10 s: warns (a start that moves or a tilted
 /// mounting are legitimate here); a unit, scale or clock slip, or an --att that contradicts the
 /// measured gravity, stops the run unless --force.
-fn check_start(args: &NavigateArgs, data: &ImuStream) -> Result<()> {
+fn check_start(args: &NavigateArgs, init: &Initial, data: &ImuStream) -> Result<()> {
     let head = ImuData {
         samples: data.head().to_vec(),
     };
-    let check = sinsmodel::estimate::imu_check::start_check(&head, args.lat.to_radians());
+    let check = sinsmodel::estimate::imu_check::start_check(&head, init.lat.to_radians());
     for p in &check.warnings {
         eprintln!("warning: {p} (`sinsmodel imu-check` shows what was read)");
     }
@@ -177,20 +265,28 @@ fn check_start(args: &NavigateArgs, data: &ImuStream) -> Result<()> {
     let d = std::f64::consts::PI / 180.0;
     if let Some(p) = sinsmodel::estimate::align::attitude_contradicts_gravity(
         &head,
-        args.att[0] * d,
-        args.att[1] * d,
+        init.att[0] * d,
+        init.att[1] * d,
     ) {
         if args.force {
             eprintln!("warning: {p} (--force given)");
         } else {
-            bail!("--att: {p}");
+            bail!("{}: {p}", init.att_option);
         }
     }
     Ok(())
 }
 
-/// Prints what was navigated and written, and how far the end is from the start.
-fn print_summary(args: &NavigateArgs, data: &ImuStream, rows: u64, s0: &NavState, s1: &NavState) {
+/// Prints what was navigated and written, and how far the end is from the start (the height
+/// change too when `vertical_moves`).
+fn print_summary(
+    args: &NavigateArgs,
+    data: &ImuStream,
+    rows: u64,
+    s0: &NavState,
+    s1: &NavState,
+    vertical_moves: bool,
+) {
     eprintln!(
         "navigated {} samples ({:.1} s), wrote {} rows to {}",
         data.count(),
@@ -199,12 +295,29 @@ fn print_summary(args: &NavigateArgs, data: &ImuStream, rows: u64, s0: &NavState
         args.out.display()
     );
     let [dn, de] = free_inertial::displacement_ne(s0, s1);
+    let mut parts = vec![
+        towards(dn / 1000.0, "km", "north", "south"),
+        towards(de / 1000.0, "km", "east", "west"),
+    ];
+    if vertical_moves {
+        parts.push(towards(s1.h - s0.h, "m", "up", "down"));
+    }
     eprintln!(
-        "final position {:.3} km from the start ({:.3} km north, {:.3} km east): free-inertial \
-         navigation, no aiding; its drift grows with the initial attitude and sensor errors (use \
-         `sinsmodel align` for --att on a static start, `sinsmodel filter` to estimate the errors)",
+        "final position {:.3} km from the start ({}): free-inertial navigation, no aiding; its \
+         drift grows with the initial attitude and sensor errors (use `sinsmodel align` for the \
+         attitude of --init or --att on a static start, `sinsmodel filter` to estimate the errors)",
         dn.hypot(de) / 1000.0,
-        dn / 1000.0,
-        de / 1000.0
+        parts.join(", ")
     );
+}
+
+/// A signed displacement `x` in words: its size toward `positive` or `negative`
+/// (`-39.155 km` north is `39.155 km south`).
+fn towards(x: f64, unit: &str, positive: &str, negative: &str) -> String {
+    let rounded = (x * 1000.0).round() / 1000.0;
+    if rounded < 0.0 {
+        format!("{:.3} {unit} {negative}", -x)
+    } else {
+        format!("{:.3} {unit} {positive}", x.abs())
+    }
 }

@@ -25,7 +25,9 @@ pub struct ReproduceArgs {
     /// Seed.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     seed: u64,
-    /// Output directory.
+    /// Output DIRECTORY (not a file; navigate's --out is a file): results.json, results.md and
+    /// the figures. The shipped full run in docs/reproduce/ is refreshed with `sinsmodel
+    /// reproduce --priors-grid --out docs/reproduce`.
     #[arg(long, default_value = "out/reproduce")]
     out: PathBuf,
 }

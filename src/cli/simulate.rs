@@ -15,8 +15,9 @@ use std::path::PathBuf;
 pub struct SimulateArgs {
     /// Scenario file (TOML; see scenarios/).
     scenario: PathBuf,
-    /// Output directory: imu.txt, gnss.txt (with [gnss]), truth.txt and a copy of the scenario;
-    /// written complete or not at all, replacing only an earlier sinsmodel run's directory.
+    /// Output DIRECTORY (not a file; navigate's --out is a file): imu.txt, gnss.txt (with
+    /// [gnss]), truth.txt and a copy of the scenario; written complete or not at all, replacing
+    /// only an earlier sinsmodel run's directory.
     #[arg(long)]
     out: PathBuf,
     /// Simulate even when the run would exceed the size limit (memory or output size).

@@ -257,11 +257,9 @@ impl DataOptions {
         outages.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
         if let Some(w) = outages.windows(2).find(|w| w[1].start_s < w[0].end_s) {
             bail!(
-                "--outage: the windows {:.3} .. {:.3} s and {:.3} .. {:.3} s overlap: give each outage once (one window from the first start to the last end)",
-                w[0].start_s,
-                w[0].end_s,
-                w[1].start_s,
-                w[1].end_s
+                "--outage: the windows {} and {} overlap: give each outage once (one window from the first start to the last end)",
+                w[0].words(first_t),
+                w[1].words(first_t)
             );
         }
         Ok(outages)

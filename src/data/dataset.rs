@@ -110,9 +110,9 @@ impl DataOptions {
         let t0 = start.state.t;
         if let Some(o) = outages.iter().find(|o| o.end_s <= t0 + 1e-9) {
             bail!(
-                "--outage: the window {:.3} .. {:.3} s ends before the run starts ({t0:.3} s{}): there is no drift to measure",
-                o.start_s,
-                o.end_s,
+                "--outage: the window {} ends before the run starts ({}{}): there is no drift to measure",
+                o.words(imu.first_t()),
+                crate::io::aiding::time_from_first_sample(t0, imu.first_t()),
                 if self.init_auto() { ", where --init auto found its start" } else { "" }
             );
         }

@@ -120,8 +120,8 @@ pub struct DataOptions {
     /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`.
     #[cfg_attr(feature = "cli", arg(long))]
     pub prior: Vec<String>,
-    /// Sensor white noise instead of the spec defaults: a `sinsmodel allan --json` file (mean
-    /// ARW of the gyros, VRW of the accelerometers), or inline with units:
+    /// Sensor white noise instead of the spec defaults: a `sinsmodel allan --json` file (the RMS
+    /// over the three axes of the gyros' ARW, and of the accelerometers' VRW), or inline with units:
     /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`; inline may add a bias random walk (bias
     /// instability) `gyro_bias_rw=10 deg/h/sqrt(h), accel_bias_rw=30 ug/sqrt(s)`, which explain
     /// then tests as noise levels too.
@@ -158,8 +158,10 @@ pub struct DataOptions {
     /// mems; --prior and --noise override single values.
     #[cfg_attr(feature = "cli", arg(long))]
     pub grade: Option<String>,
-    /// A GNSS outage: START,DURATION [s], START counted from the first IMU sample; the aiding
-    /// epochs inside are dropped and the drift at its end is reported (repeatable).
+    /// A GNSS outage: START,DURATION [s], START counted from the first IMU sample (not the
+    /// data's clock, which may be absolute GPS seconds; `--init auto` prints its start both
+    /// ways); the aiding epochs inside are dropped and the drift at its end is reported
+    /// (repeatable).
     #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub outage: Vec<String>,
     /// Known IMU–GNSS time offset with its unit (`92 ms`, `0.092 s`): a fix stamped t is the

@@ -111,22 +111,48 @@ impl DataOptions {
         Ok(out)
     }
 
+    /// What the user set over the grade's priors and noise, in words (`eps_*, nabla_* set by
+    /// --prior and the noise set by --noise`); None when nothing was.
+    fn overridden(&self) -> Option<String> {
+        let mut names: Vec<String> = Vec::new();
+        for p in &self.prior {
+            let name = p.split('=').next().unwrap_or("").trim();
+            let name = crate::io::lines::shown(name);
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+        let mut parts = Vec::new();
+        if !names.is_empty() {
+            parts.push(format!("{} set by --prior", names.join(", ")));
+        }
+        if self.noise.is_some() {
+            parts.push("the noise set by --noise".to_string());
+        }
+        (!parts.is_empty()).then(|| parts.join(" and "))
+    }
+
     /// What the run assumes of the sensor, one line each: the grade the priors assume, the known
     /// GNSS values applied, the noise `--noise` gives (said once per run).
     pub fn noise_lines(&self) -> Result<Vec<String>> {
         let mut lines = Vec::new();
-        match grade_table(self.grade.as_deref())? {
-            None => lines.push(format!(
-                "priors and noise: {} (the spec's defaults, a navigation-grade laser-gyro INS); --grade tactical|mems for other sensors{}",
+        let overridden = self.overridden();
+        match (grade_table(self.grade.as_deref())?, overridden) {
+            (None, None) => lines.push(format!(
+                "priors and noise: {} (the spec's defaults, a navigation-grade laser-gyro INS); --grade tactical|mems for other sensors",
                 if self.grade.is_some() { "--grade navigation" } else { "navigation grade" },
-                if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
             )),
-            Some(g) => lines.push(format!(
+            // a hand-tuned run is not the laser-gyro INS the defaults describe: say what is whose
+            (None, Some(o)) => lines.push(format!(
+                "priors and noise: the spec's navigation-grade defaults{}, with {o}; the other values stay those of a navigation-grade laser-gyro INS (--grade tactical|mems for other sensors)",
+                if self.grade.is_some() { " (--grade navigation)" } else { "" },
+            )),
+            (Some(g), o) => lines.push(format!(
                 "priors and noise: --grade {} (ARW {}, VRW {}; the priors of model-spec/grades.toml){}",
                 g.name,
                 g.gyro_arw_text,
                 g.accel_vrw_text,
-                if self.prior.is_empty() && self.noise.is_none() { "" } else { "; --prior/--noise override single values" }
+                o.map(|o| format!(", with {o}")).unwrap_or_default()
             )),
         }
         for (t, v) in self.known_gnss()? {
@@ -323,7 +349,7 @@ pub struct NoiseGiven {
 }
 
 /// The noise `--noise` gives: inline `arw=Q, vrw=Q[, gyro_bias_rw=Q, accel_bias_rw=Q]` with
-/// units, or an `allan --json` file (its white noise, the mean over the three axes).
+/// units, or an `allan --json` file (its white noise, the RMS over the three axes).
 pub fn noise_given(path: &std::path::Path) -> Result<NoiseGiven> {
     let text = path.to_string_lossy();
     if text.contains('=') && !path.exists() {
@@ -338,8 +364,8 @@ pub fn noise_given(path: &std::path::Path) -> Result<NoiseGiven> {
     })
 }
 
-/// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] of an `allan --json` file (the mean over
-/// the three axes), each checked for a plausible size.
+/// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] of an `allan --json` file (the RMS over
+/// the three axes: √((x² + y² + z²)/3)), each checked for a plausible size.
 fn white_noise_of_allan_json(path: &std::path::Path) -> Result<(f64, f64)> {
     let text = crate::io::lines::read_small_text(path, "--noise")
         .with_context(|| format!("--noise {}: cannot read the file", path.display()))?;

@@ -161,13 +161,19 @@ impl DataOptions {
                 note(&format!("init auto: {line}"));
             }
             // the run starts after the start's sample
+            let first_t = imu.first_t();
             let skipped = imu.skip_through(found.state.t + 1e-9)?;
-            if skipped > 0 {
-                note(&format!(
-                    "init auto: {skipped} IMU samples before {:.3} s skipped",
-                    found.state.t
-                ));
-            }
+            // the data's clock may be absolute (GPS seconds) while --outage counts from the
+            // first sample: the start said both ways
+            note(&format!(
+                "init auto: the run starts at {} (--outage START counts from that sample){}",
+                crate::io::aiding::time_from_first_sample(found.state.t, first_t),
+                if skipped > 0 {
+                    format!("; the {skipped} IMU samples before it are skipped")
+                } else {
+                    String::new()
+                }
+            ));
             return Ok(Start {
                 state: found.state,
                 sigma: Some((found.sigma_tilt, found.sigma_yaw)),

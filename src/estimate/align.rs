@@ -202,7 +202,8 @@ pub struct Alignment {
     /// 1-σ of the estimated latitude [deg]: the scatter of one-minute estimates and the gyro
     /// bias against the Earth rate (0 when given; None when the latitude is not determined).
     pub lat_sigma_deg: Option<f64>,
-    /// Seconds skipped as disturbed at the start.
+    /// Seconds from the first sample to the stretch used: skipped as disturbed or moving (and,
+    /// with align's `--skip`, set by the caller from the first sample of the file).
     pub skipped_s: f64,
     /// Coarse heading per window of the used data [deg] (evidence of stability); empty when
     /// the gyros cannot find north.
@@ -324,7 +325,7 @@ fn samples_at_rest(
             "the data are not at rest long enough to align: the longest stretch at rest is {rest_s:.0} s of {:.0} s, 60 s are needed. \
              In the {} of {} ten-second windows judged moving: specific-force spread up to {:.3} m/s^2 (at rest <= {STATIC_F_SPREAD}), \
              angular-rate spread up to {:.3} deg/s (at rest <= {:.2}), | |f| - g | up to {:.3} m/s^2 (at rest <= {:.2}). \
-             Give the attitude instead: --init for filter/explain, --att for navigate (from a known mounting, or a GNSS course once moving)",
+             Give the attitude instead: --init for filter, explain and navigate (or navigate's --att) (from a known mounting, or a GNSS course once moving)",
             data.duration(),
             moving.len(),
             evidence.len(),

@@ -169,8 +169,9 @@ pub fn outage_drifts(
         };
         let (Some(n), Some(e)) = (after(0), after(1)) else {
             bail!(
-                "--outage ending at {:.1} s: no position fix after it inside the data (which end at {t_last:.1} s): nothing to measure the drift against",
-                o.end_s
+                "--outage {}: no position fix after it inside the data (which end at {}): nothing to measure the drift against",
+                o.words(t_first),
+                crate::io::aiding::time_from_first_sample(t_last, t_first)
             );
         };
         out.push(OutageDrift {

@@ -178,4 +178,38 @@ impl Outage {
     pub fn contains(&self, t: f64) -> bool {
         t >= self.start_s && t < self.end_s
     }
+
+    /// The window in words, counted from the first IMU sample (`first_t` [s]) as `--outage`
+    /// takes it, and on the data's clock when that is not the same.
+    pub fn words(&self, first_t: f64) -> String {
+        let rel = format!(
+            "{:.3} .. {:.3} s from the first IMU sample",
+            self.start_s - first_t,
+            self.end_s - first_t
+        );
+        if first_t == 0.0 {
+            rel
+        } else {
+            format!(
+                "{rel} (t = {:.3} .. {:.3} s on the data's clock)",
+                self.start_s, self.end_s
+            )
+        }
+    }
+}
+
+/// A time `t` [s] on the data's clock in words: seconds from the first IMU sample (`first_t`),
+/// as `--outage` counts, and on the data's clock (absolute GPS seconds, say) when that differs.
+pub fn time_from_first_sample(t: f64, first_t: f64) -> String {
+    let d = t - first_t;
+    let rel = if d < -0.0005 {
+        format!("{:.3} s before the first IMU sample", -d)
+    } else {
+        format!("{:.3} s from the first IMU sample", d.abs())
+    };
+    if first_t == 0.0 {
+        rel
+    } else {
+        format!("t = {t:.3} s on the data's clock = {rel}")
+    }
 }

@@ -142,7 +142,7 @@ pub fn outage_table(rows: &[metrics::OutageDrift], t_first: f64) -> String {
         return String::new();
     }
     let mut s = String::from(
-        "GNSS outages: drift at the first fix after each (the filter's solution against that fix)\n",
+        "GNSS outages: drift at the first fix after each (the filter's solution against that fix; times in seconds from the first IMU sample, as --outage counts)\n",
     );
     s.push_str(&format!(
         "  {:>10} {:>9} {:>10} {:>9} {:>9} {:>10}\n",
