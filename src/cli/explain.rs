@@ -266,8 +266,9 @@ fn finish(
         check_json(j, args.overwrite)?;
         atomic_file::write_text(j, &text)?;
     }
+    // the terminal reads like the report: f_z², µg/g² (the JSON keeps the spec's spelling)
     for line in &e.summary {
-        eprintln!("{line}");
+        eprintln!("{}", report::notation(line));
     }
     println!(
         "report: {} (and report.html, explain.json{} there)",
