@@ -82,6 +82,23 @@ fn demo_finds_d_and_writes_the_design_contract() {
         if f["term"] == axis {
             let est = f["estimate"].as_f64().unwrap();
             assert!((est - 490.3).abs() < 49.0, "{axis} = {est} ug/g^2");
+            // the vibration runs in windows: f² is excited over part of the run, where the
+            // term's effect is several times its whole-run mean
+            let frac = f["excited_fraction"].as_f64().unwrap();
+            let (whole, there) = (
+                f["effect"].as_f64().unwrap(),
+                f["effect_excited"].as_f64().unwrap(),
+            );
+            assert!((0.1..0.8).contains(&frac), "{axis}: excited {frac}");
+            assert!(
+                there > 1.5 * whole && whole > 0.0,
+                "{axis}: {there} mg there, {whole} mg in all"
+            );
+            assert!(
+                f["words"].as_str().unwrap().contains("is excited ("),
+                "{}",
+                f["words"]
+            );
         }
     }
     let before = v["gain"]["model_error_rms_before"].as_f64().unwrap();

@@ -63,6 +63,10 @@ const NOT_RUN: &[(&str, &str)] = &[
         "cargo bench",
         "criterion runs for minutes; the benches are compiled by clippy --all-targets",
     ),
+    (
+        "tools/bench-table",
+        "it runs the benchmarks for minutes and rewrites the README's table",
+    ),
 ];
 
 /// The commands of every ```sh block, continuations joined, comments dropped.

@@ -65,6 +65,14 @@ pub struct Finding {
     pub regressor_mean: f64,
     /// Unit of `regressor_mean`, e.g. `g^2`.
     pub regressor_unit: String,
+    /// Mean regressor over the samples where it is excited (|regressor| at least a tenth of its
+    /// 99.9th percentile), in `regressor_unit`.
+    pub regressor_excited_mean: f64,
+    /// Fraction of the samples where the regressor is excited (0–1).
+    pub excited_fraction: f64,
+    /// What the term does where its regressor is excited: estimate × `regressor_excited_mean`,
+    /// in `effect_unit`.
+    pub effect_excited: f64,
     /// What the term does on these data: estimate × mean regressor, in `effect_unit`.
     pub effect: f64,
     /// `mg` (accelerometer) or `deg/h` (gyro).

@@ -941,7 +941,7 @@ fn complete_findings(
     let means = if terms.is_empty() {
         Vec::new()
     } else {
-        regressor_means(ctx.data, &terms)?
+        regressor_stats(ctx.data, &terms)?
     };
     let last = r.pass.run.records.last();
     let used_priors = ctx.extended_config(&r.model, &r.widened)?.prior_sigma;
@@ -957,14 +957,20 @@ fn complete_findings(
             prior = used_priors[i] * to_display;
             widened = used_priors[i] > prior_sigma(t, ctx.opts);
         }
-        let (regressor_mean, regressor_unit) = regressor_in_natural_units(info.regressor, c);
-        let effect_si = estimate / to_display * c;
-        let (effect, effect_unit) = match info.sensor {
-            Sensor::Accel => (effect_si / G0 * 1e3, "mg"),
-            Sensor::Gyro => (effect_si * 180.0 / std::f64::consts::PI * 3600.0, "deg/h"),
-            // a GNSS term acts on the aiding as itself
-            Sensor::Gnss => (estimate, info.display),
+        let (regressor_mean, regressor_unit) = regressor_in_natural_units(info.regressor, c.mean);
+        let (regressor_excited_mean, _) =
+            regressor_in_natural_units(info.regressor, c.excited_mean);
+        let effect_of = |r: f64| {
+            let effect_si = estimate / to_display * r;
+            match info.sensor {
+                Sensor::Accel => (effect_si / G0 * 1e3, "mg"),
+                Sensor::Gyro => (effect_si * 180.0 / std::f64::consts::PI * 3600.0, "deg/h"),
+                // a GNSS term acts on the aiding as itself
+                Sensor::Gnss => (estimate, info.display),
+            }
         };
+        let (effect, effect_unit) = effect_of(c.mean);
+        let (effect_excited, _) = effect_of(c.excited_mean);
         let mut f = Finding {
             term: info.name.to_string(),
             kind: if info.sensor == Sensor::Gnss {
@@ -989,6 +995,9 @@ fn complete_findings(
             confounded_with: n.confounded_with.clone(),
             regressor_mean,
             regressor_unit,
+            regressor_excited_mean,
+            excited_fraction: c.excited_fraction,
+            effect_excited,
             effect,
             effect_unit: effect_unit.into(),
             separate_by: n.separate_by.clone(),
@@ -1133,11 +1142,32 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
     (!why.is_empty()).then(|| why.join("; "))
 }
 
-/// Mean over the run of each term's regressor (SI), in one pass over the IMU samples (the
-/// extended pass has no candidates, so it is computed from the samples directly).
-fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f64>> {
+/// A regressor's statistics over the run (SI): its mean, and its mean and share of the samples
+/// where it is excited.
+#[derive(Debug, Clone, Copy, Default)]
+struct RegressorStats {
+    /// Mean over every sample.
+    mean: f64,
+    /// Mean over the samples where |r| is at least a tenth of its 99.9th percentile.
+    excited_mean: f64,
+    /// Share of the samples where it is excited.
+    excited_fraction: f64,
+}
+
+/// Each term's regressor statistics (SI), in one pass over the IMU samples (the extended pass
+/// has no candidates, so they are computed from the samples directly). |r| is binned on a log
+/// scale (20 bins per decade over 1e-15..1e10, sums kept per bin), so the percentile and the
+/// excited mean need no second pass and no memory per sample.
+fn regressor_stats(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<RegressorStats>> {
+    const PER_DECADE: f64 = 20.0;
+    const LO: f64 = -15.0;
+    const BINS: usize = 500;
+    let bin = |a: f64| -> Option<usize> {
+        (a > 0.0).then(|| (((a.log10() - LO) * PER_DECADE).floor().max(0.0) as usize).min(BINS - 1))
+    };
     let mut prev = data.start.t;
     let mut sums = vec![0.0; terms.len()];
+    let mut hist = vec![vec![(0u64, 0.0f64); BINS]; terms.len()];
     let mut c = 0usize;
     let mut samples = data.imu.samples()?;
     let mut rates = crate::model::SignalRates::default();
@@ -1146,13 +1176,43 @@ fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f6
         prev = smp.t;
         if dt > 0.0 {
             let sig = rates.next(&(smp.dv / dt), &(smp.dtheta / dt), dt);
-            for (sum, &t) in sums.iter_mut().zip(terms) {
-                *sum += common::regressor_value(common::TERMS[t].regressor, &sig);
+            for (k, &t) in terms.iter().enumerate() {
+                let r = common::regressor_value(common::TERMS[t].regressor, &sig);
+                sums[k] += r;
+                if let Some(b) = bin(r.abs()) {
+                    hist[k][b].0 += 1;
+                    hist[k][b].1 += r;
+                }
             }
             c += 1;
         }
     }
-    Ok(sums.into_iter().map(|s| s / c.max(1) as f64).collect())
+    let n = c.max(1) as f64;
+    Ok(sums
+        .iter()
+        .zip(&hist)
+        .map(|(&sum, h)| {
+            // the 99.9th percentile of |r| (lower edge of its bin), then the bins from a tenth of it
+            let mut above = 0u64;
+            let mut top = 0;
+            for b in (0..BINS).rev() {
+                above += h[b].0;
+                if above as f64 >= 0.001 * n {
+                    top = b;
+                    break;
+                }
+            }
+            let from = top.saturating_sub(PER_DECADE as usize);
+            let (cnt, s) = h[from..]
+                .iter()
+                .fold((0u64, 0.0), |(a, b), x| (a + x.0, b + x.1));
+            RegressorStats {
+                mean: sum / n,
+                excited_mean: if cnt > 0 { s / cnt as f64 } else { 0.0 },
+                excited_fraction: cnt as f64 / n,
+            }
+        })
+        .collect())
 }
 
 fn normalised(run: &FilterRun) -> Vec<(f64, String, f64)> {
@@ -1210,6 +1270,9 @@ mod tests {
             round: 1,
             confounded_with: None,
             regressor_mean: 0.0,
+            regressor_excited_mean: 0.0,
+            excited_fraction: 0.0,
+            effect_excited: 0.0,
             regressor_unit: String::new(),
             effect: 0.0,
             effect_unit: String::new(),

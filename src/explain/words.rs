@@ -190,6 +190,22 @@ pub(super) fn finding_words(
             sig3(f.sigma),
             f.unit,
         )
+    } else if f.excited_fraction < 0.9 && f.effect_excited.abs() > 1.5 * f.effect.abs() {
+        // a regressor excited over part of the run: its effect there, not diluted by the rest
+        format!(
+            "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): where {reg} is excited ({} % of the run) it averages {} {}, and the term acts as a {} {} {bias} along {axis} there ({} {} over the whole run)",
+            f.term,
+            sig3(f.estimate),
+            sig3(f.sigma),
+            f.unit,
+            sig3(100.0 * f.excited_fraction),
+            sig3(f.regressor_excited_mean),
+            f.regressor_unit,
+            sig3(f.effect_excited),
+            f.effect_unit,
+            sig3(f.effect),
+            f.effect_unit,
+        )
     } else {
         format!(
             "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {bias} along {axis}",

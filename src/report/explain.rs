@@ -221,6 +221,7 @@ fn short_words(f: &crate::explain::Finding) -> String {
         " (extended filter",
         "; the data cannot",
         ": with the data's",
+        ": where ",
         "; it explains",
         ". It probably",
         ": it acts",
