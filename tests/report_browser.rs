@@ -66,12 +66,13 @@ fn run_browser(browser: &Path, profile: &Path, extra: &[String], url: &str) -> S
     String::from_utf8_lossy(&std::fs::read(&dump).expect("the browser's stdout")).into_owned()
 }
 
-/// The checks, run in the page once its images are decoded; the result goes into the DOM as
+/// The checks, run in the page at its `load` event (every image loaded or failed); the result goes into the DOM as
 /// JSON text inside `<pre id="sinsmodel-check">`.
 const CHECK: &str = r#"<script>
-window.addEventListener('load', async () => {
+window.addEventListener('load', () => {
+  // synchronous: at 'load' every image has loaded (or failed); an awaited decode() runs in real
+  // time, which the virtual-time budget does not wait for
   const imgs = Array.from(document.images);
-  await Promise.all(imgs.map(i => i.decode().catch(() => null)));
   const text = document.body.innerText;
   const markers = ['**', '|---', '](', '![', '```', '`', '\n## ', '\n# ', '<figure', '&lt;'];
   const r = {
