@@ -155,7 +155,9 @@ fn candidates(out: &OutputDir, e: &Explanation, figs: &mut Vec<(String, String)>
     Ok(())
 }
 
-/// The estimates of the terms found with ±2σ (each in its own unit); nothing without findings.
+/// The estimates of the terms found, each as its distance from 0 (a noise level: from its stated
+/// value) in units of its own σ, so terms in different units share one axis, with ±2 (its 95 %
+/// interval), labelled with the value in its unit; nothing without findings.
 fn estimates(out: &OutputDir, e: &Explanation, figs: &mut Vec<(String, String)>) -> Result<()> {
     if e.findings.is_empty() {
         return Ok(());
@@ -164,21 +166,33 @@ fn estimates(out: &OutputDir, e: &Explanation, figs: &mut Vec<(String, String)>)
         .findings
         .iter()
         .map(|f| Bar {
-            label: format!("{} [{}]", f.term, f.unit),
-            value: f.estimate,
-            err: Some(2.0 * f.sigma),
+            label: format!(
+                "{} = {} ± {} {}",
+                f.term,
+                crate::io::units::sig3(f.estimate),
+                crate::io::units::sig3(f.sigma),
+                words::notation(&f.unit)
+            ),
+            // a term against 0, a noise level against its stated value
+            value: if f.sigma > 0.0 {
+                let reference = f.scale.map(|k| f.estimate / k).unwrap_or(0.0);
+                (f.estimate - reference) / f.sigma
+            } else {
+                f64::NAN
+            },
+            err: Some(2.0),
         })
         .collect();
     plot::bar_plot(
         &out.file("estimates.png"),
-        "Estimates of the terms found (extended filter), ±2σ",
-        "estimate (each in its own unit)",
+        "Estimates of the terms found (extended filter), in units of their σ, ±2",
+        "(estimate − reference) / σ; reference 0, a noise level's the stated value",
         &bars,
         None,
     )?;
     figs.push((
         "estimates.png".into(),
-        "Estimates of the terms found, with ±2σ".into(),
+        "Estimates of the terms found, each as its distance from 0 (a noise level: from its stated value) in its own σ, with ±2 (its 95 % interval; beyond ±2 the data distinguish it); the values in their units label the bars".into(),
     ));
     Ok(())
 }

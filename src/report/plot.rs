@@ -324,12 +324,15 @@ pub fn bar_plot(
         // row k is drawn at y = n - 1 - k so the first bar is on top
         let row = |k: usize| (n - 1 - k) as f64;
         let labels: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
+        // room for the longest label (about 8 px a character at 14 px)
+        let label_w = (20 + 8 * labels.iter().map(|l| l.chars().count()).max().unwrap_or(0) as u32)
+            .clamp(120, 450);
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(15)
             .margin_right(30)
             .x_label_area_size(50)
-            .y_label_area_size(170)
+            .y_label_area_size(label_w)
             .build_cartesian_2d((lo - pad)..(hi + pad), -0.5..(n as f64 - 0.5))
             .map_err(|e| err(&e))?;
         chart
