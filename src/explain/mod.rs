@@ -1318,6 +1318,38 @@ mod tests {
     }
 
     #[test]
+    fn an_unattributed_class_names_no_member_in_its_words() {
+        let t = common::TERMS
+            .iter()
+            .position(|t| t.name == "kas_x")
+            .unwrap();
+        let info = &common::TERMS[t];
+        let mut f = finding(40.0, Some(0.9));
+        f.term = "kas_x".into();
+        f.unit = info.display.into();
+        f.equivalent = vec!["kao_x".into()];
+        f.equivalent_estimates = vec![EquivalentTerm {
+            term: "kao_x".into(),
+            estimate: 5.0,
+            sigma: 0.1,
+            unit: "ppm".into(),
+            prior_sigmas: 900.0,
+        }];
+        f.separate_by = vec!["two vibration amplitudes separate them".into()];
+        let named = finding_words(&f, info, 1.0);
+        assert!(
+            named.contains("named: the one the spec's priors"),
+            "{named}"
+        );
+        f.not_attributed = Some("the priors would choose".into());
+        let w = finding_words(&f, info, 1.0);
+        assert!(
+            !w.contains("named: the one") && w.contains("none named; kas_x stands for the class"),
+            "{w}"
+        );
+    }
+
+    #[test]
     fn the_excess_to_explain_needs_a_mean_nis_above_its_band() {
         let pass = |nis: f64, count: usize| PassStats {
             model: "P28".into(),

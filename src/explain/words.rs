@@ -218,8 +218,14 @@ pub(super) fn finding_words(
                 )
             })
             .collect();
+        // an unattributed class names nothing: the priors that would choose do not fit
+        let named = if f.not_attributed.is_some() {
+            format!("none named; {} stands for the class", f.term)
+        } else {
+            "named: the one the spec's priors find most plausible".to_string()
+        };
         s.push_str(&format!(
-            "; the data cannot separate it from {} (equivalence class; named: the one the spec's priors find most plausible); {}",
+            "; the data cannot separate it from {} (equivalence class; {named}); {}",
             others.join(", "),
             f.separate_by.join("; ")
         ));
