@@ -84,6 +84,21 @@ fn demo_finds_d_and_writes_the_design_contract() {
             assert!((est - 490.3).abs() < 49.0, "{axis} = {est} ug/g^2");
         }
     }
+    // the demo's heights carry no noise: the σ stated for them scales down to the search
+    // bound, which is a bound, not an estimate with an interval
+    let h = findings
+        .iter()
+        .find(|f| f["term"] == "sigma_pos_h")
+        .expect("sigma_pos_h");
+    assert_eq!(h["scale_bound"], "at most", "{h}");
+    assert!(h["scale_interval"].is_null() && h["sigma"].is_null(), "{h}");
+    assert!(
+        h["words"]
+            .as_str()
+            .unwrap()
+            .contains("at the search bound (≤"),
+        "{h}"
+    );
     let before = v["gain"]["model_error_rms_before"].as_f64().unwrap();
     let after = v["gain"]["model_error_rms_after"].as_f64().unwrap();
     assert!(after < 0.2 * before, "model error {before} -> {after}");

@@ -97,8 +97,13 @@ pub struct Finding {
     /// A noise finding's maximum-likelihood scale of the stated value (white noise density, or
     /// the aiding's stated 1-σ).
     pub scale: Option<f64>,
-    /// Its approximate 95 % interval.
+    /// Its approximate 95 % interval; null when the scale is at the search bound.
     pub scale_interval: Option<[f64; 2]>,
+    /// `at most` when the search for the scale stopped at its lower bound with the likelihood
+    /// still rising towards smaller values (`scale` is then a bound, not an estimate, and
+    /// `sigma` and `scale_interval` are null), `at least` at its upper bound; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale_bound: Option<&'static str>,
     /// A term finding's GLR estimate and σ (display unit) from the first and from the second
     /// half of the aiding epochs alone: `[[estimate, σ], [estimate, σ]]` (null without
     /// information in a half). A constant of the sensor or the aiding holds across both.

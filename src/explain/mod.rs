@@ -1030,6 +1030,7 @@ fn complete_findings(
             }),
             scale: None,
             scale_interval: None,
+            scale_bound: None,
             halves: split_halves(&n.splits, "time"),
             speed_halves: split_halves(&n.splits, "speed"),
             consistency: n
@@ -1224,6 +1225,7 @@ mod tests {
             not_attributed: None,
             scale: None,
             scale_interval: None,
+            scale_bound: None,
             halves: None,
             speed_halves: None,
             consistency: vec![],
