@@ -84,6 +84,18 @@ fn demo_finds_d_and_writes_the_design_contract() {
             assert!((est - 490.3).abs() < 49.0, "{axis} = {est} ug/g^2");
         }
     }
+    // the baseline had an excess to explain: what the extension leaves is said, named or not
+    let summary: Vec<&str> = v["summary"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert!(v["gain"]["misfit_unexplained"].is_number());
+    assert!(
+        summary.iter().any(|l| l.starts_with("Left unexplained: ")),
+        "{summary:#?}"
+    );
     // the demo's heights carry no noise: the σ stated for them scales down to the search
     // bound, which is a bound, not an estimate with an interval
     let h = findings

@@ -383,6 +383,21 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
     }
 }
 
+/// A mean NIS for the summary's comparisons with 1 and with each other: four significant
+/// digits (1.012 → 1.004, where three would print 1.01 → 1.00).
+pub(super) fn nis_text(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() || a == 0.0 || !(1e-3..1e5).contains(&a) {
+        return if v.is_finite() && a != 0.0 {
+            format!("{v:.3e}")
+        } else {
+            sig3(v)
+        };
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
+}
+
 /// A p-value for the words: three significant digits, "< 1e-16" below double precision's
 /// resolution of 1 − p (where it is 0 or a rounding residue).
 fn p_text(p: f64) -> String {
@@ -478,7 +493,7 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
         out.push(format!(
             "The baseline {} is consistent with the data: mean NIS {} and white innovations in every channel.",
             e.baseline_model,
-            sig3(e.baseline.nis_mean)
+            nis_text(e.baseline.nis_mean)
         ));
     }
 }
@@ -531,8 +546,8 @@ fn findings_words(e: &Explanation, out: &mut Vec<String>) {
         let mut s = format!(
             "Extended model {}: mean NIS {} → {}, log-likelihood {:+.1}",
             e.extended_model,
-            sig3(e.gain.nis_mean_before),
-            sig3(e.gain.nis_mean_after),
+            nis_text(e.gain.nis_mean_before),
+            nis_text(e.gain.nis_mean_after),
             e.gain.loglik
         );
         if let (Some(b), Some(a)) = (e.gain.model_error_rms_before, e.gain.model_error_rms_after) {
@@ -555,19 +570,23 @@ fn findings_words(e: &Explanation, out: &mut Vec<String>) {
 /// The summary's lines on what the extension leaves: the unexplained share of the misfit and the
 /// structure left in the innovations; times from `t_ref` [s].
 fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
+    // said whenever the baseline had an excess to explain (a mean NIS of the extended model
+    // below 1 leaves none of it: 0 %)
     if let Some(left) = e.misfit_unexplained {
-        if e.findings.is_empty() || left > 0.1 {
-            out.push(format!(
-                "Left unexplained: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter){}.",
-                sig3(100.0 * left),
-                sig3(e.extended.nis_mean),
-                if left > 0.5 {
-                    "; most of the misfit is something the candidates do not describe"
-                } else {
-                    ""
-                }
-            ));
-        }
+        out.push(format!(
+            "Left unexplained: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter){}.",
+            if left > 0.0 {
+                sig3(100.0 * left)
+            } else {
+                "0".into()
+            },
+            nis_text(e.extended.nis_mean),
+            if left > 0.5 {
+                "; most of the misfit is something the candidates do not describe"
+            } else {
+                ""
+            }
+        ));
     }
     // what the extended model leaves in the innovations (the baseline's was said above)
     let left = e.extended.structure();
@@ -658,5 +677,20 @@ fn not_named_words(e: &Explanation, out: &mut Vec<String>) {
             "Not testable on these data (no information): {}.",
             e.not_testable.join(", ")
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_mean_nis_near_1_keeps_enough_digits_to_differ() {
+        assert_eq!(nis_text(1.0123), "1.012");
+        assert_eq!(nis_text(1.0041), "1.004");
+        assert_eq!(nis_text(0.917), "0.9170");
+        assert_eq!(nis_text(2324.4), "2324");
+        assert_eq!(nis_text(21.53), "21.53");
+        assert_eq!(nis_text(3.0e6), "3.000e6");
     }
 }
