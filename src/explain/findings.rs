@@ -131,17 +131,23 @@ pub struct Consistency {
     /// The split: `time` (halves of the aiding epochs), `speed` (below and from the median
     /// aided speed), `motion` (by the body axis of the most recent rotation).
     pub split: String,
-    /// The groups with information, each with its estimate and σ (display unit).
+    /// The groups with information, each with its estimate and σ (display unit); a group
+    /// whose σ is infinite, NaN or more than 100× the best group's carries none and is left out.
     pub groups: Vec<GroupEstimate>,
     /// χ² of the group estimates about their information-weighted mean.
     pub chi2: f64,
     /// Its degrees of freedom (groups with information − 1).
     pub dof: usize,
-    /// Its p-value.
+    /// Its p-value; null when the split is not tested.
     pub p_value: f64,
     /// False when the groups disagree: χ² p < 0.0027 (3σ) and two groups more than 3σ and
-    /// more than a quarter of the larger apart.
+    /// more than a quarter of the larger apart. True also when the split is not tested (see
+    /// `tested`): nothing speaks against the term there, but nothing for it either.
     pub holds: bool,
+    /// False when fewer than two groups carry information: no test was made.
+    pub tested: bool,
+    /// Why the split holds, fails or was not tested, in words.
+    pub why: String,
 }
 
 /// A finding's estimate from one group of the updates alone.
@@ -289,7 +295,10 @@ pub struct Implausible {
 }
 
 /// χ² p-value below which a split's groups disagree (the two-sided 3σ level).
-const SPLIT_P: f64 = 0.0027;
+pub(super) const SPLIT_P: f64 = 0.0027;
+
+/// A group carries information when its σ is within this many times the best group's.
+const INFORMATIVE: f64 = 100.0;
 
 impl Consistency {
     /// The test over `split`'s groups (group k named `label(k)`), given each group's estimate
@@ -300,10 +309,18 @@ impl Consistency {
         label: &dyn Fn(usize) -> String,
         est: &[(f64, f64)],
     ) -> Consistency {
+        let finite = |e: f64, s: f64| e.is_finite() && s.is_finite() && s > 0.0;
+        // a group far less informed than the best one says nothing (e.g. −4.2e12 ± 4.2e14 beside
+        // ± 0.02): its estimate is whatever the numerics give
+        let best = est
+            .iter()
+            .filter(|(e, s)| finite(*e, *s))
+            .map(|x| x.1)
+            .fold(f64::INFINITY, f64::min);
         let groups: Vec<GroupEstimate> = est
             .iter()
             .enumerate()
-            .filter(|(_, (e, s))| e.is_finite() && s.is_finite() && *s > 0.0)
+            .filter(|(_, (e, s))| finite(*e, *s) && *s <= INFORMATIVE * best)
             .map(|(k, &(estimate, sigma))| GroupEstimate {
                 group: label(k),
                 estimate,
@@ -321,26 +338,59 @@ impl Consistency {
             .map(|g| ((g.estimate - mean) / g.sigma).powi(2))
             .sum();
         let dof = groups.len().saturating_sub(1);
-        let p_value = if dof > 0 {
+        let tested = dof > 0;
+        let p_value = if tested {
             crate::estimate::stats::chi2_sf(chi2, dof as f64)
         } else {
-            1.0
+            f64::NAN
         };
         // two groups far apart on both counts: beyond their noise, and by more than a quarter
-        let apart = groups.iter().enumerate().any(|(i, a)| {
-            groups[i + 1..].iter().any(|b| {
-                let d = (a.estimate - b.estimate).abs();
-                d > 3.0 * a.sigma.hypot(b.sigma)
-                    && d > 0.25 * a.estimate.abs().max(b.estimate.abs())
+        let pairs = || {
+            groups.iter().enumerate().flat_map(|(i, a)| {
+                groups[i + 1..].iter().map(move |b| {
+                    let d = (a.estimate - b.estimate).abs();
+                    (
+                        a,
+                        b,
+                        d > 3.0 * a.sigma.hypot(b.sigma),
+                        d > 0.25 * a.estimate.abs().max(b.estimate.abs()),
+                    )
+                })
             })
-        });
+        };
+        let apart = pairs().find(|p| p.2 && p.3);
+        let holds = !(p_value < SPLIT_P && apart.is_some());
+        let p = super::words::sig3(p_value);
+        let why = if !tested {
+            format!(
+                "not tested: {} of the {} groups carries information, two are needed",
+                groups.len(),
+                est.len()
+            )
+        } else if p_value >= SPLIT_P {
+            format!("holds: the groups agree within their σ (χ² p {p}, not below {SPLIT_P})")
+        } else if let (false, Some((a, b, _, _))) = (holds, apart) {
+            format!(
+                "fails: χ² p {p}, and {} ({}) and {} ({}) differ by more than 3 σ and more than a quarter",
+                a.group,
+                super::words::sig3(a.estimate),
+                b.group,
+                super::words::sig3(b.estimate)
+            )
+        } else if pairs().any(|p| p.2) {
+            format!("holds: χ² p {p}, but no two groups that differ by more than 3 σ differ by more than a quarter")
+        } else {
+            format!("holds: χ² p {p}, but no two groups differ by more than 3 σ")
+        };
         Consistency {
             split: split.to_string(),
             groups,
-            chi2: if dof > 0 { chi2 } else { 0.0 },
+            chi2: if tested { chi2 } else { 0.0 },
             dof,
             p_value,
-            holds: !(p_value < SPLIT_P && apart),
+            holds,
+            tested,
+            why,
         }
     }
 

@@ -1287,11 +1287,37 @@ mod tests {
         // far apart on both counts
         let c = test(&[(-1.6, 0.02), (-0.4, 0.02)]);
         assert!(!c.holds && c.dof == 1 && c.p_value < 1e-6);
+        assert!(
+            c.tested && c.why.starts_with("fails: χ² p") && c.why.contains("(-1.60)"),
+            "{}",
+            c.why
+        );
         let w = c.disagreement("m").unwrap();
         assert!(w.contains("-1.60 ± 0.020 and -0.400 ± 0.020 m"), "{w}");
-        // a half without information says nothing
+        let c = test(&[(179.0, 1.0), (190.0, 1.0)]);
+        assert!(
+            c.tested
+                && c.why.starts_with("holds: χ² p")
+                && c.why.contains("differ by more than a quarter"),
+            "{}",
+            c.why
+        );
+        // a half without information says nothing: no test, not a passed one
         let c = test(&[(1.0, f64::INFINITY), (5.0, 0.1)]);
         assert!(c.holds && c.dof == 0 && c.groups.len() == 1);
+        assert!(!c.tested && c.why.starts_with("not tested: 1 of the 2 groups"));
+        let j = serde_json::to_value(&c).unwrap();
+        assert!(j["p_value"].is_null() && j["tested"] == false, "{j}");
+        // nor does one whose σ is absurd beside the others'
+        let c = test(&[(-4.2e12, 4.2e14), (5.0, 0.1)]);
+        assert!(!c.tested && c.groups.len() == 1 && c.groups[0].estimate == 5.0);
+        let c = Consistency::test(
+            "motion",
+            &|k| Split::Motion.group_label(k),
+            &[(-4.2e12, 4.2e14), (5.0, 0.1), (5.1, 0.1)],
+        );
+        assert!(c.tested && c.dof == 1 && c.groups.len() == 2, "{c:?}");
+        assert!(c.why.starts_with("holds: the groups agree"), "{}", c.why);
         // four groups: three agree, one is far off; the words name every group
         let motion = |k| Split::Motion.group_label(k);
         let c = Consistency::test(

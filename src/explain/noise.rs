@@ -488,7 +488,22 @@ fn split_scales(
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), u| {
                 (lo.min(u), hi.max(u))
             });
-        c.holds = !(c.p_value < 0.0027 && spread.1 - spread.0 > 1.5f64.log2());
+        let wide = spread.1 - spread.0 > 1.5f64.log2();
+        c.holds = !(c.p_value < super::findings::SPLIT_P && wide);
+        if c.tested && c.p_value < super::findings::SPLIT_P {
+            let ratio = sig3(2f64.powf(spread.1 - spread.0));
+            c.why = if wide {
+                format!(
+                    "fails: χ² p {}, and the groups' scales differ by {ratio}×, more than 1.5×",
+                    sig3(c.p_value)
+                )
+            } else {
+                format!(
+                    "holds: χ² p {}, but the groups' scales differ by only {ratio}×, not more than 1.5×",
+                    sig3(c.p_value)
+                )
+            };
+        }
         // said as scales of the stated value (σ by the delta method)
         for g in &mut c.groups {
             let scale = 2f64.powf(g.estimate);
