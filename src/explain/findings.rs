@@ -177,7 +177,8 @@ pub struct TightPrior {
     pub prior: f64,
     /// |estimate| in units of that prior σ.
     pub prior_sigmas: f64,
-    /// A prior σ that holds the data's value (display unit): 3 |estimate|, rounded up.
+    /// A prior σ that holds the data's value (display unit): 3 |estimate|, rounded up to one
+    /// significant digit (3 × 408 µg = 1224 µg → 2000 µg).
     pub suggested: f64,
     /// Display unit.
     pub unit: String,

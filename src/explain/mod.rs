@@ -1346,6 +1346,14 @@ mod tests {
     }
 
     #[test]
+    fn a_suggested_prior_is_3x_the_estimate_rounded_up_to_one_digit() {
+        // 3 × 408 µg = 1224 µg → 2000 µg; 3 × 0.0041 = 0.0123 → 0.02
+        assert_eq!(round_up_1(3.0 * 408.0), 2000.0);
+        assert!((round_up_1(3.0 * 0.0041) - 0.02).abs() < 1e-15);
+        assert_eq!(round_up_1(300.0), 300.0);
+    }
+
+    #[test]
     fn an_unattributed_class_names_no_member_in_its_words() {
         let t = common::TERMS
             .iter()

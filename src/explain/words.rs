@@ -343,25 +343,16 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
         let w = &e.baseline_priors_tight;
         let values = w
             .iter()
-            .map(|p| {
-                format!(
-                    "{} = {} ± {} {} is {} of its {} {} prior σ",
-                    p.term,
-                    sig3(p.estimate),
-                    sig3(p.sigma),
-                    p.unit,
-                    sig3(p.prior_sigmas),
-                    sig3(p.prior),
-                    p.unit
-                )
-            })
+            .map(tight_prior_words)
             .collect::<Vec<_>>()
             .join("; ");
-        let options = w
-            .iter()
-            .map(|p| format!("--prior '{}={} {}'", p.term, sig3(p.suggested), p.unit))
-            .collect::<Vec<_>>()
-            .join(" ");
+        let options = format!(
+            "{} (each 3× the estimate's magnitude, rounded up to one significant digit)",
+            w.iter()
+                .map(|p| format!("--prior '{}={} {}'", p.term, sig3(p.suggested), p.unit))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
         let gain = sig3(e.baseline_priors_gain.unwrap_or(0.0));
         // the check runs on the model explain recommends: the baseline plus its causes
         let with = if e.findings.iter().any(|f| f.is_cause() && f.kind != "noise") {
@@ -381,6 +372,20 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
             )
         });
     }
+}
+
+/// One baseline prior the data find too tight: its estimate and how many of its prior σ that is.
+pub(super) fn tight_prior_words(p: &super::findings::TightPrior) -> String {
+    format!(
+        "{} = {} ± {} {} is {}× its prior σ of {} {}",
+        p.term,
+        sig3(p.estimate),
+        sig3(p.sigma),
+        p.unit,
+        sig3(p.prior_sigmas),
+        sig3(p.prior),
+        p.unit
+    )
 }
 
 /// A mean NIS for the summary's comparisons with 1 and with each other: four significant
@@ -683,6 +688,24 @@ fn not_named_words(e: &Explanation, out: &mut Vec<String>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tight_prior_is_said_as_a_multiple_of_its_prior_sigma() {
+        let p = super::super::findings::TightPrior {
+            term: "nabla_x".into(),
+            index: 0,
+            estimate: 408.0,
+            sigma: 12.0,
+            prior: 100.0,
+            prior_sigmas: 4.08,
+            suggested: 2000.0,
+            unit: "ug".into(),
+        };
+        assert_eq!(
+            tight_prior_words(&p),
+            "nabla_x = 408 ± 12.0 ug is 4.08× its prior σ of 100 ug"
+        );
+    }
 
     #[test]
     fn a_mean_nis_near_1_keeps_enough_digits_to_differ() {
