@@ -89,6 +89,12 @@ pub struct Finding {
     /// Why it probably stands in for an effect the candidates do not describe (it needs
     /// ≫ its prior, or it explains little of the misfit); absent for a finding read as a cause.
     pub stand_in: Option<String>,
+    /// For a stand-in only because it needs more than `ExplainOptions::stand_in_prior_sigmas` (30) of its prior
+    /// (every consistency split that was tested holds, at least one was, and it explains more
+    /// than half of the baseline's excess misfit): a prior σ that holds it (display unit; 3×
+    /// the estimate's magnitude rounded up to one significant digit, at most the term's
+    /// `limit`), to give with `--prior` if the sensor can have such a value. Null otherwise.
+    pub suggested_prior: Option<f64>,
     /// Why no member of its equivalence class is named as the cause: the values they would need
     /// differ by 10× or more in prior σ and even the most plausible lies beyond 3 prior σ (the
     /// priors, which do not fit this sensor, would choose, not the data); the finding then

@@ -439,6 +439,11 @@ pub fn explain(
         if !j.is_cause() {
             // a stand-in keeps the value it was fitted with; its words say what is left now
             *f = j;
+            // (a stand-in for a withheld GNSS term is no value to hold with a prior)
+            f.suggested_prior = rival
+                .is_none()
+                .then(|| suggested_prior(f, ctx.opts))
+                .flatten();
             f.stand_in = f.stand_in.as_ref().and(joined(
                 stand_in_reason(f, misfit_unexplained, ctx.opts),
                 rival,
@@ -999,6 +1004,7 @@ fn complete_findings(
             misfit_share: excess.map(|e| n.nis_removed / e),
             prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
             stand_in: None,
+            suggested_prior: None,
             // the priors choose within a class when they differ by an order of magnitude; they
             // are credible for that only while the chosen member sits within 3 of its prior σ
             not_attributed: (n.prior_ratio >= selection::UNATTRIBUTED_RATIO
@@ -1042,6 +1048,7 @@ fn complete_findings(
                 .collect(),
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
+        f.suggested_prior = suggested_prior(&f, ctx.opts);
         f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         out.push(f);
     }
@@ -1134,6 +1141,23 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// A prior σ (display unit) that would hold stand-in `f`'s value, when it is a stand-in only
+/// because it needs more than `stand_in_prior_sigmas` of its prior: within the term's `limit`,
+/// every consistency split tested holds (at least one was tested) and it explains more than
+/// half of the baseline's excess misfit. 3× its magnitude rounded up to one significant digit,
+/// at most the `limit`.
+fn suggested_prior(f: &Finding, opts: &ExplainOptions) -> Option<f64> {
+    let info = common::TERMS.iter().find(|t| t.name == f.term)?;
+    let limit = info.limit / info.display_to_si;
+    let holds = f.consistency.iter().any(|c| c.tested) && f.consistency.iter().all(|c| c.holds);
+    (f.stand_in.is_some()
+        && f.prior_sigmas > opts.stand_in_prior_sigmas
+        && holds
+        && f.misfit_share.is_some_and(|s| s > 0.5)
+        && f.estimate.abs() <= limit)
+        .then(|| round_up_1(3.0 * f.estimate.abs()).min(limit))
+}
+
 /// Mean over the run of each term's regressor (SI), in one pass over the IMU samples (the
 /// extended pass has no candidates, so it is computed from the samples directly).
 fn regressor_means(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<f64>> {
@@ -1222,6 +1246,7 @@ mod tests {
             misfit_share,
             prior_sigmas,
             stand_in: None,
+            suggested_prior: None,
             not_attributed: None,
             scale: None,
             scale_interval: None,
@@ -1343,6 +1368,55 @@ mod tests {
         )];
         let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default()).unwrap();
         assert!(why.contains("slower and the faster"), "{why}");
+    }
+
+    #[test]
+    fn a_stand_in_only_for_its_prior_says_which_prior_would_hold_it() {
+        let o = ExplainOptions::default();
+        let t = common::TERMS
+            .iter()
+            .position(|t| t.name == "tau_x")
+            .unwrap();
+        let info = &common::TERMS[t];
+        let holds =
+            |e: &[(f64, f64)]| Consistency::test("time", &|k| Split::Time(0.0).group_label(k), e);
+        // the review's case: tau_x = 40.0 ± 0.293 ms, 40 prior σ, explaining 104 %
+        let mut f = finding(40.0, Some(1.04));
+        f.term = "tau_x".into();
+        f.unit = info.display.into();
+        f.estimate = 40.0;
+        f.sigma = 0.293;
+        f.consistency = vec![holds(&[(40.1, 0.4), (39.9, 0.4)])];
+        f.stand_in = stand_in_reason(&f, Some(0.0), &o);
+        assert!(f.stand_in.is_some());
+        // 3 × 40 = 120 → 200 ms, beyond the 100 ms tau_x can have: the limit
+        f.suggested_prior = suggested_prior(&f, &o);
+        assert_eq!(f.suggested_prior, Some(100.0));
+        let w = finding_words(&f, info, 1.0);
+        assert!(
+            w.contains("give --prior 'tau_x=100 ms' (a prior that holds it) and run again"),
+            "{w}"
+        );
+        // 10 ms: 30 → 30 ms
+        let mut g = f.clone();
+        g.estimate = 10.0;
+        assert_eq!(suggested_prior(&g, &o), Some(30.0));
+        // not when a split fails, none was tested, it explains little, or it is within 30 σ
+        let mut g = f.clone();
+        g.consistency = vec![holds(&[(40.0, 0.4), (10.0, 0.4)])];
+        assert_eq!(suggested_prior(&g, &o), None);
+        g.consistency = vec![holds(&[(40.0, 0.4), (10.0, f64::INFINITY)])];
+        assert_eq!(suggested_prior(&g, &o), None);
+        let mut g = f.clone();
+        g.misfit_share = Some(0.3);
+        assert_eq!(suggested_prior(&g, &o), None);
+        let mut g = f.clone();
+        g.prior_sigmas = 20.0;
+        assert_eq!(suggested_prior(&g, &o), None);
+        let mut g = f.clone();
+        g.stand_in = None;
+        assert_eq!(suggested_prior(&g, &o), None);
+        assert!(!finding_words(&g, info, 1.0).contains("--prior"));
     }
 
     #[test]

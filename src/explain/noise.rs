@@ -636,6 +636,7 @@ fn noise_finding(
         misfit_share,
         prior_sigmas: 0.0,
         stand_in: None,
+        suggested_prior: None,
         not_attributed: None,
         scale: Some(f.scale),
         scale_interval: bound.is_none().then_some(f.interval),

@@ -270,6 +270,14 @@ fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
         s.push_str(&format!(
             ". It probably stands in for an effect the candidates do not describe ({why}){what_else}"
         ));
+        if let Some(p) = f.suggested_prior {
+            s.push_str(&format!(
+                ". Yet it holds across the data and explains most of the misfit: if this sensor can have such a value, give --prior '{}={} {}' (a prior that holds it) and run again",
+                f.term,
+                sig3(p),
+                f.unit
+            ));
+        }
     } else if let Some(why) = &f.not_attributed {
         s.push_str(&format!(
             ". No member of its class is named as the cause: {why}"
