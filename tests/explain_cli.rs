@@ -332,10 +332,24 @@ fn explain_refuses_bad_input_with_the_reason() {
 /// any pass runs.
 #[test]
 fn a_prior_beyond_the_spec_limit_is_a_unit_slip() {
+    // (and other --prior slips: a unit glued on, no name, no value, a prior that pins the term)
     let out = tmp("limit");
     for (prior, want) in [
         ("tau_x=5 s", "5000 ms is beyond the 100 ms"),
         ("size_*=40 m", "40000 mm is beyond the 1000 mm"),
+        // as many digits as it takes to differ from the limit
+        ("tau_x=100.001 ms", "100.001 ms is beyond the 100 ms"),
+        // so small a prior pins the terms at zero: refused, naming the spec's σ
+        (
+            "size_*=1e-9 mm",
+            "1.00e-9 mm is more than 10^6 times below the spec's prior σ of 10.0 mm",
+        ),
+        (
+            "tau_x=2ms",
+            "write a space between the number and its unit (`2 ms`)",
+        ),
+        ("=2 ms", "the term name is missing before `=`"),
+        ("tau_x=", "the quantity is missing after `=`"),
     ] {
         let mut args = rlg_static_explain(&out);
         args.extend(["--prior".to_string(), prior.to_string()]);

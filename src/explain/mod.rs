@@ -238,6 +238,8 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
     if given.is_empty() {
         out = (0..common::TERM_COUNT).filter(|&t| !in_base(t)).collect();
     }
+    // each item's terms, to say which named ones a withholding takes back
+    let mut sets: Vec<(bool, &str, Vec<usize>)> = Vec::new();
     for item in given.iter().chain(&withheld) {
         let (drop, item) = match item.strip_prefix('!') {
             Some(rest) => (true, rest.trim()),
@@ -262,6 +264,7 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
                 did_you_mean(item.trim_end_matches('*'))
             ));
         }
+        sets.push((drop, item, matched.clone()));
         if drop {
             out.retain(|t| !matched.contains(t));
             continue;
@@ -270,6 +273,20 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
             if !out.contains(&t) {
                 out.push(t);
             }
+        }
+    }
+    // a name (or family) every term of which is withheld again contradicts itself
+    for (_, name, terms) in sets.iter().filter(|s| !s.0) {
+        if terms.iter().all(|t| !out.contains(t)) {
+            let by: Vec<String> = sets
+                .iter()
+                .filter(|(drop, _, w)| *drop && w.iter().any(|t| terms.contains(t)))
+                .map(|(_, w, _)| format!("`!{w}`"))
+                .collect();
+            return Err(format!(
+                "--candidates {spec}: `{name}` is both named and withheld ({}); name it or withhold it",
+                by.join(", ")
+            ));
         }
     }
     if out.is_empty() {
@@ -1087,12 +1104,11 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
     // a value the term cannot physically have is no property of the sensor
     if let Some(info) = common::TERMS.iter().find(|t| t.name == f.term) {
         if (f.estimate * info.display_to_si).abs() > info.limit {
+            let (v, l) =
+                crate::io::units::sig_distinct(f.estimate, info.limit / info.display_to_si);
             why.push(format!(
-                "{} {} is beyond the {} {} the term can physically have (its `limit` in model-spec/terms.toml)",
-                sig3(f.estimate),
-                f.unit,
-                sig3(info.limit / info.display_to_si),
-                f.unit
+                "{v} {} is beyond the {l} {} the term can physically have (its `limit` in model-spec/terms.toml)",
+                f.unit, f.unit
             ));
         }
     }
@@ -1530,7 +1546,17 @@ mod tests {
         let e = parse_candidates(Some("!nope_*"), &base).unwrap_err();
         assert!(e.contains("unknown term `nope_*`"), "{e}");
         let e = parse_candidates(Some("d_x,!d_*"), &base).unwrap_err();
-        assert!(e.contains("withholds every candidate"), "{e}");
+        assert!(
+            e.contains("`d_x` is both named and withheld (`!d_*`)"),
+            "{e}"
+        );
+        let e = parse_candidates(Some("size_x,!size_x"), &base).unwrap_err();
+        assert!(
+            e.contains("`size_x` is both named and withheld (`!size_x`)"),
+            "{e}"
+        );
+        // a family of which one member is withheld is no contradiction
+        assert!(parse_candidates(Some("size_*,!size_x"), &base).is_ok());
     }
 
     #[test]
