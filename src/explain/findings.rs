@@ -140,9 +140,13 @@ pub struct Consistency {
     /// The groups with information, each with its estimate and σ (display unit); a group
     /// whose σ is infinite, NaN or more than 100× the best group's carries none and is left out.
     pub groups: Vec<GroupEstimate>,
-    /// χ² of the group estimates about their information-weighted mean.
+    /// Groups with a finite σ more than 100× the best group's: left out of `groups`, but in
+    /// χ² and its degrees of freedom (where they add nothing but a degree of freedom each).
+    pub uninformative_groups: usize,
+    /// χ² of the group estimates (those in `groups` and the uninformative ones) about their
+    /// information-weighted mean.
     pub chi2: f64,
-    /// Its degrees of freedom (groups with information − 1).
+    /// Its degrees of freedom (groups with a finite σ − 1).
     pub dof: usize,
     /// Its p-value; null when the split is not tested.
     pub p_value: f64,
@@ -316,18 +320,25 @@ impl Consistency {
         label: &dyn Fn(usize) -> String,
         est: &[(f64, f64)],
     ) -> Consistency {
+        Self::test_within(split, label, est, INFORMATIVE)
+    }
+
+    /// [`Consistency::test`] with groups whose σ is more than `informative` × the best group's
+    /// counted as carrying no information (∞: every group with a finite σ carries some).
+    pub(super) fn test_within(
+        split: &str,
+        label: &dyn Fn(usize) -> String,
+        est: &[(f64, f64)],
+        informative: f64,
+    ) -> Consistency {
         let finite = |e: f64, s: f64| e.is_finite() && s.is_finite() && s > 0.0;
-        // a group far less informed than the best one says nothing (e.g. −4.2e12 ± 4.2e14 beside
-        // ± 0.02): its estimate is whatever the numerics give
-        let best = est
-            .iter()
-            .filter(|(e, s)| finite(*e, *s))
-            .map(|x| x.1)
-            .fold(f64::INFINITY, f64::min);
+        // every group with a finite σ enters χ² (where one far less informed than the best adds
+        // nothing but a degree of freedom); such a group (e.g. −4.2e12 ± 4.2e14 beside ± 0.02)
+        // is left out of `groups`: its estimate is whatever the numerics give
         let groups: Vec<GroupEstimate> = est
             .iter()
             .enumerate()
-            .filter(|(_, (e, s))| finite(*e, *s) && *s <= INFORMATIVE * best)
+            .filter(|(_, (e, s))| finite(*e, *s))
             .map(|(k, &(estimate, sigma))| GroupEstimate {
                 group: label(k),
                 estimate,
@@ -344,8 +355,11 @@ impl Consistency {
             .iter()
             .map(|g| ((g.estimate - mean) / g.sigma).powi(2))
             .sum();
+        let best = groups.iter().map(|g| g.sigma).fold(f64::INFINITY, f64::min);
+        let is_informative = |g: &GroupEstimate| g.sigma <= informative * best;
+        let n_informative = groups.iter().filter(|g| is_informative(g)).count();
         let dof = groups.len().saturating_sub(1);
-        let tested = dof > 0;
+        let tested = n_informative >= 2;
         let p_value = if tested {
             crate::estimate::stats::chi2_sf(chi2, dof as f64)
         } else {
@@ -371,7 +385,7 @@ impl Consistency {
         let why = if !tested {
             format!(
                 "not tested: {} of the {} groups carries information, two are needed",
-                groups.len(),
+                n_informative,
                 est.len()
             )
         } else if p_value >= SPLIT_P {
@@ -389,10 +403,17 @@ impl Consistency {
         } else {
             format!("holds: χ² p {p}, but no two groups differ by more than 3 σ")
         };
+        let uninformative_groups = groups.len() - n_informative;
+        let groups = groups
+            .iter()
+            .filter(|g| is_informative(g))
+            .cloned()
+            .collect();
         Consistency {
             split: split.to_string(),
             groups,
-            chi2: if tested { chi2 } else { 0.0 },
+            uninformative_groups,
+            chi2: if dof > 0 { chi2 } else { 0.0 },
             dof,
             p_value,
             holds,
@@ -459,15 +480,12 @@ impl Consistency {
                         informative.len()
                     ));
                 }
-                if informative.len() < g.len() {
+                let left_out = g.len() - informative.len() + self.uninformative_groups;
+                if left_out > 0 {
                     list.push_str(&format!(
                         "; {} group{} without information left out",
-                        g.len() - informative.len(),
-                        if g.len() - informative.len() == 1 {
-                            ""
-                        } else {
-                            "s"
-                        }
+                        left_out,
+                        if left_out == 1 { "" } else { "s" }
                     ));
                 }
                 format!(

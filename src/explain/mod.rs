@@ -1352,12 +1352,16 @@ mod tests {
         // nor does one whose σ is absurd beside the others'
         let c = test(&[(-4.2e12, 4.2e14), (5.0, 0.1)]);
         assert!(!c.tested && c.groups.len() == 1 && c.groups[0].estimate == 5.0);
+        assert!(c.p_value.is_nan() && c.holds && c.uninformative_groups == 1);
         let c = Consistency::test(
             "motion",
             &|k| Split::Motion.group_label(k),
             &[(-4.2e12, 4.2e14), (5.0, 0.1), (5.1, 0.1)],
         );
-        assert!(c.tested && c.dof == 1 && c.groups.len() == 2, "{c:?}");
+        assert!(
+            c.tested && c.groups.len() == 2 && c.uninformative_groups == 1 && c.dof == 2,
+            "{c:?}"
+        );
         assert!(c.why.starts_with("holds: the groups agree"), "{}", c.why);
         // four groups: three agree, one is far off; the words name every group
         let motion = |k| Split::Motion.group_label(k);

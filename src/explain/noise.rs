@@ -480,7 +480,9 @@ fn split_scales(
             .collect();
         // tested in log₂ s (where the likelihood is near a parabola): the groups disagree when
         // χ² p < 0.0027 and their scales differ by more than 1.5×
-        let mut c = super::Consistency::test(name, &|k| labels[k].to_string(), &est);
+        // (a group's information is judged above, by its σ in log₂ s)
+        let mut c =
+            super::Consistency::test_within(name, &|k| labels[k].to_string(), &est, f64::INFINITY);
         let spread = c
             .groups
             .iter()
