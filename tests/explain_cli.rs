@@ -101,6 +101,33 @@ fn demo_finds_d_and_writes_the_design_contract() {
             );
         }
     }
+    // the baseline had an excess to explain: what the extension leaves is said, named or not
+    let summary: Vec<&str> = v["summary"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert!(v["gain"]["misfit_unexplained"].is_number());
+    assert!(
+        summary.iter().any(|l| l.starts_with("Left unexplained: ")),
+        "{summary:#?}"
+    );
+    // the demo's heights carry no noise: the σ stated for them scales down to the search
+    // bound, which is a bound, not an estimate with an interval
+    let h = findings
+        .iter()
+        .find(|f| f["term"] == "sigma_pos_h")
+        .expect("sigma_pos_h");
+    assert_eq!(h["scale_bound"], "at most", "{h}");
+    assert!(h["scale_interval"].is_null() && h["sigma"].is_null(), "{h}");
+    assert!(
+        h["words"]
+            .as_str()
+            .unwrap()
+            .contains("at the search bound (≤"),
+        "{h}"
+    );
     let before = v["gain"]["model_error_rms_before"].as_f64().unwrap();
     let after = v["gain"]["model_error_rms_after"].as_f64().unwrap();
     assert!(after < 0.2 * before, "model error {before} -> {after}");
@@ -322,10 +349,24 @@ fn explain_refuses_bad_input_with_the_reason() {
 /// any pass runs.
 #[test]
 fn a_prior_beyond_the_spec_limit_is_a_unit_slip() {
+    // (and other --prior slips: a unit glued on, no name, no value, a prior that pins the term)
     let out = tmp("limit");
     for (prior, want) in [
         ("tau_x=5 s", "5000 ms is beyond the 100 ms"),
         ("size_*=40 m", "40000 mm is beyond the 1000 mm"),
+        // as many digits as it takes to differ from the limit
+        ("tau_x=100.001 ms", "100.001 ms is beyond the 100 ms"),
+        // so small a prior pins the terms at zero: refused, naming the spec's σ
+        (
+            "size_*=1e-9 mm",
+            "1.00e-9 mm is more than 10^6 times below the spec's prior σ of 10.0 mm",
+        ),
+        (
+            "tau_x=2ms",
+            "write a space between the number and its unit (`2 ms`)",
+        ),
+        ("=2 ms", "the term name is missing before `=`"),
+        ("tau_x=", "the quantity is missing after `=`"),
     ] {
         let mut args = rlg_static_explain(&out);
         args.extend(["--prior".to_string(), prior.to_string()]);

@@ -209,10 +209,7 @@ impl DataOptions {
             out.extend(g.term_sigma.iter().copied().enumerate());
         }
         for spec in &self.prior {
-            let (name, value) = spec
-                .split_once('=')
-                .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
-            let (name, value) = (name.trim(), value.trim());
+            let (name, value) = prior_parts(spec)?;
             let pattern = StatePattern::new(name);
             for (t, info) in common::TERMS.iter().enumerate() {
                 if pattern.matches(info.name) {
@@ -221,7 +218,7 @@ impl DataOptions {
                     if !(si.is_finite() && si > 0.0) {
                         bail!("--prior `{spec}`: a prior σ must be positive and finite");
                     }
-                    if let Some(why) = info.beyond_limit(si) {
+                    if let Some(why) = info.beyond_limit(si).or(info.prior_too_small(si)) {
                         bail!("--prior `{spec}`: {}: {why}", info.name);
                     }
                     out.retain(|x| x.0 != t);
@@ -236,7 +233,7 @@ impl DataOptions {
     pub fn check_prior_names(&self, model: &Model) -> Result<()> {
         use crate::model::generated::common;
         for spec in &self.prior {
-            let name = spec.split_once('=').map(|x| x.0.trim()).unwrap_or(spec);
+            let (name, _) = prior_parts(spec)?;
             let hit = |n: &str| match name.strip_suffix('*') {
                 Some(prefix) => n.starts_with(prefix),
                 None => n == name,
@@ -295,10 +292,7 @@ impl DataOptions {
             cfg.vertical = Vertical::Fixed;
         }
         for spec in &args.prior {
-            let (name, value) = spec
-                .split_once('=')
-                .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
-            let (name, value) = (name.trim(), value.trim());
+            let (name, value) = prior_parts(spec)?;
             let pattern = StatePattern::new(name);
             let matches: Vec<usize> = (0..model.n())
                 .filter(|&i| pattern.matches(model.names[i]))
@@ -317,7 +311,7 @@ impl DataOptions {
                 }
                 if let crate::model::catalog::StateRef::Term(t) = model.states[i] {
                     let info = &crate::model::generated::common::TERMS[t];
-                    if let Some(why) = info.beyond_limit(si) {
+                    if let Some(why) = info.beyond_limit(si).or(info.prior_too_small(si)) {
                         bail!("--prior `{spec}`: {}: {why}", info.name);
                     }
                 }
@@ -461,4 +455,20 @@ fn noise_range(gyro: bool) -> (f64, f64) {
     } else {
         (1e-7, 100.0)
     }
+}
+
+/// A `--prior` option's name and quantity, trimmed: refused without `=`, without a name before
+/// it or without a quantity after it.
+fn prior_parts(spec: &str) -> Result<(&str, &str)> {
+    let (name, value) = spec
+        .split_once('=')
+        .with_context(|| format!("--prior `{spec}`: expected NAME=QUANTITY"))?;
+    let (name, value) = (name.trim(), value.trim());
+    if name.is_empty() {
+        bail!("--prior `{spec}`: the term name is missing before `=` (NAME=QUANTITY, e.g. `tau_x=2 ms`)");
+    }
+    if value.is_empty() {
+        bail!("--prior `{spec}`: the quantity is missing after `=` (NAME=QUANTITY, e.g. `{name}=2 ms`)");
+    }
+    Ok((name, value))
 }

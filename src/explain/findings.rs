@@ -97,6 +97,12 @@ pub struct Finding {
     /// Why it probably stands in for an effect the candidates do not describe (it needs
     /// ≫ its prior, or it explains little of the misfit); absent for a finding read as a cause.
     pub stand_in: Option<String>,
+    /// For a stand-in only because it needs more than `ExplainOptions::stand_in_prior_sigmas` (30) of its prior
+    /// (every consistency split that was tested holds, at least one was, and it explains more
+    /// than half of the baseline's excess misfit): a prior σ that holds it (display unit; 3×
+    /// the estimate's magnitude rounded up to one significant digit, at most the term's
+    /// `limit`), to give with `--prior` if the sensor can have such a value. Null otherwise.
+    pub suggested_prior: Option<f64>,
     /// Why no member of its equivalence class is named as the cause: the values they would need
     /// differ by 10× or more in prior σ and even the most plausible lies beyond 3 prior σ (the
     /// priors, which do not fit this sensor, would choose, not the data); the finding then
@@ -105,8 +111,13 @@ pub struct Finding {
     /// A noise finding's maximum-likelihood scale of the stated value (white noise density, or
     /// the aiding's stated 1-σ).
     pub scale: Option<f64>,
-    /// Its approximate 95 % interval.
+    /// Its approximate 95 % interval; null when the scale is at the search bound.
     pub scale_interval: Option<[f64; 2]>,
+    /// `at most` when the search for the scale stopped at its lower bound with the likelihood
+    /// still rising towards smaller values (`scale` is then a bound, not an estimate, and
+    /// `sigma` and `scale_interval` are null), `at least` at its upper bound; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale_bound: Option<&'static str>,
     /// A term finding's GLR estimate and σ (display unit) from the first and from the second
     /// half of the aiding epochs alone: `[[estimate, σ], [estimate, σ]]` (null without
     /// information in a half). A constant of the sensor or the aiding holds across both.
@@ -134,17 +145,27 @@ pub struct Consistency {
     /// The split: `time` (halves of the aiding epochs), `speed` (below and from the median
     /// aided speed), `motion` (by the body axis of the most recent rotation).
     pub split: String,
-    /// The groups with information, each with its estimate and σ (display unit).
+    /// The groups with information, each with its estimate and σ (display unit); a group
+    /// whose σ is infinite, NaN or more than 100× the best group's carries none and is left out.
     pub groups: Vec<GroupEstimate>,
-    /// χ² of the group estimates about their information-weighted mean.
+    /// Groups with a finite σ more than 100× the best group's: left out of `groups`, but in
+    /// χ² and its degrees of freedom (where they add nothing but a degree of freedom each).
+    pub uninformative_groups: usize,
+    /// χ² of the group estimates (those in `groups` and the uninformative ones) about their
+    /// information-weighted mean.
     pub chi2: f64,
-    /// Its degrees of freedom (groups with information − 1).
+    /// Its degrees of freedom (groups with a finite σ − 1).
     pub dof: usize,
-    /// Its p-value.
+    /// Its p-value; null when the split is not tested.
     pub p_value: f64,
     /// False when the groups disagree: χ² p < 0.0027 (3σ) and two groups more than 3σ and
-    /// more than a quarter of the larger apart.
+    /// more than a quarter of the larger apart. True also when the split is not tested (see
+    /// `tested`): nothing speaks against the term there, but nothing for it either.
     pub holds: bool,
+    /// False when fewer than two groups carry information: no test was made.
+    pub tested: bool,
+    /// Why the split holds, fails or was not tested, in words.
+    pub why: String,
 }
 
 /// A finding's estimate from one group of the updates alone.
@@ -174,7 +195,8 @@ pub struct TightPrior {
     pub prior: f64,
     /// |estimate| in units of that prior σ.
     pub prior_sigmas: f64,
-    /// A prior σ that holds the data's value (display unit): 3 |estimate|, rounded up.
+    /// A prior σ that holds the data's value (display unit): 3 |estimate|, rounded up to one
+    /// significant digit (3 × 408 µg = 1224 µg → 2000 µg).
     pub suggested: f64,
     /// Display unit.
     pub unit: String,
@@ -292,7 +314,10 @@ pub struct Implausible {
 }
 
 /// χ² p-value below which a split's groups disagree (the two-sided 3σ level).
-const SPLIT_P: f64 = 0.0027;
+pub(super) const SPLIT_P: f64 = 0.0027;
+
+/// A group carries information when its σ is within this many times the best group's.
+const INFORMATIVE: f64 = 100.0;
 
 impl Consistency {
     /// The test over `split`'s groups (group k named `label(k)`), given each group's estimate
@@ -303,10 +328,25 @@ impl Consistency {
         label: &dyn Fn(usize) -> String,
         est: &[(f64, f64)],
     ) -> Consistency {
+        Self::test_within(split, label, est, INFORMATIVE)
+    }
+
+    /// [`Consistency::test`] with groups whose σ is more than `informative` × the best group's
+    /// counted as carrying no information (∞: every group with a finite σ carries some).
+    pub(super) fn test_within(
+        split: &str,
+        label: &dyn Fn(usize) -> String,
+        est: &[(f64, f64)],
+        informative: f64,
+    ) -> Consistency {
+        let finite = |e: f64, s: f64| e.is_finite() && s.is_finite() && s > 0.0;
+        // every group with a finite σ enters χ² (where one far less informed than the best adds
+        // nothing but a degree of freedom); such a group (e.g. −4.2e12 ± 4.2e14 beside ± 0.02)
+        // is left out of `groups`: its estimate is whatever the numerics give
         let groups: Vec<GroupEstimate> = est
             .iter()
             .enumerate()
-            .filter(|(_, (e, s))| e.is_finite() && s.is_finite() && *s > 0.0)
+            .filter(|(_, (e, s))| finite(*e, *s))
             .map(|(k, &(estimate, sigma))| GroupEstimate {
                 group: label(k),
                 estimate,
@@ -323,27 +363,70 @@ impl Consistency {
             .iter()
             .map(|g| ((g.estimate - mean) / g.sigma).powi(2))
             .sum();
+        let best = groups.iter().map(|g| g.sigma).fold(f64::INFINITY, f64::min);
+        let is_informative = |g: &GroupEstimate| g.sigma <= informative * best;
+        let n_informative = groups.iter().filter(|g| is_informative(g)).count();
         let dof = groups.len().saturating_sub(1);
-        let p_value = if dof > 0 {
+        let tested = n_informative >= 2;
+        let p_value = if tested {
             crate::estimate::stats::chi2_sf(chi2, dof as f64)
         } else {
-            1.0
+            f64::NAN
         };
         // two groups far apart on both counts: beyond their noise, and by more than a quarter
-        let apart = groups.iter().enumerate().any(|(i, a)| {
-            groups[i + 1..].iter().any(|b| {
-                let d = (a.estimate - b.estimate).abs();
-                d > 3.0 * a.sigma.hypot(b.sigma)
-                    && d > 0.25 * a.estimate.abs().max(b.estimate.abs())
+        let pairs = || {
+            groups.iter().enumerate().flat_map(|(i, a)| {
+                groups[i + 1..].iter().map(move |b| {
+                    let d = (a.estimate - b.estimate).abs();
+                    (
+                        a,
+                        b,
+                        d > 3.0 * a.sigma.hypot(b.sigma),
+                        d > 0.25 * a.estimate.abs().max(b.estimate.abs()),
+                    )
+                })
             })
-        });
+        };
+        let apart = pairs().find(|p| p.2 && p.3);
+        let holds = !(p_value < SPLIT_P && apart.is_some());
+        let p = super::words::sig3(p_value);
+        let why = if !tested {
+            format!(
+                "not tested: {} of the {} groups carries information, two are needed",
+                n_informative,
+                est.len()
+            )
+        } else if p_value >= SPLIT_P {
+            format!("holds: the groups agree within their σ (χ² p {p}, not below {SPLIT_P})")
+        } else if let (false, Some((a, b, _, _))) = (holds, apart) {
+            format!(
+                "fails: χ² p {p}, and {} ({}) and {} ({}) differ by more than 3 σ and more than a quarter",
+                a.group,
+                super::words::sig3(a.estimate),
+                b.group,
+                super::words::sig3(b.estimate)
+            )
+        } else if pairs().any(|p| p.2) {
+            format!("holds: χ² p {p}, but no two groups that differ by more than 3 σ differ by more than a quarter")
+        } else {
+            format!("holds: χ² p {p}, but no two groups differ by more than 3 σ")
+        };
+        let uninformative_groups = groups.len() - n_informative;
+        let groups = groups
+            .iter()
+            .filter(|g| is_informative(g))
+            .cloned()
+            .collect();
         Consistency {
             split: split.to_string(),
             groups,
+            uninformative_groups,
             chi2: if dof > 0 { chi2 } else { 0.0 },
             dof,
             p_value,
-            holds: !(p_value < SPLIT_P && apart),
+            holds,
+            tested,
+            why,
         }
     }
 
@@ -405,15 +488,12 @@ impl Consistency {
                         informative.len()
                     ));
                 }
-                if informative.len() < g.len() {
+                let left_out = g.len() - informative.len() + self.uninformative_groups;
+                if left_out > 0 {
                     list.push_str(&format!(
                         "; {} group{} without information left out",
-                        g.len() - informative.len(),
-                        if g.len() - informative.len() == 1 {
-                            ""
-                        } else {
-                            "s"
-                        }
+                        left_out,
+                        if left_out == 1 { "" } else { "s" }
                     ));
                 }
                 format!(

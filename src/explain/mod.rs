@@ -238,6 +238,8 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
     if given.is_empty() {
         out = (0..common::TERM_COUNT).filter(|&t| !in_base(t)).collect();
     }
+    // each item's terms, to say which named ones a withholding takes back
+    let mut sets: Vec<(bool, &str, Vec<usize>)> = Vec::new();
     for item in given.iter().chain(&withheld) {
         let (drop, item) = match item.strip_prefix('!') {
             Some(rest) => (true, rest.trim()),
@@ -262,6 +264,7 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
                 did_you_mean(item.trim_end_matches('*'))
             ));
         }
+        sets.push((drop, item, matched.clone()));
         if drop {
             out.retain(|t| !matched.contains(t));
             continue;
@@ -270,6 +273,20 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
             if !out.contains(&t) {
                 out.push(t);
             }
+        }
+    }
+    // a name (or family) every term of which is withheld again contradicts itself
+    for (_, name, terms) in sets.iter().filter(|s| !s.0) {
+        if terms.iter().all(|t| !out.contains(t)) {
+            let by: Vec<String> = sets
+                .iter()
+                .filter(|(drop, _, w)| *drop && w.iter().any(|t| terms.contains(t)))
+                .map(|(_, w, _)| format!("`!{w}`"))
+                .collect();
+            return Err(format!(
+                "--candidates {spec}: `{name}` is both named and withheld ({}); name it or withhold it",
+                by.join(", ")
+            ));
         }
     }
     if out.is_empty() {
@@ -439,6 +456,11 @@ pub fn explain(
         if !j.is_cause() {
             // a stand-in keeps the value it was fitted with; its words say what is left now
             *f = j;
+            // (a stand-in for a withheld GNSS term is no value to hold with a prior)
+            f.suggested_prior = rival
+                .is_none()
+                .then(|| suggested_prior(f, ctx.opts))
+                .flatten();
             f.stand_in = f.stand_in.as_ref().and(joined(
                 stand_in_reason(f, misfit_unexplained, ctx.opts),
                 rival,
@@ -1008,6 +1030,7 @@ fn complete_findings(
             misfit_share: excess.map(|e| n.nis_removed / e),
             prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
             stand_in: None,
+            suggested_prior: None,
             // the priors choose within a class when they differ by an order of magnitude; they
             // are credible for that only while the chosen member sits within 3 of its prior σ
             not_attributed: (n.prior_ratio >= selection::UNATTRIBUTED_RATIO
@@ -1039,6 +1062,7 @@ fn complete_findings(
             }),
             scale: None,
             scale_interval: None,
+            scale_bound: None,
             halves: split_halves(&n.splits, "time"),
             speed_halves: split_halves(&n.splits, "speed"),
             consistency: n
@@ -1050,6 +1074,7 @@ fn complete_findings(
                 .collect(),
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
+        f.suggested_prior = suggested_prior(&f, ctx.opts);
         f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         out.push(f);
     }
@@ -1088,12 +1113,11 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
     // a value the term cannot physically have is no property of the sensor
     if let Some(info) = common::TERMS.iter().find(|t| t.name == f.term) {
         if (f.estimate * info.display_to_si).abs() > info.limit {
+            let (v, l) =
+                crate::io::units::sig_distinct(f.estimate, info.limit / info.display_to_si);
             why.push(format!(
-                "{} {} is beyond the {} {} the term can physically have (its `limit` in model-spec/terms.toml)",
-                sig3(f.estimate),
-                f.unit,
-                sig3(info.limit / info.display_to_si),
-                f.unit
+                "{v} {} is beyond the {l} {} the term can physically have (its `limit` in model-spec/terms.toml)",
+                f.unit, f.unit
             ));
         }
     }
@@ -1140,6 +1164,23 @@ fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions)
     }
     why.extend(clauses);
     (!why.is_empty()).then(|| why.join("; "))
+}
+
+/// A prior σ (display unit) that would hold stand-in `f`'s value, when it is a stand-in only
+/// because it needs more than `stand_in_prior_sigmas` of its prior: within the term's `limit`,
+/// every consistency split tested holds (at least one was tested) and it explains more than
+/// half of the baseline's excess misfit. 3× its magnitude rounded up to one significant digit,
+/// at most the `limit`.
+fn suggested_prior(f: &Finding, opts: &ExplainOptions) -> Option<f64> {
+    let info = common::TERMS.iter().find(|t| t.name == f.term)?;
+    let limit = info.limit / info.display_to_si;
+    let holds = f.consistency.iter().any(|c| c.tested) && f.consistency.iter().all(|c| c.holds);
+    (f.stand_in.is_some()
+        && f.prior_sigmas > opts.stand_in_prior_sigmas
+        && holds
+        && f.misfit_share.is_some_and(|s| s > 0.5)
+        && f.estimate.abs() <= limit)
+        .then(|| round_up_1(3.0 * f.estimate.abs()).min(limit))
 }
 
 /// A regressor's statistics over the run (SI): its mean, and its mean and share of the samples
@@ -1284,9 +1325,11 @@ mod tests {
             misfit_share,
             prior_sigmas,
             stand_in: None,
+            suggested_prior: None,
             not_attributed: None,
             scale: None,
             scale_interval: None,
+            scale_bound: None,
             halves: None,
             speed_halves: None,
             consistency: vec![],
@@ -1348,11 +1391,41 @@ mod tests {
         // far apart on both counts
         let c = test(&[(-1.6, 0.02), (-0.4, 0.02)]);
         assert!(!c.holds && c.dof == 1 && c.p_value < 1e-6);
+        assert!(
+            c.tested && c.why.starts_with("fails: χ² p") && c.why.contains("(-1.60)"),
+            "{}",
+            c.why
+        );
         let w = c.disagreement("m").unwrap();
         assert!(w.contains("-1.60 ± 0.020 and -0.400 ± 0.020 m"), "{w}");
-        // a half without information says nothing
+        let c = test(&[(179.0, 1.0), (190.0, 1.0)]);
+        assert!(
+            c.tested
+                && c.why.starts_with("holds: χ² p")
+                && c.why.contains("differ by more than a quarter"),
+            "{}",
+            c.why
+        );
+        // a half without information says nothing: no test, not a passed one
         let c = test(&[(1.0, f64::INFINITY), (5.0, 0.1)]);
         assert!(c.holds && c.dof == 0 && c.groups.len() == 1);
+        assert!(!c.tested && c.why.starts_with("not tested: 1 of the 2 groups"));
+        let j = serde_json::to_value(&c).unwrap();
+        assert!(j["p_value"].is_null() && j["tested"] == false, "{j}");
+        // nor does one whose σ is absurd beside the others'
+        let c = test(&[(-4.2e12, 4.2e14), (5.0, 0.1)]);
+        assert!(!c.tested && c.groups.len() == 1 && c.groups[0].estimate == 5.0);
+        assert!(c.p_value.is_nan() && c.holds && c.uninformative_groups == 1);
+        let c = Consistency::test(
+            "motion",
+            &|k| Split::Motion.group_label(k),
+            &[(-4.2e12, 4.2e14), (5.0, 0.1), (5.1, 0.1)],
+        );
+        assert!(
+            c.tested && c.groups.len() == 2 && c.uninformative_groups == 1 && c.dof == 2,
+            "{c:?}"
+        );
+        assert!(c.why.starts_with("holds: the groups agree"), "{}", c.why);
         // four groups: three agree, one is far off; the words name every group
         let motion = |k| Split::Motion.group_label(k);
         let c = Consistency::test(
@@ -1378,6 +1451,95 @@ mod tests {
         )];
         let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default()).unwrap();
         assert!(why.contains("slower and the faster"), "{why}");
+    }
+
+    #[test]
+    fn a_stand_in_only_for_its_prior_says_which_prior_would_hold_it() {
+        let o = ExplainOptions::default();
+        let t = common::TERMS
+            .iter()
+            .position(|t| t.name == "tau_x")
+            .unwrap();
+        let info = &common::TERMS[t];
+        let holds =
+            |e: &[(f64, f64)]| Consistency::test("time", &|k| Split::Time(0.0).group_label(k), e);
+        // the review's case: tau_x = 40.0 ± 0.293 ms, 40 prior σ, explaining 104 %
+        let mut f = finding(40.0, Some(1.04));
+        f.term = "tau_x".into();
+        f.unit = info.display.into();
+        f.estimate = 40.0;
+        f.sigma = 0.293;
+        f.consistency = vec![holds(&[(40.1, 0.4), (39.9, 0.4)])];
+        f.stand_in = stand_in_reason(&f, Some(0.0), &o);
+        assert!(f.stand_in.is_some());
+        // 3 × 40 = 120 → 200 ms, beyond the 100 ms tau_x can have: the limit
+        f.suggested_prior = suggested_prior(&f, &o);
+        assert_eq!(f.suggested_prior, Some(100.0));
+        let w = finding_words(&f, info, 1.0);
+        assert!(
+            w.contains("give --prior 'tau_x=100 ms' (a prior that holds it) and run again"),
+            "{w}"
+        );
+        // 10 ms: 30 → 30 ms
+        let mut g = f.clone();
+        g.estimate = 10.0;
+        assert_eq!(suggested_prior(&g, &o), Some(30.0));
+        // not when a split fails, none was tested, it explains little, or it is within 30 σ
+        let mut g = f.clone();
+        g.consistency = vec![holds(&[(40.0, 0.4), (10.0, 0.4)])];
+        assert_eq!(suggested_prior(&g, &o), None);
+        g.consistency = vec![holds(&[(40.0, 0.4), (10.0, f64::INFINITY)])];
+        assert_eq!(suggested_prior(&g, &o), None);
+        let mut g = f.clone();
+        g.misfit_share = Some(0.3);
+        assert_eq!(suggested_prior(&g, &o), None);
+        let mut g = f.clone();
+        g.prior_sigmas = 20.0;
+        assert_eq!(suggested_prior(&g, &o), None);
+        let mut g = f.clone();
+        g.stand_in = None;
+        assert_eq!(suggested_prior(&g, &o), None);
+        assert!(!finding_words(&g, info, 1.0).contains("--prior"));
+    }
+
+    #[test]
+    fn a_suggested_prior_is_3x_the_estimate_rounded_up_to_one_digit() {
+        // 3 × 408 µg = 1224 µg → 2000 µg; 3 × 0.0041 = 0.0123 → 0.02
+        assert_eq!(round_up_1(3.0 * 408.0), 2000.0);
+        assert!((round_up_1(3.0 * 0.0041) - 0.02).abs() < 1e-15);
+        assert_eq!(round_up_1(300.0), 300.0);
+    }
+
+    #[test]
+    fn an_unattributed_class_names_no_member_in_its_words() {
+        let t = common::TERMS
+            .iter()
+            .position(|t| t.name == "kas_x")
+            .unwrap();
+        let info = &common::TERMS[t];
+        let mut f = finding(40.0, Some(0.9));
+        f.term = "kas_x".into();
+        f.unit = info.display.into();
+        f.equivalent = vec!["kao_x".into()];
+        f.equivalent_estimates = vec![EquivalentTerm {
+            term: "kao_x".into(),
+            estimate: 5.0,
+            sigma: 0.1,
+            unit: "ppm".into(),
+            prior_sigmas: 900.0,
+        }];
+        f.separate_by = vec!["two vibration amplitudes separate them".into()];
+        let named = finding_words(&f, info, 1.0);
+        assert!(
+            named.contains("named: the one the spec's priors"),
+            "{named}"
+        );
+        f.not_attributed = Some("the priors would choose".into());
+        let w = finding_words(&f, info, 1.0);
+        assert!(
+            !w.contains("named: the one") && w.contains("none named; kas_x stands for the class"),
+            "{w}"
+        );
     }
 
     #[test]
@@ -1451,7 +1613,17 @@ mod tests {
         let e = parse_candidates(Some("!nope_*"), &base).unwrap_err();
         assert!(e.contains("unknown term `nope_*`"), "{e}");
         let e = parse_candidates(Some("d_x,!d_*"), &base).unwrap_err();
-        assert!(e.contains("withholds every candidate"), "{e}");
+        assert!(
+            e.contains("`d_x` is both named and withheld (`!d_*`)"),
+            "{e}"
+        );
+        let e = parse_candidates(Some("size_x,!size_x"), &base).unwrap_err();
+        assert!(
+            e.contains("`size_x` is both named and withheld (`!size_x`)"),
+            "{e}"
+        );
+        // a family of which one member is withheld is no contradiction
+        assert!(parse_candidates(Some("size_*,!size_x"), &base).is_ok());
     }
 
     #[test]

@@ -71,6 +71,10 @@ pub(super) struct LevelFit {
     pub(super) scale: f64,
     /// Approximate 95 % interval of the scale.
     pub(super) interval: [f64; 2],
+    /// −1 when the last search for the level ended at its lower bound with the likelihood still
+    /// rising towards it (the scale is at most `scale`), +1 at its upper bound (at least), 0
+    /// when the maximum was bracketed.
+    pub(super) at_bound: i8,
     /// 2Δℓ of the fitted scale over the stated value, the other levels at their fitted scales.
     pub(super) two_delta_loglik: f64,
     /// Holm-adjusted p-value over the levels.
@@ -102,6 +106,7 @@ pub(super) fn fit(
     let mut scales = vec![1.0; levels.len()];
     let mut gains = vec![0.0; levels.len()];
     let mut curvs = vec![0.0; levels.len()];
+    let mut bounds = vec![0i8; levels.len()];
     for (step, &level) in order.iter().enumerate() {
         let li = step % levels.len();
         let mut eval = |u: f64| -> anyhow::Result<f64> {
@@ -111,7 +116,7 @@ pub(super) fn fit(
             done += 1.0;
             Ok(p.stats.loglik)
         };
-        let (u, l, curv) = search(&mut eval, l_cur)?;
+        let (u, l, curv, edge) = search(&mut eval, l_cur)?;
         if l > l_cur {
             level.apply(model, &mut cur, 2f64.powf(u));
             scales[li] *= 2f64.powf(u);
@@ -119,6 +124,7 @@ pub(super) fn fit(
             l_cur = l;
         }
         curvs[li] = curv;
+        bounds[li] = edge;
     }
     // each level's evidence is the drop in ℓ when it alone goes back to its stated value, the
     // others kept at their fitted scales: a level that in the first sweep took up another's
@@ -139,6 +145,7 @@ pub(super) fn fit(
             level,
             scale: scales[li],
             interval: interval(scales[li], curvs[li]),
+            at_bound: bounds[li],
             two_delta_loglik: gains[li],
             p_holm: stats::chi2_sf(gains[li], 1.0),
             significant: false,
@@ -182,12 +189,13 @@ fn refit_named(
             level.apply(model, &mut c, 2f64.powf(u));
             Ok(run_pass(model, &[], data, &c, &mut |_| {})?.stats.loglik)
         };
-        let (u, l, curv) = search(&mut eval, l_out)?;
+        let (u, l, curv, edge) = search(&mut eval, l_out)?;
         if l > l_out {
             level.apply(model, out, 2f64.powf(u));
             f.scale *= 2f64.powf(u);
             l_out = l;
         }
+        f.at_bound = edge;
         if curv < 0.0 {
             f.interval = interval(f.scale, curv);
         }
@@ -210,11 +218,13 @@ fn interval(scale: f64, curv: f64) -> [f64; 2] {
 /// Maximises ℓ(u) over u = log₂ s from u = 0 (where ℓ = `l0`) in at most [`MAX_EVALS`]
 /// passes: ±1, then successive parabolic interpolation through the best point and its nearest
 /// neighbours on either side (a step of 2 beyond the best point while it lies at an end),
-/// within [−4, 6]. Returns (u, ℓ(u), the curvature a of the last parabola, ℓ ≈ a u² + …).
+/// within [−4, 6]. Returns (u, ℓ(u), the curvature a of the last parabola, ℓ ≈ a u² + …, and
+/// −1 or +1 when the best point is the lowest or highest tried: the likelihood still rises
+/// beyond it, so u is a bound of the maximum, not the maximum; else 0).
 fn search(
     eval: &mut dyn FnMut(f64) -> anyhow::Result<f64>,
     l0: f64,
-) -> anyhow::Result<(f64, f64, f64)> {
+) -> anyhow::Result<(f64, f64, f64, i8)> {
     const LO: f64 = -4.0;
     const HI: f64 = 6.0;
     let mut pts: Vec<(f64, f64)> = vec![(0.0, l0), (-1.0, eval(-1.0)?), (1.0, eval(1.0)?)];
@@ -247,11 +257,16 @@ fn search(
     let k = (0..pts.len())
         .max_by(|&i, &j| pts[i].1.total_cmp(&pts[j].1))
         .expect("points");
-    if k > 0 && k + 1 < pts.len() {
+    let edge = if k == 0 {
+        -1
+    } else if k + 1 == pts.len() {
+        1
+    } else {
         let ((x0, y0), (x1, y1), (x2, y2)) = (pts[k - 1], pts[k], pts[k + 1]);
         curv = ((y2 - y1) / (x2 - x1) - (y1 - y0) / (x1 - x0)) / (x2 - x0);
-    }
-    Ok((pts[k].0, pts[k].1, curv))
+        0
+    };
+    Ok((pts[k].0, pts[k].1, curv, edge))
 }
 
 /// Most filter passes per noise level (the start point's pass not counted).
@@ -465,7 +480,9 @@ fn split_scales(
             .collect();
         // tested in log₂ s (where the likelihood is near a parabola): the groups disagree when
         // χ² p < 0.0027 and their scales differ by more than 1.5×
-        let mut c = super::Consistency::test(name, &|k| labels[k].to_string(), &est);
+        // (a group's information is judged above, by its σ in log₂ s)
+        let mut c =
+            super::Consistency::test_within(name, &|k| labels[k].to_string(), &est, f64::INFINITY);
         let spread = c
             .groups
             .iter()
@@ -473,7 +490,22 @@ fn split_scales(
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), u| {
                 (lo.min(u), hi.max(u))
             });
-        c.holds = !(c.p_value < 0.0027 && spread.1 - spread.0 > 1.5f64.log2());
+        let wide = spread.1 - spread.0 > 1.5f64.log2();
+        c.holds = !(c.p_value < super::findings::SPLIT_P && wide);
+        if c.tested && c.p_value < super::findings::SPLIT_P {
+            let ratio = sig3(2f64.powf(spread.1 - spread.0));
+            c.why = if wide {
+                format!(
+                    "fails: χ² p {}, and the groups' scales differ by {ratio}×, more than 1.5×",
+                    sig3(c.p_value)
+                )
+            } else {
+                format!(
+                    "holds: χ² p {}, but the groups' scales differ by only {ratio}×, not more than 1.5×",
+                    sig3(c.p_value)
+                )
+            };
+        }
         // said as scales of the stated value (σ by the delta method)
         for g in &mut c.groups {
             let scale = 2f64.powf(g.estimate);
@@ -532,15 +564,34 @@ fn noise_finding(
     };
     let estimate = stated * f.scale;
     let [lo, hi] = f.interval;
-    let words = match f.level {
-        Level::Sigma(_) => format!(
+    // a scale the search stopped at with the likelihood still rising is a bound, not an
+    // estimate: no interval (e.g. a σ stated for fixes that carry no noise at all)
+    let bound = match f.at_bound {
+        -1 => Some(("≤", "smaller", "at most")),
+        1 => Some(("≥", "larger", "at least")),
+        _ => None,
+    };
+    let words = match (bound, f.level) {
+        (Some((cmp, way, _)), Level::Sigma(_)) => format!(
+            "the data show {what} at the search bound ({cmp} {}× the σ the fixes state; the likelihood still rises towards {way} values, so no estimate or interval; 2Δℓ {})",
+            sig3(f.scale),
+            sig3(f.two_delta_loglik)
+        ),
+        (Some((cmp, way, _)), _) => format!(
+            "the data show {what} at the search bound ({cmp} {} {unit}, {cmp} {}× the stated {}; the likelihood still rises towards {way} values, so no estimate or interval; 2Δℓ {})",
+            sig3(estimate),
+            sig3(f.scale),
+            sig3(stated),
+            sig3(f.two_delta_loglik)
+        ),
+        (None, Level::Sigma(_)) => format!(
             "the data show {what} {}× the σ the fixes state (95 % interval {}–{}×; 2Δℓ {})",
             sig3(f.scale),
             sig3(lo),
             sig3(hi),
             sig3(f.two_delta_loglik)
         ),
-        _ => format!(
+        (None, _) => format!(
             "the data show {what} of {} {unit}, {}× the stated {} (95 % interval {}–{}×; 2Δℓ {})",
             sig3(estimate),
             sig3(f.scale),
@@ -561,7 +612,11 @@ fn noise_finding(
         term: f.level.name(),
         kind: "noise",
         estimate,
-        sigma: stated * f.scale * (hi / lo).ln() / (2.0 * 1.959_964),
+        sigma: if bound.is_some() {
+            f64::NAN
+        } else {
+            stated * f.scale * (hi / lo).ln() / (2.0 * 1.959_964)
+        },
         unit: unit.into(),
         llr: f.two_delta_loglik,
         p_value: f.p_holm,
@@ -586,9 +641,11 @@ fn noise_finding(
         misfit_share,
         prior_sigmas: 0.0,
         stand_in: None,
+        suggested_prior: None,
         not_attributed: None,
         scale: Some(f.scale),
-        scale_interval: Some(f.interval),
+        scale_interval: bound.is_none().then_some(f.interval),
+        scale_bound: bound.map(|b| b.2),
         halves: None,
         speed_halves: None,
         consistency: vec![],
@@ -604,7 +661,7 @@ mod tests {
         // ℓ(u) = −3 (u − 1.7)², maximum at s = 2^1.7 = 3.25
         let f = |u: f64| -3.0 * (u - 1.7) * (u - 1.7);
         let mut calls = 0;
-        let (u, l, a) = search(
+        let (u, l, a, edge) = search(
             &mut |u| {
                 calls += 1;
                 Ok(f(u))
@@ -616,17 +673,64 @@ mod tests {
         assert!(l.abs() < 1e-9);
         assert!((a + 3.0).abs() < 1e-9, "{a}");
         assert!(calls <= MAX_EVALS, "{calls}");
+        assert_eq!(edge, 0);
     }
 
     #[test]
     fn the_search_steps_on_when_the_likelihood_keeps_rising() {
         // rises up to u = 5 (s = 32): steps of 2 from 1
         let f = |u: f64| -((u - 5.0) * (u - 5.0)).sqrt();
-        let (u, _, _) = search(&mut |u| Ok(f(u)), f(0.0)).unwrap();
+        let (u, _, _, _) = search(&mut |u| Ok(f(u)), f(0.0)).unwrap();
         assert!(u >= 3.0, "{u}");
         // and stays at 1 when nothing is to gain
         let g = |u: f64| -u * u;
-        let (u, _, a) = search(&mut |u| Ok(g(u)), g(0.0)).unwrap();
-        assert!(u.abs() < 1e-9 && (a + 1.0).abs() < 1e-9);
+        let (u, _, a, edge) = search(&mut |u| Ok(g(u)), g(0.0)).unwrap();
+        assert!(u.abs() < 1e-9 && (a + 1.0).abs() < 1e-9 && edge == 0);
+    }
+
+    #[test]
+    fn a_scale_at_the_search_bound_is_said_as_a_bound_without_an_interval() {
+        // a σ stated for noise-free fixes: the likelihood rises without end towards 0
+        let (u, _, _, edge) = search(&mut |u| Ok(-u), 0.0).unwrap();
+        assert!(u == -4.0 && edge == -1, "{u} {edge}");
+        let (u, _, _, edge) = search(&mut |u| Ok(u), 0.0).unwrap();
+        assert!(u == 6.0 && edge == 1, "{u} {edge}");
+        let fit = |at_bound| LevelFit {
+            level: Level::Sigma("pos_h"),
+            scale: 2f64.powi(-12),
+            interval: [1.71e-4, 3.49e-4],
+            at_bound,
+            two_delta_loglik: 900.0,
+            p_holm: 0.0,
+            significant: true,
+        };
+        let stated = Stated {
+            white: (1e-4, 1e-3),
+            bias_rw: (0.0, 0.0),
+        };
+        let f = noise_finding(&fit(-1), &stated, None, 900.0);
+        assert!(
+            f.words
+                .contains("at the search bound (≤ 2.44e-4× the σ the fixes state")
+                && !f.words.contains("interval 1.71e-4"),
+            "{}",
+            f.words
+        );
+        assert!(f.scale_interval.is_none() && f.sigma.is_nan());
+        assert_eq!(f.scale_bound, Some("at most"));
+        let mut g = fit(1);
+        g.level = Level::GyroArw;
+        g.scale = 64.0;
+        let f = noise_finding(&g, &stated, None, 900.0);
+        assert!(f.words.contains("at the search bound (≥"), "{}", f.words);
+        assert_eq!(f.scale_bound, Some("at least"));
+        // bracketed: an estimate with its interval
+        let f = noise_finding(&fit(0), &stated, None, 900.0);
+        assert!(
+            f.words.contains("95 % interval 1.71e-4–3.49e-4×"),
+            "{}",
+            f.words
+        );
+        assert!(f.scale_interval.is_some() && f.scale_bound.is_none());
     }
 }

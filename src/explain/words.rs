@@ -234,8 +234,14 @@ pub(super) fn finding_words(
                 )
             })
             .collect();
+        // an unattributed class names nothing: the priors that would choose do not fit
+        let named = if f.not_attributed.is_some() {
+            format!("none named; {} stands for the class", f.term)
+        } else {
+            "named: the one the spec's priors find most plausible".to_string()
+        };
         s.push_str(&format!(
-            "; the data cannot separate it from {} (equivalence class; named: the one the spec's priors find most plausible); {}",
+            "; the data cannot separate it from {} (equivalence class; {named}); {}",
             others.join(", "),
             f.separate_by.join("; ")
         ));
@@ -280,6 +286,14 @@ fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
         s.push_str(&format!(
             ". It probably stands in for an effect the candidates do not describe ({why}){what_else}"
         ));
+        if let Some(p) = f.suggested_prior {
+            s.push_str(&format!(
+                ". Yet it holds across the data and explains most of the misfit: if this sensor can have such a value, give --prior '{}={} {}' (a prior that holds it) and run again",
+                f.term,
+                sig3(p),
+                f.unit
+            ));
+        }
     } else if let Some(why) = &f.not_attributed {
         s.push_str(&format!(
             ". No member of its class is named as the cause: {why}"
@@ -353,25 +367,16 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
         let w = &e.baseline_priors_tight;
         let values = w
             .iter()
-            .map(|p| {
-                format!(
-                    "{} = {} ± {} {} is {} of its {} {} prior σ",
-                    p.term,
-                    sig3(p.estimate),
-                    sig3(p.sigma),
-                    p.unit,
-                    sig3(p.prior_sigmas),
-                    sig3(p.prior),
-                    p.unit
-                )
-            })
+            .map(tight_prior_words)
             .collect::<Vec<_>>()
             .join("; ");
-        let options = w
-            .iter()
-            .map(|p| format!("--prior '{}={} {}'", p.term, sig3(p.suggested), p.unit))
-            .collect::<Vec<_>>()
-            .join(" ");
+        let options = format!(
+            "{} (each 3× the estimate's magnitude, rounded up to one significant digit)",
+            w.iter()
+                .map(|p| format!("--prior '{}={} {}'", p.term, sig3(p.suggested), p.unit))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
         let gain = sig3(e.baseline_priors_gain.unwrap_or(0.0));
         // the check runs on the model explain recommends: the baseline plus its causes
         let with = if e.findings.iter().any(|f| f.is_cause() && f.kind != "noise") {
@@ -391,6 +396,35 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
             )
         });
     }
+}
+
+/// One baseline prior the data find too tight: its estimate and how many of its prior σ that is.
+pub(super) fn tight_prior_words(p: &super::findings::TightPrior) -> String {
+    format!(
+        "{} = {} ± {} {} is {}× its prior σ of {} {}",
+        p.term,
+        sig3(p.estimate),
+        sig3(p.sigma),
+        p.unit,
+        sig3(p.prior_sigmas),
+        sig3(p.prior),
+        p.unit
+    )
+}
+
+/// A mean NIS for the summary's comparisons with 1 and with each other: four significant
+/// digits (1.012 → 1.004, where three would print 1.01 → 1.00).
+pub(super) fn nis_text(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() || a == 0.0 || !(1e-3..1e5).contains(&a) {
+        return if v.is_finite() && a != 0.0 {
+            format!("{v:.3e}")
+        } else {
+            sig3(v)
+        };
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
 }
 
 /// A p-value for the words: three significant digits, "< 1e-16" below double precision's
@@ -488,7 +522,7 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
         out.push(format!(
             "The baseline {} is consistent with the data: mean NIS {} and white innovations in every channel.",
             e.baseline_model,
-            sig3(e.baseline.nis_mean)
+            nis_text(e.baseline.nis_mean)
         ));
     }
 }
@@ -541,8 +575,8 @@ fn findings_words(e: &Explanation, out: &mut Vec<String>) {
         let mut s = format!(
             "Extended model {}: mean NIS {} → {}, log-likelihood {:+.1}",
             e.extended_model,
-            sig3(e.gain.nis_mean_before),
-            sig3(e.gain.nis_mean_after),
+            nis_text(e.gain.nis_mean_before),
+            nis_text(e.gain.nis_mean_after),
             e.gain.loglik
         );
         if let (Some(b), Some(a)) = (e.gain.model_error_rms_before, e.gain.model_error_rms_after) {
@@ -565,19 +599,23 @@ fn findings_words(e: &Explanation, out: &mut Vec<String>) {
 /// The summary's lines on what the extension leaves: the unexplained share of the misfit and the
 /// structure left in the innovations; times from `t_ref` [s].
 fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
+    // said whenever the baseline had an excess to explain (a mean NIS of the extended model
+    // below 1 leaves none of it: 0 %)
     if let Some(left) = e.misfit_unexplained {
-        if e.findings.is_empty() || left > 0.1 {
-            out.push(format!(
-                "Left unexplained: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter){}.",
-                sig3(100.0 * left),
-                sig3(e.extended.nis_mean),
-                if left > 0.5 {
-                    "; most of the misfit is something the candidates do not describe"
-                } else {
-                    ""
-                }
-            ));
-        }
+        out.push(format!(
+            "Left unexplained: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter){}.",
+            if left > 0.0 {
+                sig3(100.0 * left)
+            } else {
+                "0".into()
+            },
+            nis_text(e.extended.nis_mean),
+            if left > 0.5 {
+                "; most of the misfit is something the candidates do not describe"
+            } else {
+                ""
+            }
+        ));
     }
     // what the extended model leaves in the innovations (the baseline's was said above)
     let left = e.extended.structure();
@@ -668,5 +706,38 @@ fn not_named_words(e: &Explanation, out: &mut Vec<String>) {
             "Not testable on these data (no information): {}.",
             e.not_testable.join(", ")
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tight_prior_is_said_as_a_multiple_of_its_prior_sigma() {
+        let p = super::super::findings::TightPrior {
+            term: "nabla_x".into(),
+            index: 0,
+            estimate: 408.0,
+            sigma: 12.0,
+            prior: 100.0,
+            prior_sigmas: 4.08,
+            suggested: 2000.0,
+            unit: "ug".into(),
+        };
+        assert_eq!(
+            tight_prior_words(&p),
+            "nabla_x = 408 ± 12.0 ug is 4.08× its prior σ of 100 ug"
+        );
+    }
+
+    #[test]
+    fn a_mean_nis_near_1_keeps_enough_digits_to_differ() {
+        assert_eq!(nis_text(1.0123), "1.012");
+        assert_eq!(nis_text(1.0041), "1.004");
+        assert_eq!(nis_text(0.917), "0.9170");
+        assert_eq!(nis_text(2324.4), "2324");
+        assert_eq!(nis_text(21.53), "21.53");
+        assert_eq!(nis_text(3.0e6), "3.000e6");
     }
 }

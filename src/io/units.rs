@@ -23,3 +23,56 @@ pub fn sig3(v: f64) -> String {
         format!("{v:.3}")
     }
 }
+
+/// `a` and `b` each with three significant digits ([`sig3`]), or with as many more as it takes
+/// for their magnitudes to read differently (100.001 against 100, not 100 against 100; −100.001
+/// against 100 likewise).
+pub fn sig_distinct(a: f64, b: f64) -> (String, String) {
+    let signed = |v: f64, text: String| {
+        if v < 0.0 {
+            format!("-{text}")
+        } else {
+            text
+        }
+    };
+    let (x, y) = (sig3(a.abs()), sig3(b.abs()));
+    if x != y || a.abs() == b.abs() || !(a.is_finite() && b.is_finite()) {
+        return (sig3(a), sig3(b));
+    }
+    // rounded to `digits` significant digits, then printed in the shortest form that reads back
+    let round = |v: f64, digits: usize| -> String {
+        let r: f64 = format!("{v:.prec$e}", prec = digits - 1)
+            .parse()
+            .unwrap_or(v);
+        format!("{r}")
+    };
+    for digits in 4..=17 {
+        let (x, y) = (round(a.abs(), digits), round(b.abs(), digits));
+        if x != y {
+            return (signed(a, x), signed(b, y));
+        }
+    }
+    (format!("{a:e}"), format!("{b:e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_values_read_differently_when_they_differ() {
+        assert_eq!(
+            sig_distinct(100.001, 100.0),
+            ("100.001".into(), "100".into())
+        );
+        assert_eq!(sig_distinct(5000.0, 100.0), ("5000".into(), "100".into()));
+        assert_eq!(
+            sig_distinct(1000.5, 1000.0),
+            ("1000.5".into(), "1000".into())
+        );
+        assert_eq!(
+            sig_distinct(-100.001, 100.0),
+            ("-100.001".into(), "100".into())
+        );
+    }
+}

@@ -84,17 +84,38 @@ impl TermInfo {
     pub fn beyond_limit(&self, value: f64) -> Option<String> {
         (value.abs() > self.limit).then(|| {
             let k = 1.0 / self.display_to_si;
+            let (v, l) = crate::io::units::sig_distinct(value * k, self.limit * k);
             format!(
-                "{} {} is beyond the {} {} the term can physically have (its `limit` in model-spec/terms.toml): a larger unit written where {} was meant?",
-                crate::io::units::sig3(value * k),
+                "{v} {} is beyond the {l} {} the term can physically have (its `limit` in model-spec/terms.toml): a larger unit written where {} was meant?",
                 self.display,
-                crate::io::units::sig3(self.limit * k),
                 self.display,
                 self.display
             )
         })
     }
 }
+
+impl TermInfo {
+    /// Why `sigma` [SI], a prior σ given for this term, is refused when it is more than
+    /// [`PRIOR_BELOW_SPEC`] times below the spec's prior σ: the term is then pinned at zero, and
+    /// explain would call it "not testable (no information)", which it is not.
+    pub fn prior_too_small(&self, sigma: f64) -> Option<String> {
+        (self.sigma > 0.0 && sigma < self.sigma / PRIOR_BELOW_SPEC).then(|| {
+            let k = 1.0 / self.display_to_si;
+            format!(
+                "{} {} is more than 10^6 times below the spec's prior σ of {} {}: it pins the term at zero (the data could tell nothing about it); give a prior σ within 10^6 of the spec's, or withhold the term (`--candidates '!{}'`, or a model without it)",
+                crate::io::units::sig3(sigma * k),
+                self.display,
+                crate::io::units::sig3(self.sigma * k),
+                self.display,
+                self.name
+            )
+        })
+    }
+}
+
+/// How far below the spec's prior σ a `--prior` may go ([`TermInfo::prior_too_small`]).
+pub const PRIOR_BELOW_SPEC: f64 = 1e6;
 
 /// A sensor grade as declared in `model-spec/grades.toml`: white noise and the prior of every
 /// state (navigation states in `NAV_STATES` order, terms in `TERMS` order; SI).

@@ -86,30 +86,13 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Draws `series` into a 1000×600 PNG at `path`: the legend in a strip right of the axes (it
-/// never covers data), points the scale cannot show (non-finite, ≤ 0 on a log axis) breaking
-/// the line, ticks labelled by [`tick`]. An x axis of large values over a short span (absolute
-/// GPS times) is drawn from its whole-number start, which the axis label then names.
-pub fn line_plot(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
+/// The data's ranges (x0, x1, y0, y1) over the points `shown` accepts, widened to a unit span
+/// (a decade on a log axis) where the data have none.
+fn data_ranges(
     series: &[Series],
     scale: Scale,
-) -> Result<()> {
-    register_font();
-    let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
-    let shown = |&(x, y): &(f64, f64)| {
-        x.is_finite()
-            && y.is_finite()
-            && match scale {
-                Scale::Linear => true,
-                Scale::LogLog => x > 0.0 && y > 0.0,
-                Scale::LogX => x > 0.0,
-                Scale::LogY => y > 0.0,
-            }
-    };
+    shown: &dyn Fn(&(f64, f64)) -> bool,
+) -> (f64, f64, f64, f64) {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for &(x, y) in series
         .iter()
@@ -144,6 +127,54 @@ pub fn line_plot(
             y0 + 1.0
         };
     }
+    (x0, x1, y0, y1)
+}
+
+/// Draws the legend of `series` into `area` (a strip beside the axes), one line and label each.
+fn draw_legend(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    series: &[Series],
+) -> Result<()> {
+    for (k, s) in series.iter().enumerate() {
+        let c = COLORS[k % COLORS.len()];
+        let y = 70 + 26 * k as i32;
+        area.draw(&PathElement::new(vec![(6, y), (32, y)], c.stroke_width(3)))
+            .map_err(|e| anyhow!("legend: {e}"))?;
+        area.draw(&Text::new(
+            s.label.clone(),
+            (38, y - 9),
+            ("sans-serif", 15).into_font().color(&BLACK),
+        ))
+        .map_err(|e| anyhow!("legend: {e}"))?;
+    }
+    Ok(())
+}
+
+/// Draws `series` into a 1000×600 PNG at `path`: the legend in a strip right of the axes (it
+/// never covers data), points the scale cannot show (non-finite, ≤ 0 on a log axis) breaking
+/// the line, ticks labelled by [`tick`]. An x axis of large values over a short span (absolute
+/// GPS times) is drawn from its whole-number start, which the axis label then names.
+pub fn line_plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    scale: Scale,
+) -> Result<()> {
+    register_font();
+    let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
+    let shown = |&(x, y): &(f64, f64)| {
+        x.is_finite()
+            && y.is_finite()
+            && match scale {
+                Scale::Linear => true,
+                Scale::LogLog => x > 0.0 && y > 0.0,
+                Scale::LogX => x > 0.0,
+                Scale::LogY => y > 0.0,
+            }
+    };
+    let (x0, x1, y0, y1) = data_ranges(series, scale, &shown);
     // absolute times (GPS seconds) over a short span: counted from their whole-second start
     let x_off = if matches!(scale, Scale::Linear | Scale::LogY)
         && x0.abs() >= 1e5
@@ -264,20 +295,7 @@ pub fn line_plot(
                 .map_err(|e| err(&e))?),
         }
         if labelled {
-            for (k, s) in series.iter().enumerate() {
-                let c = COLORS[k % COLORS.len()];
-                let y = 70 + 26 * k as i32;
-                legend
-                    .draw(&PathElement::new(vec![(6, y), (32, y)], c.stroke_width(3)))
-                    .map_err(|e| err(&e))?;
-                legend
-                    .draw(&Text::new(
-                        s.label.clone(),
-                        (38, y - 9),
-                        ("sans-serif", 15).into_font().color(&BLACK),
-                    ))
-                    .map_err(|e| err(&e))?;
-            }
+            draw_legend(&legend, series).map_err(|e| err(&e))?;
         }
         root.present().map_err(|e| err(&e))?;
     }

@@ -309,6 +309,35 @@ fn check_si(si: f64, written_nonzero: bool, what: &str) -> Result<f64, UnitError
     Ok(si)
 }
 
+/// Length in bytes of the decimal number `s` starts with: sign, digits, a point, digits, and an
+/// exponent only when digits follow it (`2e-3ms` → `2e-3`, `2em` → `2`).
+fn numeric_prefix(s: &str) -> usize {
+    let b = s.as_bytes();
+    let digits = |mut i: usize| {
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        i
+    };
+    let mut i = usize::from(matches!(b.first(), Some(b'+' | b'-')));
+    let start = i;
+    i = digits(i);
+    if b.get(i) == Some(&b'.') {
+        i = digits(i + 1);
+    }
+    if i == start {
+        return 0;
+    }
+    if matches!(b.get(i), Some(b'e' | b'E')) {
+        let j = i + 1 + usize::from(matches!(b.get(i + 1), Some(b'+' | b'-')));
+        let k = digits(j);
+        if k > j {
+            i = k;
+        }
+    }
+    i
+}
+
 /// Parses `"<number> <unit>"` (a bare number is dimensionless) into SI.
 ///
 /// Refused with a message: a number that is not finite, a unit [`parse_unit`] refuses, and a
@@ -317,9 +346,20 @@ pub fn parse_quantity(text: &str) -> Result<Quantity, UnitError> {
     let t = text.trim();
     let split = t.find(|c: char| c.is_whitespace()).unwrap_or(t.len());
     let (num, unit) = t.split_at(split);
-    let value: f64 = num
-        .parse()
-        .map_err(|_| UnitError(format!("`{t}`: `{num}` is not a number")))?;
+    let value: f64 = num.parse().map_err(|_| {
+        // a unit glued to its number (`2ms`): the number and the unit need a space between
+        let digits = numeric_prefix(num);
+        if digits > 0 && num[..digits].parse::<f64>().is_ok() && parse_unit(&num[digits..]).is_ok()
+        {
+            UnitError(format!(
+                "`{t}`: write a space between the number and its unit (`{} {}`)",
+                &num[..digits],
+                &num[digits..]
+            ))
+        } else {
+            UnitError(format!("`{t}`: `{num}` is not a number"))
+        }
+    })?;
     if !value.is_finite() {
         return Err(UnitError(format!("`{t}`: value is not finite")));
     }
@@ -375,6 +415,27 @@ pub mod fuzz_property {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_unit_glued_to_its_number_is_refused_asking_for_a_space() {
+        let e = parse_quantity("2ms").unwrap_err().0;
+        assert!(
+            e.contains("write a space between the number and its unit (`2 ms`)"),
+            "{e}"
+        );
+        let e = parse_quantity("1e-9mm").unwrap_err().0;
+        assert!(e.contains("(`1e-9 mm`)"), "{e}");
+        let e = parse_quantity("-0.5deg/h").unwrap_err().0;
+        assert!(e.contains("(`-0.5 deg/h`)"), "{e}");
+        // no number, or no unit after it: as before
+        let e = parse_quantity("abc ms").unwrap_err().0;
+        assert!(e.contains("`abc` is not a number"), "{e}");
+        let e = parse_quantity("2xyz").unwrap_err().0;
+        assert!(e.contains("`2xyz` is not a number"), "{e}");
+        assert_eq!(numeric_prefix("2em"), 1);
+        assert_eq!(numeric_prefix("+.5e+3x"), 6);
+        assert_eq!(numeric_prefix("ms"), 0);
+    }
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() <= 1e-12 * b.abs().max(1e-300)
