@@ -92,6 +92,8 @@ window.addEventListener('load', () => {
       return !c || c.textContent.trim().length < 10;
     }).length,
     raw_markdown: markers.filter(m => text.includes(m)),
+    figure_numbers: Array.from(document.querySelectorAll('figcaption'))
+      .map(c => parseInt((c.textContent.match(/^Figure (\d+)\./) || [0, -1])[1])),
     page_width: document.documentElement.scrollWidth,
     window_width: window.innerWidth,
   };
@@ -167,6 +169,14 @@ fn explain_report_renders_in_a_browser() {
         "every figure decoded and shown: {r}"
     );
     assert_eq!(n("uncaptioned"), 0, "every figure beside its caption: {r}");
+    let numbers: Vec<i64> = r["figure_numbers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_i64().unwrap())
+        .collect();
+    let expected: Vec<i64> = (1..=numbers.len() as i64).collect();
+    assert_eq!(numbers, expected, "figures numbered in page order: {r}");
     assert_eq!(
         r["raw_markdown"],
         serde_json::json!([]),

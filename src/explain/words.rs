@@ -496,15 +496,24 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
                 sig3(ch.nis_mean.sqrt()),
                 sig3(ch.nis_mean)
             )),
-            // only the whiteness test failed: the size is as predicted, the sequence is not
-            (false, _) => out.push(format!(
-                "{} innovations are correlated in time (Ljung–Box p {} after Bonferroni over the channels) while their size is close to what the model predicts (mean NIS {}, 95 % band {}–{}): the model misses a slow effect.",
-                channel_word(&ch.channel),
-                correlated.map(p_text).unwrap_or_default(),
-                sig3(ch.nis_mean),
-                sig3(ch.nis_band[0]),
-                sig3(ch.nis_band[1])
-            )),
+            // the whiteness test failed and the size is not too large: say where the size lies
+            (false, _) => {
+                let size = if ch.nis_mean < ch.nis_band[0] {
+                    "their size is below what the model predicts"
+                } else if ch.nis_mean > ch.nis_band[1] {
+                    "their size is somewhat above what the model predicts"
+                } else {
+                    "their size is what the model predicts"
+                };
+                out.push(format!(
+                    "{} innovations are correlated in time (Ljung–Box p {} after Bonferroni over the channels); {size} (mean NIS {}, 95 % band {}–{}): the model misses a slow effect.",
+                    channel_word(&ch.channel),
+                    correlated.map(p_text).unwrap_or_default(),
+                    sig3(ch.nis_mean),
+                    sig3(ch.nis_band[0]),
+                    sig3(ch.nis_band[1])
+                ))
+            }
         }
     }
     for ch in &e.baseline.channels {

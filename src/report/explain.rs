@@ -180,11 +180,14 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     }
     at_a_glance(e, &mut s);
     let mut placed = vec![false; figures.len()];
+    // figures are numbered in the order the page shows them
+    let mut number = 0;
     let mut place = |s: &mut String, files: &[&str]| {
         for (k, (file, caption)) in figures.iter().enumerate() {
             if !placed[k] && files.iter().any(|f| file == f) {
                 placed[k] = true;
-                s.push_str(&figure(k + 1, file, caption));
+                number += 1;
+                s.push_str(&figure(number, file, caption));
             }
         }
     };
@@ -206,8 +209,8 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     let rest: Vec<usize> = (0..figures.len()).filter(|&k| !placed[k]).collect();
     if !rest.is_empty() {
         s.push_str("\n## Further figures\n\n");
-        for k in rest {
-            s.push_str(&figure(k + 1, &figures[k].0, &figures[k].1));
+        for (i, k) in rest.into_iter().enumerate() {
+            s.push_str(&figure(number + i + 1, &figures[k].0, &figures[k].1));
         }
     }
     notes_section(&mut s);
@@ -369,6 +372,7 @@ pub fn notation(text: &str) -> String {
             ("sqrt(s)", "√s"),
             ("^2", "²"),
             ("^3", "³"),
+            (" x stated", " × stated"),
         ];
         if let Some((p, q)) = units.iter().find(|(p, _)| {
             text[i..].starts_with(p)

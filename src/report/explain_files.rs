@@ -214,19 +214,19 @@ fn model_error(
     };
     let curves = vec![
         Series {
-            label: format!("e_n {}", e.baseline_model),
+            label: format!("e_n baseline {}", e.baseline_model),
             points: pick(&e.model_error_before, 0),
         },
         Series {
-            label: format!("e_e {}", e.baseline_model),
+            label: format!("e_e baseline {}", e.baseline_model),
             points: pick(&e.model_error_before, 1),
         },
         Series {
-            label: format!("e_n {}", e.extended_model),
+            label: "e_n extended".to_string(),
             points: pick(&e.model_error_after, 0),
         },
         Series {
-            label: format!("e_e {}", e.extended_model),
+            label: "e_e extended".to_string(),
             points: pick(&e.model_error_after, 1),
         },
     ];

@@ -213,8 +213,10 @@ pub fn line_plot(
             .margin_right(30)
             .x_label_area_size(50)
             .y_label_area_size(85);
-        let x_fmt = |v: &f64| tick(*v);
-        let y_fmt = |v: &f64| tick(*v);
+        // a tick a rounding residue away from 0 (-2.2e-16) reads 0
+        let snap = |v: f64, span: f64| if v.abs() < 1e-9 * span { 0.0 } else { v };
+        let x_fmt = |v: &f64| tick(snap(*v, x1 - x0));
+        let y_fmt = |v: &f64| tick(snap(*v, y1 - y0));
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
