@@ -120,6 +120,14 @@ fn init_auto_and_outages_say_their_times_from_the_first_sample() {
         err.contains("100.000 .. 120.000 s from the first IMU sample (t = 1000000100.005 .. 1000000120.005 s on the data's clock)"),
         "{err}"
     );
+    // a START given on the data's clock: refused with the START that was probably meant
+    let (ok, err) = run(&["1000000100.005,20"], "k");
+    assert!(!ok);
+    assert!(
+        err.contains("looks like a time on that clock")
+            && err.contains("START = 100.000 was probably meant"),
+        "{err}"
+    );
     let (ok, err) = run(&["200,20"], "h");
     assert!(!ok);
     assert!(

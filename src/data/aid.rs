@@ -237,6 +237,16 @@ impl DataOptions {
                         crate::io::lines::shown(o)
                     )
                 })?;
+            // a START on the data's clock (GPS seconds) where seconds from the first sample are meant
+            if v.len() == 2 && first_t.abs() > 1e5 && (v[0] - first_t).abs() < 1e6 {
+                bail!(
+                    "--outage `{}`: START counts from the first IMU sample, not on the data's clock; {} looks like a time on that clock (the first sample is at {:.3} s), so START = {:.3} was probably meant",
+                    crate::io::lines::shown(o),
+                    v[0],
+                    first_t,
+                    v[0] - first_t
+                );
+            }
             if v.len() != 2
                 || !v.iter().all(|x| x.is_finite())
                 || v[0] < 0.0
