@@ -127,6 +127,11 @@ fn data_ranges(
             y0 + 1.0
         };
     }
+    // a log y axis gets the margin a linear one gets from its pad: curves clear of the frame
+    if matches!(scale, Scale::LogLog | Scale::LogY) {
+        let r = (y1 / y0).powf(0.04);
+        (y0, y1) = (y0 / r, y1 * r);
+    }
     (x0, x1, y0, y1)
 }
 
