@@ -86,6 +86,8 @@ pub struct Finding {
     pub prior_widened: bool,
     /// The finding in words.
     pub words: String,
+    /// Its first clause: what it is and its value (how `words` begins), for a one-line summary.
+    pub headline: String,
     /// 2Δℓ the extended filter gained in the round that added it, its share when several
     /// terms were added in one round (weighted by their conditional llr).
     pub two_delta_loglik: f64,

@@ -41,7 +41,7 @@ pub use findings::{
     Implausible, TightPrior,
 };
 pub use selection::prior_sigma;
-pub use words::{separation_hint, sig3};
+pub use words::{finding_line, separation_hint, share_percent, sig3, verdict};
 
 use crate::estimate::filter::{self, channel_name, AidingEpoch, FilterConfig, FilterRun};
 use crate::estimate::stats;
@@ -467,7 +467,8 @@ pub fn explain(
             ));
             let t = n.term;
             let info = &common::TERMS[t];
-            f.words = finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+            (f.headline, f.words) =
+                finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         }
     }
     findings.extend(noise_findings);
@@ -1026,6 +1027,7 @@ fn complete_findings(
             prior_sigma: prior,
             prior_widened: widened,
             words: String::new(),
+            headline: String::new(),
             two_delta_loglik: n.two_delta_loglik,
             misfit_share: excess.map(|e| n.nis_removed / e),
             prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
@@ -1075,7 +1077,8 @@ fn complete_findings(
         };
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
         f.suggested_prior = suggested_prior(&f, ctx.opts);
-        f.words = finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+        (f.headline, f.words) =
+            finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         out.push(f);
     }
     Ok(out)
@@ -1321,6 +1324,7 @@ mod tests {
             prior_sigma: 0.0,
             prior_widened: false,
             words: String::new(),
+            headline: String::new(),
             two_delta_loglik: 0.0,
             misfit_share,
             prior_sigmas,
@@ -1475,7 +1479,7 @@ mod tests {
         // 3 × 40 = 120 → 200 ms, beyond the 100 ms tau_x can have: the limit
         f.suggested_prior = suggested_prior(&f, &o);
         assert_eq!(f.suggested_prior, Some(100.0));
-        let w = finding_words(&f, info, 1.0);
+        let (_, w) = finding_words(&f, info, 1.0);
         assert!(
             w.contains("give --prior 'tau_x=100 ms' (a prior that holds it) and run again"),
             "{w}"
@@ -1499,7 +1503,7 @@ mod tests {
         let mut g = f.clone();
         g.stand_in = None;
         assert_eq!(suggested_prior(&g, &o), None);
-        assert!(!finding_words(&g, info, 1.0).contains("--prior"));
+        assert!(!finding_words(&g, info, 1.0).1.contains("--prior"));
     }
 
     #[test]
@@ -1529,16 +1533,21 @@ mod tests {
             prior_sigmas: 900.0,
         }];
         f.separate_by = vec!["two vibration amplitudes separate them".into()];
-        let named = finding_words(&f, info, 1.0);
+        let (_, named) = finding_words(&f, info, 1.0);
         assert!(
             named.contains("named: the one the spec's priors"),
             "{named}"
         );
         f.not_attributed = Some("the priors would choose".into());
-        let w = finding_words(&f, info, 1.0);
+        let (headline, w) = finding_words(&f, info, 1.0);
         assert!(
             !w.contains("named: the one") && w.contains("none named; kas_x stands for the class"),
             "{w}"
+        );
+        // the headline is what the finding is and its value, and the words begin with it
+        assert!(
+            w.starts_with(&headline) && headline.contains("kas_x = ") && !headline.contains(';'),
+            "{headline} / {w}"
         );
     }
 

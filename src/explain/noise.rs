@@ -601,10 +601,11 @@ fn noise_finding(
             sig3(f.two_delta_loglik)
         ),
     };
+    let headline = words.clone();
     let words = match misfit_share {
         Some(s) => format!(
             "{words}; it explains {} % of the baseline's excess misfit",
-            sig3(100.0 * s.max(0.0))
+            super::share_percent(s)
         ),
         None => words,
     };
@@ -637,6 +638,7 @@ fn noise_finding(
         prior_sigma: stated,
         prior_widened: false,
         words,
+        headline,
         two_delta_loglik,
         misfit_share,
         prior_sigmas: 0.0,

@@ -159,11 +159,13 @@ pub(super) fn regressor_in_natural_units(id: usize, mean_si: f64) -> (f64, Strin
     }
 }
 
+/// A term finding in words: (its headline — what it is and its value —, the whole text, which
+/// begins with the headline).
 pub(super) fn finding_words(
     f: &Finding,
     info: &crate::model::catalog::TermInfo,
     prior_display: f64,
-) -> String {
+) -> (String, String) {
     if info.sensor == Sensor::Gnss {
         return gnss_finding_words(f, info);
     }
@@ -180,24 +182,23 @@ pub(super) fn finding_words(
     } else {
         "drift"
     };
+    let headline = format!(
+        "{sensor} {axis} {group} {} = {} ± {} {}",
+        f.term,
+        sig3(f.estimate),
+        sig3(f.sigma),
+        f.unit,
+    );
     let mut s = if crate::model::regressor_reads(info.regressor, &["dw", "df"]) {
         // a regressor of the signals' rates of change averages to nothing over a run: the term
         // acts while the motion changes, not as a constant
         format!(
-            "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): it acts while the motion changes (regressor {reg}), not as a constant {bias}",
-            f.term,
-            sig3(f.estimate),
-            sig3(f.sigma),
-            f.unit,
+            "{headline} (extended filter): it acts while the motion changes (regressor {reg}), not as a constant {bias}"
         )
     } else if f.excited_fraction < 0.9 && f.effect_excited.abs() > 1.5 * f.effect.abs() {
         // a regressor excited over part of the run: its effect there, not diluted by the rest
         format!(
-            "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): where {reg} is excited ({} % of the run) it averages {} {}, and the term acts as a {} {} {bias} along {axis} there ({} {} over the whole run)",
-            f.term,
-            sig3(f.estimate),
-            sig3(f.sigma),
-            f.unit,
+            "{headline} (extended filter): where {reg} is excited ({} % of the run) it averages {} {}, and the term acts as a {} {} {bias} along {axis} there ({} {} over the whole run)",
             sig3(100.0 * f.excited_fraction),
             sig3(f.regressor_excited_mean),
             f.regressor_unit,
@@ -208,11 +209,7 @@ pub(super) fn finding_words(
         )
     } else {
         format!(
-            "{sensor} {axis} {group} {} = {} ± {} {} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {bias} along {axis}",
-            f.term,
-            sig3(f.estimate),
-            sig3(f.sigma),
-            f.unit,
+            "{headline} (extended filter): with the data's mean {reg} of {} {} it acts as a {} {} {bias} along {axis}",
             sig3(f.regressor_mean),
             f.regressor_unit,
             sig3(f.effect),
@@ -268,7 +265,7 @@ pub(super) fn finding_words(
         f,
         ": noise stated too small, an aiding error or a sensor effect outside the library fit sensor terms this way; do not read it as a property of the sensor",
     ));
-    s
+    (headline, s)
 }
 
 /// The tail every term finding's words end with: the share of the misfit it explains and, for a
@@ -278,7 +275,7 @@ fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
     if let Some(share) = f.misfit_share {
         s.push_str(&format!(
             "; it explains {} % of the baseline's excess misfit (2Δℓ {})",
-            sig3(100.0 * share),
+            share_percent(share),
             sig3(f.two_delta_loglik)
         ));
     }
@@ -304,16 +301,16 @@ fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
 
 /// A GNSS term's finding in words: what it is, its value, and the shared tail (class, share
 /// of the misfit, stand-in).
-fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> String {
-    let mut s = format!(
-        "{} {} = {} ± {} {} (extended filter; {})",
+fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> (String, String) {
+    let headline = format!(
+        "{} {} = {} ± {} {}",
         info.group,
         f.term,
         sig3(f.estimate),
         sig3(f.sigma),
         f.unit,
-        info.doc
     );
+    let mut s = format!("{headline} (extended filter; {})", info.doc);
     if !f.equivalent.is_empty() {
         let others: Vec<String> = f
             .equivalent_estimates
@@ -335,7 +332,7 @@ fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> St
         ));
     }
     s.push_str(&share_and_stand_in(f, ""));
-    s
+    (headline, s)
 }
 
 pub(super) fn channel_word(c: &str) -> String {
@@ -425,6 +422,29 @@ pub(super) fn nis_text(v: f64) -> String {
     }
     let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
     format!("{v:.decimals$}")
+}
+
+/// A finding's share of the baseline's excess misfit in percent for the words: none (0) when
+/// its round raised the misfit instead.
+pub fn share_percent(share: f64) -> String {
+    sig3(100.0 * share.max(0.0))
+}
+
+/// A finding's verdict as the summary opens its line: `Found`, `Fitted, but not a cause` (a
+/// stand-in) or `Fitted, not attributed`.
+pub fn verdict(f: &Finding) -> &'static str {
+    if f.stand_in.is_some() {
+        "Fitted, but not a cause"
+    } else if f.not_attributed.is_some() {
+        "Fitted, not attributed"
+    } else {
+        "Found"
+    }
+}
+
+/// A finding's line in the summary: its verdict and its words.
+pub fn finding_line(f: &Finding) -> String {
+    format!("{}: {}.", verdict(f), f.words)
 }
 
 /// A p-value for the words: three significant digits, "< 1e-16" below double precision's
@@ -562,13 +582,7 @@ fn findings_words(e: &Explanation, out: &mut Vec<String>) {
         out.push(line);
     }
     for f in &e.findings {
-        if f.stand_in.is_some() {
-            out.push(format!("Fitted, but not a cause: {}.", f.words));
-        } else if f.not_attributed.is_some() {
-            out.push(format!("Fitted, not attributed: {}.", f.words));
-        } else {
-            out.push(format!("Found: {}.", f.words));
-        }
+        out.push(finding_line(f));
     }
     // every finding a term that is no cause (no noise level either): nothing is added
     if !e.findings.is_empty()

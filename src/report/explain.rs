@@ -166,13 +166,12 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     ));
     s.push_str("## In words\n\n");
     for line in &e.summary {
-        // a finding's line is "Found: WORDS." (or "Fitted, …: WORDS."): its verdict and one sentence
-        let short = e.findings.iter().find_map(|f| {
-            let body = line.strip_suffix('.').unwrap_or(line);
-            body.strip_suffix(f.words.as_str())
-                .filter(|verdict| verdict.ends_with(": "))
-                .map(|verdict| format!("{verdict}{}", short_words(f)))
-        });
+        // a finding's line: its verdict and one sentence (the whole in section 3)
+        let short = e
+            .findings
+            .iter()
+            .find(|f| crate::explain::finding_line(f) == *line)
+            .map(|f| format!("{}: {}", crate::explain::verdict(f), short_words(f)));
         s.push_str(&format!(
             "- {}\n",
             notation(short.as_deref().unwrap_or(line))
@@ -217,29 +216,14 @@ pub fn markdown(e: &Explanation, data: &str, figures: &[(String, String)]) -> St
     s
 }
 
-/// A finding in one sentence for the report's summary: its words up to the value (the rest is
-/// in section 3), the share of the misfit it explains, and whether it is a stand-in.
+/// A finding in one sentence for the report's summary: its headline (the rest is in section 3),
+/// the share of the misfit it explains, and whether it is a stand-in.
 fn short_words(f: &crate::explain::Finding) -> String {
-    let cuts = [
-        " (extended filter",
-        "; the data cannot",
-        ": with the data's",
-        ": where ",
-        "; it explains",
-        ". It probably",
-        ": it acts",
-        ". It is not one level",
-    ];
-    let end = cuts
-        .iter()
-        .filter_map(|c| f.words.find(c))
-        .min()
-        .unwrap_or(f.words.len());
-    let mut s = f.words[..end].trim_end_matches('.').to_string();
+    let mut s = f.headline.clone();
     if let Some(x) = f.misfit_share {
         s.push_str(&format!(
             "; explains {} % of the baseline's excess misfit",
-            sig3(100.0 * x)
+            crate::explain::share_percent(x)
         ));
     }
     if f.stand_in.is_some() {
@@ -302,7 +286,13 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
         };
         let share = f
             .misfit_share
-            .map(|x| format!("{} % (2Δℓ {})", sig3(100.0 * x), sig3(f.two_delta_loglik)))
+            .map(|x| {
+                format!(
+                    "{} % (2Δℓ {})",
+                    crate::explain::share_percent(x),
+                    sig3(f.two_delta_loglik)
+                )
+            })
             .unwrap_or_else(|| format!("— (2Δℓ {})", sig3(f.two_delta_loglik)));
         s.push_str(&format!(
             "| {} | {} | {value} | {share} | {verdict} |\n",
@@ -521,7 +511,7 @@ fn candidate_note(e: &Explanation, c: &crate::explain::CandidateTest) -> String 
         } else {
             let named: Vec<&str> = e.findings.iter().map(|f| f.term.as_str()).collect();
             format!(
-                "significant alone, but not once {} in the model: they take up its signature",
+                "significant alone, but not once {} fitted beside it: they take up its signature",
                 if named.len() == 1 {
                     format!("{} is", named[0])
                 } else {
@@ -549,7 +539,12 @@ fn findings_section(e: &Explanation, s: &mut String) {
         };
         let share = f
             .misfit_share
-            .map(|x| format!("; explains {} % of the excess misfit", sig3(100.0 * x)))
+            .map(|x| {
+                format!(
+                    "; explains {} % of the excess misfit",
+                    crate::explain::share_percent(x)
+                )
+            })
             .unwrap_or_default();
         s.push_str(&format!(
             "- **{}** = {} ± {} {}: {verdict}{share} (llr {:.1}, p {}; round {}).\n\n  <details><summary>In full</summary>{}</details>\n\n",
