@@ -228,7 +228,11 @@ fn navigate_takes_init_and_nav_rate_as_filter_does() {
         "--out",
         p(&dir.path().join("x.txt")),
     ]);
-    assert!(!ok && err.contains("--init: attitude"), "{err}");
+    // the same check and words as filter's --init
+    assert!(
+        !ok && err.contains("--init: pitch = 95 is outside [-90, 90] deg"),
+        "{err}"
+    );
     let (ok, _, err) = sinsmodel(&[
         "navigate",
         "--imu",

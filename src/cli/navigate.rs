@@ -177,23 +177,10 @@ fn initial(args: &NavigateArgs) -> Result<Initial> {
 /// `--init LAT,LON,H,ROLL,PITCH,YAW[,VN,VE,VD]` as filter and explain take it (no `auto`:
 /// navigate has no GNSS to head by).
 fn from_init(text: &str) -> Result<Initial> {
-    let expected = "expected lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (numbers, deg, m, deg, m/s)";
     if text.trim() == "auto" {
-        bail!("--init auto: navigate has no aiding to start from; {expected}, e.g. the attitude from `sinsmodel align`");
+        bail!("--init auto: navigate has no aiding to start from; expected lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (numbers, deg, m, deg, m/s), e.g. the attitude from `sinsmodel align`");
     }
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| {
-            anyhow::anyhow!("--init `{}`: {expected}", sinsmodel::io::lines::shown(text))
-        })?;
-    if v.len() != 6 && v.len() != 9 {
-        bail!(
-            "--init takes lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (6 or 9 numbers), got {}",
-            v.len()
-        );
-    }
+    let v = sinsmodel::data::init_numbers(text)?;
     Ok(Initial {
         lat: v[0],
         lon: v[1],

@@ -8,6 +8,7 @@ pub mod dataset;
 pub mod options;
 pub mod setup;
 mod start;
+pub use start::init_numbers;
 
 pub use aid::{AidPlan, Outage};
 pub use dataset::{check_inside, Dataset, PassInputs, DEFAULT_STEP_S};

@@ -36,8 +36,19 @@ const INIT_RANGES: [(&str, f64, f64, &str); 9] = [
     ("vd", -1000.0, 1000.0, "m/s"),
 ];
 
-/// The navigation state of `--init` values `v` at time `t0` [s], each checked.
-fn state_from_values(v: &[f64], t0: f64) -> Result<NavState> {
+/// The numbers of an `--init` text `lat,lon,h,roll,pitch,yaw[,vn,ve,vd]` (deg, m, deg, m/s),
+/// each inside its physical range and the latitude off the poles; `auto` is not numbers.
+pub fn init_numbers(text: &str) -> Result<Vec<f64>> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| {
+            anyhow::anyhow!(
+                "--init `{}`: expected auto or lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (numbers, deg, m, m/s)",
+                crate::io::lines::shown(text)
+            )
+        })?;
     if v.len() != 6 && v.len() != 9 {
         bail!(
             "--init takes lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (6 or 9 numbers), got {}",
@@ -55,9 +66,14 @@ fn state_from_values(v: &[f64], t0: f64) -> Result<NavState> {
             v[0]
         );
     }
+    Ok(v)
+}
+
+/// The navigation state of checked `--init` numbers `v` ([`init_numbers`]) at time `t0` [s].
+fn state_from_values(v: &[f64], t0: f64) -> NavState {
     let d = std::f64::consts::PI / 180.0;
     let c = dcm_from_euler(v[3] * d, v[4] * d, v[5] * d);
-    Ok(NavState {
+    NavState {
         t: t0,
         lat: v[0] * d,
         lon: v[1] * d,
@@ -68,7 +84,7 @@ fn state_from_values(v: &[f64], t0: f64) -> Result<NavState> {
             Vector3::zeros()
         },
         q: UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c)),
-    })
+    }
 }
 
 /// The truth row at the start of the first sample's interval: t0 on a uniform clock; on a
@@ -116,22 +132,12 @@ fn state_from_truth(
 }
 
 impl DataOptions {
-    /// The numbers of `--init` (None for `auto` or none given).
+    /// The numbers of `--init` (None for `auto` or none given), checked.
     fn init_values(&self) -> Result<Option<Vec<f64>>> {
-        Ok(match self.init.as_deref() {
-            None | Some("auto") => None,
-            Some(text) => Some(
-                text.split(',')
-                    .map(|x| x.trim().parse::<f64>())
-                    .collect::<std::result::Result<_, _>>()
-                    .map_err(|_| {
-                        anyhow::anyhow!(
-                            "--init `{}`: expected auto or lat,lon,h,roll,pitch,yaw[,vn,ve,vd] (numbers, deg, m, m/s)",
-                            crate::io::lines::shown(text)
-                        )
-                    })?,
-            ),
-        })
+        match self.init.as_deref() {
+            None | Some("auto") => Ok(None),
+            Some(text) => init_numbers(text).map(Some),
+        }
     }
 
     /// True with `--init auto`.
@@ -181,7 +187,7 @@ impl DataOptions {
             });
         }
         let state = match (&init_values, truth_reader) {
-            (Some(v), _) => state_from_values(v, t0)?,
+            (Some(v), _) => state_from_values(v, t0),
             (None, Some(tr)) => {
                 let p = self.truth.as_ref().expect("a truth reader has a path");
                 state_from_truth(tr, p, imu, t0)?
