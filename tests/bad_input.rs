@@ -632,3 +632,103 @@ fn imu_unit_and_clock_slips_are_refused_with_their_cause() {
     let (ok, err) = navigate(&o.join("imu.txt"), &d.join("nav.txt"));
     assert!(ok && !err.contains("warning"), "{err}");
 }
+
+/// A slip the first 10 s cannot show (they are disturbed, not at rest) is found where the data
+/// first come to rest, and a specific force no vehicle averages anywhere in the run: the run
+/// stops (filter, explain) or warns (navigate, for the gyros), naming the stretch; the same
+/// disturbed data in the right units run without a word.
+#[test]
+fn imu_slips_after_the_first_seconds_are_found_where_the_data_show_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let o = d.join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(o.join("imu.txt")).unwrap();
+    // the first 20 s shaken (±2 m/s² alternating on x: the mean stays, the spread is 2 m/s²)
+    let rewrite = |name: &str, f: &dyn Fn(&mut [f64])| {
+        let mut out = String::new();
+        for (k, l) in text.lines().enumerate() {
+            if l.starts_with('#') {
+                out.push_str(l);
+            } else {
+                let mut v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                if v[0] < 20.0 {
+                    v[4] += if k % 2 == 0 { 0.02 } else { -0.02 };
+                }
+                f(&mut v);
+                let w: Vec<String> = v.iter().map(|x| format!("{x:.15e}")).collect();
+                out.push_str(&w.join(" "));
+            }
+            out.push('\n');
+        }
+        let p = d.join(name);
+        std::fs::write(&p, out).unwrap();
+        p
+    };
+    let deg = 180.0 / std::f64::consts::PI;
+    let shaken = rewrite("shaken.txt", &|_| {});
+    let dps = rewrite("dps.txt", &|v| v[1..4].iter_mut().for_each(|x| *x *= deg));
+    let g_late = rewrite("g_late.txt", &|v| {
+        if v[0] > 15.0 {
+            v[4..7].iter_mut().for_each(|x| *x /= 9.80665);
+        }
+    });
+    let gnss = o.join("gnss.txt");
+    let filter = |imu: &Path, out: &str| {
+        run(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--aid",
+            gnss.to_str().unwrap(),
+            "--init",
+            "30,110,0,0,0,0",
+            "--out",
+            d.join(out).to_str().unwrap(),
+        ])
+    };
+    let (ok, err) = filter(&shaken, "f0");
+    assert!(ok && !err.contains("warning"), "{err}");
+    let (ok, err) = navigate(&shaken, &d.join("nav0.txt"));
+    assert!(ok && !err.contains("warning"), "{err}");
+
+    let (ok, err) = filter(&dps, "f1");
+    assert!(
+        !ok && err.contains("deg/s read as rad/s")
+            && err.contains("after the first 10 s")
+            && err.contains("dps.txt"),
+        "{err}"
+    );
+    assert!(!d.join("f1").exists(), "a refused run left its output");
+    let (ok, err) = navigate(&dps, &d.join("nav1.txt"));
+    assert!(
+        ok && err.contains("deg/s read as rad/s") && err.contains("MEMS"),
+        "{err}"
+    );
+
+    let (ok, err) = filter(&g_late, "f2");
+    assert!(
+        !ok && err.contains("look like g read as m/s²") && err.contains("after the first 10 s"),
+        "{err}"
+    );
+    let (ok, err) = navigate(&g_late, &d.join("nav2.txt"));
+    assert!(!ok && err.contains("g read as m/s²"), "{err}");
+    assert!(
+        !d.join("nav2.txt").exists(),
+        "a refused navigate wrote its output"
+    );
+}

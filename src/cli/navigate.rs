@@ -84,7 +84,7 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     if args.in_memory {
         data = data.into_memory()?;
     }
-    check_start(args, &init, &data)?;
+    check_start(args, &init, &mut data)?;
     let t0 = data.start_time();
     let start = free_inertial::start_state(t0, init.lat, init.lon, init.h, init.att, init.vel);
     let mut clock = RowClock::new(t0, Some(args.nav_rate), data.interval());
@@ -233,7 +233,7 @@ fn check_initial(i: &Initial) -> Result<()> {
 /// The plausibility imu-check applies, on the first 10 s: warns (a start that moves or a tilted
 /// mounting are legitimate here); a unit, scale or clock slip, or an --att that contradicts the
 /// measured gravity, stops the run unless --force.
-fn check_start(args: &NavigateArgs, init: &Initial, data: &ImuStream) -> Result<()> {
+fn check_start(args: &NavigateArgs, init: &Initial, data: &mut ImuStream) -> Result<()> {
     let head = ImuData {
         samples: data.head().to_vec(),
     };
@@ -261,6 +261,14 @@ fn check_start(args: &NavigateArgs, init: &Initial, data: &ImuStream) -> Result<
             bail!("{}: {p}", init.att_option);
         }
     }
+    // the rest of the run, a window at a time as it is read (gyro slips are warnings, as above)
+    use sinsmodel::estimate::imu_check::{window_check, WindowJudge};
+    data.judge_windows(window_check(
+        WindowJudge::new(init.lat.to_radians(), &check.head, true),
+        data.name().to_string(),
+        args.force,
+        "or an uncalibrated MEMS gyro's bias",
+    ));
     Ok(())
 }
 

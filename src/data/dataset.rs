@@ -116,7 +116,7 @@ impl DataOptions {
                 if self.init_auto() { ", where --init auto found its start" } else { "" }
             );
         }
-        self.check_head(&imu, &start.state, note)?;
+        self.check_head(&mut imu, &start.state, note)?;
         check_plan_at_start(&plan, &start.state)?;
         Ok(Dataset {
             imu,
@@ -135,7 +135,7 @@ impl DataOptions {
     /// plausible-looking nonsense downstream), and the start's roll and pitch against gravity.
     fn check_head(
         &self,
-        imu: &ImuStream,
+        imu: &mut ImuStream,
         start: &NavState,
         note: &mut dyn FnMut(&str),
     ) -> Result<()> {
@@ -181,6 +181,14 @@ impl DataOptions {
                 bail!("{}{p}", if self.init.is_some() { "--init: " } else { "" });
             }
         }
+        // the rest of the run, a window at a time as it is read
+        use crate::estimate::imu_check::{window_check, WindowJudge};
+        imu.judge_windows(window_check(
+            WindowJudge::new(start.lat, &check, mems),
+            imu_path.display().to_string(),
+            self.force,
+            "or a MEMS gyro's bias: --grade mems given",
+        ));
         Ok(())
     }
 

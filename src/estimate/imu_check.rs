@@ -366,13 +366,15 @@ impl Said {
 
 /// What the first seconds of a log say before free-inertial navigation (`navigate`): warnings,
 /// and the unit, scale or clock slip that stops it.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct StartCheck {
     /// The problems that are only warnings here (a start that moves or a tilted mounting are
     /// legitimate), a gyro unit problem with the MEMS-bias alternative said.
     pub warnings: Vec<String>,
     /// The first problem only a unit, scale or clock slip explains.
     pub unit_problem: Option<String>,
+    /// The whole check of the first seconds.
+    pub head: ImuCheck,
 }
 
 /// Checks the first 10 s `head` as `imu-check` does (a tilted mounting accepted), `lat` [rad]
@@ -394,6 +396,7 @@ pub fn start_check(head: &ImuData, lat: f64) -> StartCheck {
     StartCheck {
         warnings,
         unit_problem: check.unit_problems.first().cloned(),
+        head: check,
     }
 }
 
@@ -426,4 +429,89 @@ fn unit_hint(k: f64) -> String {
     .find(|(r, _)| k.is_finite() && (k / r - 1.0).abs() < 0.05)
     .map(|(_, h)| format!("; {h}"))
     .unwrap_or_default()
+}
+
+/// Judges the IMU's data after its first seconds, a window of [`crate::io::imu_stream::HEAD_SECONDS`]
+/// at a time as the stream hands them out, for the slips the first seconds could not show: a
+/// mean specific force no vehicle averages (0.5–2 g, any window), and — when the first seconds
+/// were not at rest — the first window at rest against gravity and Earth rate.
+#[derive(Debug, Clone)]
+pub struct WindowJudge {
+    /// Latitude for local gravity [rad].
+    lat: f64,
+    /// A window at rest has been judged already (the first seconds, or a later one).
+    rest_judged: bool,
+    /// Gyro unit problems are warnings (a MEMS gyro's bias can give them).
+    gyro_warn_only: bool,
+}
+
+impl WindowJudge {
+    /// A judge for a run at latitude `lat` [rad] whose first seconds were `head` (their check);
+    /// `gyro_warn_only` with a MEMS grade.
+    pub fn new(lat: f64, head: &ImuCheck, gyro_warn_only: bool) -> WindowJudge {
+        WindowJudge {
+            lat,
+            rest_judged: head.is_static,
+            gyro_warn_only,
+        }
+    }
+
+    /// The unit, scale or clock slip `window` (consecutive samples, FRD increments) shows, in
+    /// words that begin with its time span ("at 20.0–30.0 s: …"), and whether it is only a
+    /// warning; None when it shows none.
+    pub fn judge(&mut self, window: &[crate::io::imu::ImuSample]) -> Option<(String, bool)> {
+        if window.len() < 12 {
+            return None;
+        }
+        let data = ImuData {
+            samples: window.to_vec(),
+        };
+        let (t0, t1) = (window[0].t, window[window.len() - 1].t);
+        let m = Seen::of(&data, Some(self.lat), t0, t1 - t0);
+        let mut said = Said::default();
+        if !m.is_static {
+            said.moving(&m);
+        } else if !self.rest_judged {
+            self.rest_judged = true;
+            said.at_rest(&m, true);
+        } else if !(0.5..2.0).contains(&m.gravity_ratio) {
+            // at rest again: only what no calibration error explains
+            said.moving(&m);
+        }
+        let at = |p: &String| format!("at {t0:.1}–{t1:.1} s: {p}");
+        if let Some(p) = said.unit_problems.first() {
+            return Some((at(p), false));
+        }
+        said.gyro_unit_problems
+            .first()
+            .map(|p| (at(p), self.gyro_warn_only))
+    }
+}
+
+/// The stream's check of each window after the head with `judge`: a slip ends the run with an
+/// error naming the IMU file `name` and the window, unless `force` (then, like a warning-only
+/// gyro problem, it is said once on stderr, `why_warn` telling why it is only a warning).
+pub fn window_check(
+    mut judge: WindowJudge,
+    name: String,
+    force: bool,
+    why_warn: &'static str,
+) -> crate::io::imu_stream::WindowCheck {
+    let mut warned = false;
+    Box::new(move |w| {
+        match judge.judge(w) {
+        Some((p, warn_only)) if warn_only || force => {
+            if !warned {
+                warned = true;
+                let why = if force { "--force given" } else { why_warn };
+                eprintln!("warning: --imu {name}: {p} ({why})");
+            }
+            Ok(())
+        }
+        Some((p, _)) => anyhow::bail!(
+            "--imu {name}: {p} (after the first 10 s: `sinsmodel imu-check --skip S` shows that stretch; --force runs anyway)"
+        ),
+        None => Ok(()),
+    }
+    })
 }

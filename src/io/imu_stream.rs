@@ -80,7 +80,15 @@ pub struct ImuStream {
     last_t: f64,
     /// A sample read by [`ImuStream::skip_through`] past its time, handed out next.
     pending: Option<ImuSample>,
+    /// Judges each window of [`HEAD_SECONDS`] after the head ([`ImuStream::judge_windows`]).
+    judge: Option<WindowCheck>,
+    /// The samples after the head not yet judged.
+    window: Vec<ImuSample>,
 }
+
+/// A check of the samples of one window after the head (consecutive, in time order); its error
+/// ends the stream.
+pub type WindowCheck = Box<dyn FnMut(&[ImuSample]) -> Result<()>>;
 
 impl ImuStream {
     /// A stream over `src`; `name` is the file's name in messages. Reads the head ahead and
@@ -150,6 +158,8 @@ impl ImuStream {
             delivered: 0,
             last_t: f64::NAN,
             pending: None,
+            judge: None,
+            window: Vec::new(),
         };
         // validate the head in order, as every later sample will be (prev_t then stands at the
         // last head sample, where the samples after the head continue)
@@ -337,14 +347,40 @@ impl ImuStream {
             s
         } else {
             let Some((s, line)) = self.src.next_sample()? else {
+                self.judge_window()?;
                 return Ok(None);
             };
             self.check(&s, line, self.delivered + 1)?;
+            if self.judge.is_some() {
+                self.window.push(s);
+                let span = s.t - self.window[0].t;
+                if span >= HEAD_SECONDS && self.window.len() >= HEAD_MIN_SAMPLES {
+                    self.judge_window()?;
+                }
+            }
             s
         };
         self.delivered += 1;
         self.last_t = s.t;
         Ok(Some(s))
+    }
+
+    /// Has `check` judge every window of [`HEAD_SECONDS`] read after the head (the head is judged
+    /// where the stream is opened), and the last, shorter one at the end of the file.
+    pub fn judge_windows(&mut self, check: WindowCheck) {
+        self.judge = Some(check);
+    }
+
+    /// Judges the samples collected since the last window and forgets them.
+    fn judge_window(&mut self) -> Result<()> {
+        if let Some(judge) = self.judge.as_mut() {
+            if !self.window.is_empty() {
+                let r = judge(&self.window);
+                self.window.clear();
+                r?;
+            }
+        }
+        Ok(())
     }
 
     /// Reads and drops the samples whose time is at or before `t` [s] (a run that starts at
