@@ -236,3 +236,65 @@ fn a_given_latitude_the_data_contradict_is_refused() {
         assert!(e.contains("--lat") && e.contains("σ away"), "{e}");
     }
 }
+
+/// A drive-off (60 s at rest, then 30 s at a constant 0.8 m/s², which passes every test inside
+/// a 10-s window) is not taken as rest: on the whole log the alignment uses the first 60 s
+/// and finds the heading and zero gyro biases within their σ; from 10 s on, too little rest is
+/// left and the refusal says the mean specific force moved between windows.
+#[test]
+fn a_drive_off_is_not_taken_as_rest() {
+    let sc = Scenario::parse(
+        "name = \"off\"\nimu_rate_hz = 100.0\nseed = 3\n[start]\nlat_deg = 28.22\nlon_deg = 112.99\nh_m = 50.0\n\
+         euler_deg = [0.5, -0.3, 30.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n[[segment]]\n\
+         kind = \"accelerate\"\nduration_s = 30.0\naccel_mps2 = 0.8\n[noise]\narw = \"0.005 deg/sqrt(h)\"\n\
+         vrw = \"10 ug/sqrt(Hz)\"\n",
+        "align",
+    )
+    .unwrap();
+    let sim = simulate(&sc, |_| {});
+    let a = align(
+        &sim.imu,
+        Some(28.22 * D),
+        None,
+        112.99 * D,
+        50.0,
+        0.01 * D / 3600.0,
+    )
+    .unwrap();
+    let (hd, hs) = (a.heading_deg.unwrap(), a.heading_sigma_deg.unwrap());
+    assert!((hd - 30.0).abs() < 3.0 * hs, "heading {hd} ± {hs}");
+    assert!(
+        (a.roll_deg - 0.5).abs() < 0.02 && (a.pitch_deg + 0.3).abs() < 0.02,
+        "{a:?}"
+    );
+    for k in 0..3 {
+        let (b, s) = (a.gyro_bias_deg_h[k], a.gyro_bias_sigma_deg_h[k]);
+        assert!(
+            s > 0.0 && b.abs() < 3.0 * s,
+            "gyro bias {k}: {b} ± {s} deg/h"
+        );
+    }
+    let late = sinsmodel::io::imu::ImuData {
+        samples: sim
+            .imu
+            .samples
+            .iter()
+            .filter(|s| s.t > 10.0)
+            .copied()
+            .collect(),
+    };
+    let e = align(
+        &late,
+        Some(28.22 * D),
+        None,
+        112.99 * D,
+        50.0,
+        0.01 * D / 3600.0,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("not at rest long enough") && e.contains("moved by up to 0.8"),
+        "{e}"
+    );
+}

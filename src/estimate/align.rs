@@ -85,6 +85,13 @@ pub const STATIC_W_SPREAD: f64 = 0.1 * std::f64::consts::PI / 180.0;
 /// At rest: the mean |f| is within this of local gravity [m/s²] (0.05 g: room for a MEMS
 /// accelerometer's bias and scale).
 pub const STATIC_G_ERROR: f64 = 0.05 * 9.80665;
+/// At rest: a window's mean specific force stays within this of the first window's of the
+/// same stretch [m/s²] (10 mg, a tilt of 0.6°: a constant acceleration passes the spread tests
+/// inside each window but not this one).
+pub const STATIC_F_STEP: f64 = 0.1;
+/// Largest zero-velocity innovation the fine alignment accepts [m/s] (its updates are 1 s apart:
+/// 0.3 m/s is a 1.7° tilt error's drift, which the coarse levelling is far below at rest).
+pub const ZUPT_INNOVATION_MAX: f64 = 0.3;
 
 /// What one window of data says about being at rest.
 #[derive(Debug, Clone, Copy)]
@@ -95,6 +102,8 @@ pub struct RestEvidence {
     pub w_spread: f64,
     /// |mean f| − local gravity [m/s²].
     pub g_error: f64,
+    /// Mean specific force of the window, body frame [m/s²].
+    pub f_mean: Vector3<f64>,
 }
 
 impl RestEvidence {
@@ -128,6 +137,7 @@ pub fn rest_evidence(data: &ImuData, win: usize, g: f64) -> Vec<RestEvidence> {
                 f_spread: rms(means.iter().map(|m| (m.0 - fm).norm()).collect()),
                 w_spread: rms(means.iter().map(|m| (m.1 - wm).norm()).collect()),
                 g_error: fm.norm() - g,
+                f_mean: fm,
             }
         })
         .collect()
@@ -212,6 +222,8 @@ pub struct Alignment {
     pub coarse_lat_deg: Option<f64>,
     /// Estimated gyro biases after fine alignment [deg/h].
     pub gyro_bias_deg_h: [f64; 3],
+    /// Their 1-σ from the fine alignment [deg/h].
+    pub gyro_bias_sigma_deg_h: [f64; 3],
 }
 
 /// Aligns static data: skips a disturbed start, uses at most `seconds` of the rest; latitude
@@ -242,7 +254,7 @@ pub fn align(
     let north = north_seen(&c, lat, lat_used, gyro_bias_sigma);
     let (bias_sigma, no_heading) = (north.bias_sigma, north.no_heading);
     let fine = fine_align(used, dt, &c, lat_used, lon, h, bias_sigma)?;
-    let (e, eps) = (fine.euler, fine.eps_deg_h);
+    let (e, eps, eps_sigma) = (fine.euler, fine.eps_deg_h, fine.eps_sigma_deg_h);
     let deg = 180.0 / std::f64::consts::PI;
     let deg_h = 180.0 / std::f64::consts::PI * 3600.0;
     Ok(Alignment {
@@ -271,23 +283,31 @@ pub fn align(
         },
         coarse_lat_deg: (!no_heading).then_some(c.lat * deg),
         gyro_bias_deg_h: [eps[0], eps[1], eps[2]],
+        gyro_bias_sigma_deg_h: [eps_sigma[0], eps_sigma[1], eps_sigma[2]],
     })
 }
 
-/// The first and end window index of the longest run of `true` in `rest` ((0, 0) when none).
-fn longest_run(rest: &[bool]) -> (usize, usize) {
-    let (mut best, mut run_start) = ((0usize, 0usize), None);
-    for (k, r) in rest.iter().chain(std::iter::once(&false)).enumerate() {
-        match (r, run_start) {
-            (true, None) => run_start = Some(k),
-            (false, Some(s0)) => {
-                if k - s0 > best.1 - best.0 {
-                    best = (s0, k);
-                }
-                run_start = None;
+/// The first and end window index of the longest run of windows at rest whose mean specific
+/// force stays within [`STATIC_F_STEP`] of the run's first window ((0, 0) when none).
+fn longest_run(evidence: &[RestEvidence]) -> (usize, usize) {
+    let (mut best, mut run_start): ((usize, usize), Option<usize>) = ((0, 0), None);
+    for k in 0..=evidence.len() {
+        let e = evidence.get(k);
+        let continues = match (e, run_start) {
+            (Some(e), Some(s0)) => {
+                e.at_rest() && (e.f_mean - evidence[s0].f_mean).norm() <= STATIC_F_STEP
             }
-            _ => {}
+            _ => false,
+        };
+        if continues {
+            continue;
         }
+        if let Some(s0) = run_start {
+            if k - s0 > best.1 - best.0 {
+                best = (s0, k);
+            }
+        }
+        run_start = e.filter(|e| e.at_rest()).map(|_| k);
     }
     best
 }
@@ -308,8 +328,7 @@ fn samples_at_rest(
     let g_local = crate::nav::earth::gravity(lat.unwrap_or(45f64.to_radians()), h);
     let (w10, disturbed) = disturbed_windows(data, 10.0);
     let evidence = rest_evidence(data, w10, g_local);
-    let rest: Vec<bool> = evidence.iter().map(|e| e.at_rest()).collect();
-    let best = longest_run(&rest);
+    let best = longest_run(&evidence);
     // from the sample times: on a jittered clock a window of w10 samples is not 10 s
     let rest_s = if best.1 > best.0 {
         let (a, b) = (best.0 * w10, (best.1 * w10).min(data.samples.len()) - 1);
@@ -324,7 +343,9 @@ fn samples_at_rest(
         anyhow::bail!(
             "the data are not at rest long enough to align: the longest stretch at rest is {rest_s:.0} s of {:.0} s, 60 s are needed. \
              In the {} of {} ten-second windows judged moving: specific-force spread up to {:.3} m/s^2 (at rest <= {STATIC_F_SPREAD}), \
-             angular-rate spread up to {:.3} deg/s (at rest <= {:.2}), | |f| - g | up to {:.3} m/s^2 (at rest <= {:.2}). \
+             angular-rate spread up to {:.3} deg/s (at rest <= {:.2}), | |f| - g | up to {:.3} m/s^2 (at rest <= {:.2}); \
+             and a stretch ends where a window's mean specific force moves more than {STATIC_F_STEP} m/s^2 from its first window's \
+             (a constant acceleration, a drive-off, passes the tests inside each window): between windows it moved by up to {:.3} m/s^2. \
              Give the attitude instead: --init for filter, explain and navigate (or navigate's --att) (from a known mounting, or a GNSS course once moving)",
             data.duration(),
             moving.len(),
@@ -333,7 +354,11 @@ fn samples_at_rest(
             worst(&|e| e.w_spread).to_degrees(),
             STATIC_W_SPREAD.to_degrees(),
             worst(&|e| e.g_error.abs()),
-            STATIC_G_ERROR
+            STATIC_G_ERROR,
+            evidence
+                .windows(2)
+                .map(|w| (w[1].f_mean - w[0].f_mean).norm())
+                .fold(0.0, f64::max)
         );
     }
     // inside it, a disturbed start (a touch, a door: at rest by the thresholds but unlike the
@@ -346,7 +371,7 @@ fn samples_at_rest(
         .unwrap_or(best.0);
     let q0 = first * w10;
     // a run that reaches the last whole window keeps the samples after it too
-    let end = if best.1 == rest.len() {
+    let end = if best.1 == evidence.len() {
         data.samples.len()
     } else {
         best.1 * w10
@@ -494,6 +519,8 @@ struct Fine {
     heading_sigma: f64,
     /// Estimated gyro biases [deg/h].
     eps_deg_h: Vec<f64>,
+    /// Their 1-σ [deg/h].
+    eps_sigma_deg_h: Vec<f64>,
 }
 
 /// Fine alignment of `used` (sample period `dt` [s]) from the coarse one `c`: P13, closed
@@ -545,6 +572,21 @@ fn fine_align(
         .collect();
     let imu = ImuData { samples: used };
     let run = filter::run(&model, &cfg, &imu, start, &aid, None, |_| {});
+    // at rest the velocity cannot drift far in the second between updates: one that does
+    // says the data move (a drive-off the rest tests let through)
+    if let Some(nu) = run
+        .innovations
+        .iter()
+        .filter(|i| i.meas.starts_with("vel"))
+        .find(|i| i.nu.abs() > ZUPT_INNOVATION_MAX)
+    {
+        anyhow::bail!(
+            "the data move during the stretch taken as at rest: the fine alignment's zero-velocity update at {:.1} s after its start \
+             finds a velocity of {:.3} m/s (at rest <= {ZUPT_INNOVATION_MAX} m/s within 1 s); --skip and --seconds choose a stretch at rest",
+            nu.t - t0,
+            nu.nu.abs()
+        );
+    }
     let e = run.final_state.euler();
     let last = run
         .records
@@ -552,13 +594,17 @@ fn fine_align(
         .ok_or_else(|| anyhow::anyhow!("no filter update"))?;
     let i_phid = model.index_of("phi_d").expect("P13 has phi_d");
     let deg = 180.0 / std::f64::consts::PI;
-    let eps: Vec<f64> = ["eps_x", "eps_y", "eps_z"]
-        .iter()
-        .map(|n| last.x[model.index_of(n).expect("P13 eps")] * deg * 3600.0)
-        .collect();
+    let of = |v: &[f64]| -> Vec<f64> {
+        ["eps_x", "eps_y", "eps_z"]
+            .iter()
+            .map(|n| v[model.index_of(n).expect("P13 eps")] * deg * 3600.0)
+            .collect()
+    };
+    let (eps, eps_sigma) = (of(&last.x), of(&last.sigma));
     Ok(Fine {
         euler: e,
         heading_sigma: last.sigma[i_phid],
         eps_deg_h: eps,
+        eps_sigma_deg_h: eps_sigma,
     })
 }

@@ -37,9 +37,17 @@ pub fn lines(a: &Alignment, lat_given: bool) -> Vec<String> {
             a.heading_windows_deg.len()
         ));
     }
+    let b = |k: usize| {
+        format!(
+            "{:.4} ± {:.4}",
+            a.gyro_bias_deg_h[k], a.gyro_bias_sigma_deg_h[k]
+        )
+    };
     v.push(format!(
-        "gyro bias estimates [deg/h]: {:.4} {:.4} {:.4}",
-        a.gyro_bias_deg_h[0], a.gyro_bias_deg_h[1], a.gyro_bias_deg_h[2]
+        "gyro bias estimates x y z [deg/h], with 1-σ from the fine alignment: {}, {}, {}",
+        b(0),
+        b(1),
+        b(2)
     ));
     v
 }
