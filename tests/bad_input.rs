@@ -732,3 +732,69 @@ fn imu_slips_after_the_first_seconds_are_found_where_the_data_show_them() {
         "a refused navigate wrote its output"
     );
 }
+
+/// `--zupt` and `--static-aid` say the whole run is at rest: on data that drive off they are
+/// refused where the IMU first moves (the filter had run with NIS of 1e5 and blamed the model);
+/// on data at rest they run.
+#[test]
+fn a_claim_of_rest_on_data_that_move_is_refused_where_they_move() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 25.0\n\
+         [[segment]]\nkind = \"accelerate\"\nduration_s = 20.0\naccel_mps2 = 1.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let o = d.join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let imu = o.join("imu.txt");
+    let filter = |extra: &[&str], out: &str| {
+        let out = d.join(out);
+        let mut a = vec![
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--init",
+            "30,110,0,0,0,0",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let gnss = o.join("gnss.txt");
+    let (ok, err) = filter(
+        &[
+            "--aid",
+            gnss.to_str().unwrap(),
+            "--aid-use",
+            "pos",
+            "--zupt",
+            "0.01",
+        ],
+        "z",
+    );
+    assert!(
+        !ok && err.contains("--zupt says the vehicle does not move")
+            && err.contains("accelerates at 20.0–30.0 s without turning"),
+        "{err}"
+    );
+    let (ok, err) = filter(&["--static-aid", "30,110,0"], "s");
+    assert!(
+        !ok && err.contains("--static-aid says the vehicle does not move"),
+        "{err}"
+    );
+    // the GNSS fixes alone run
+    let (ok, err) = filter(&["--aid", gnss.to_str().unwrap()], "g");
+    assert!(ok, "{err}");
+}

@@ -183,8 +183,24 @@ impl DataOptions {
         }
         // the rest of the run, a window at a time as it is read
         use crate::estimate::imu_check::{window_check, WindowJudge};
+        let mut judge = WindowJudge::new(start.lat, &check, mems);
+        let claim = if self.static_aid.is_some() {
+            Some("--static-aid")
+        } else {
+            self.zupt.map(|_| "--zupt")
+        };
+        if let Some(p) = claim.and_then(|o| judge.claim_rest(o, imu.head())) {
+            if self.force {
+                note(&format!(
+                    "warning: --imu {}: {p} (--force given)",
+                    imu_path.display()
+                ));
+            } else {
+                bail!("--imu {}: {p} (--force runs anyway)", imu_path.display());
+            }
+        }
         imu.judge_windows(window_check(
-            WindowJudge::new(start.lat, &check, mems),
+            judge,
             imu_path.display().to_string(),
             self.force,
             "or a MEMS gyro's bias: --grade mems given",

@@ -104,6 +104,8 @@ pub struct RestEvidence {
     pub g_error: f64,
     /// Mean specific force of the window, body frame [m/s²].
     pub f_mean: Vector3<f64>,
+    /// Mean angular rate of the window, body frame [rad/s].
+    pub w_mean: Vector3<f64>,
 }
 
 impl RestEvidence {
@@ -138,6 +140,7 @@ pub fn rest_evidence(data: &ImuData, win: usize, g: f64) -> Vec<RestEvidence> {
                 w_spread: rms(means.iter().map(|m| (m.1 - wm).norm()).collect()),
                 g_error: fm.norm() - g,
                 f_mean: fm,
+                w_mean: wm,
             }
         })
         .collect()

@@ -443,6 +443,78 @@ pub struct WindowJudge {
     rest_judged: bool,
     /// Gyro unit problems are warnings (a MEMS gyro's bias can give them).
     gyro_warn_only: bool,
+    /// What `--zupt` or `--static-aid` holds the windows to.
+    rest_claim: Option<RestClaim>,
+    /// Time of the run's first sample [s] (times are said from it).
+    t_first: f64,
+}
+
+/// The stretch `t0`–`t1` [s] of a run whose first sample is at `t_first` [s], in words: on the
+/// data's clock when that starts near 0, else from the first sample and on the data's clock.
+pub fn span_words(t0: f64, t1: f64, t_first: f64) -> String {
+    let rel = format!("{:.1}–{:.1} s", t0 - t_first, t1 - t_first);
+    if t_first.abs() < 1.0 {
+        format!("{t0:.1}–{t1:.1} s")
+    } else {
+        format!("{rel} from the first IMU sample (t = {t0:.1} s on the data's clock)")
+    }
+}
+
+/// A run said to be at rest (no translation: `--zupt`, `--static-aid`; it may turn in place,
+/// as on a turntable) moves where, in a window that does not turn, its 1-s mean specific forces
+/// spread by more than this [m/s²] (30 mg: far above engine vibration's, which 1-s means
+/// average out) …
+pub const MOVING_F_SPREAD: f64 = 0.3;
+/// … or its mean specific force moves this far from the last still window's with no turn
+/// between [m/s²] (a constant acceleration begun or ended).
+pub const MOVING_F_STEP: f64 = 0.3;
+/// A window turns when its 1-s mean angular rates spread by more than this, or its mean rate
+/// exceeds it [rad/s] (2 deg/s: above an uncalibrated MEMS gyro's bias).
+pub const TURNING_RATE: f64 = 2.0 * std::f64::consts::PI / 180.0;
+
+/// What a claim of rest holds a run to, window by window: translation shows in the specific
+/// force of windows that do not turn (turning in place is allowed).
+#[derive(Debug, Clone)]
+pub struct RestClaim {
+    /// The option that makes the claim (`--zupt`, `--static-aid`).
+    option: &'static str,
+    /// Mean specific force of the last window that did not turn, FRD [m/s²]; None after a turn.
+    reference: Option<Vector3<f64>>,
+}
+
+impl RestClaim {
+    /// Judges `window` (consecutive samples, FRD increments; its first at `t_first` [s] from
+    /// the run's first sample): the claim and the motion that contradicts it, in words.
+    fn judge(&mut self, window: &[crate::io::imu::ImuSample], t_first: f64) -> Option<String> {
+        if window.len() < 12 {
+            return None;
+        }
+        let data = ImuData {
+            samples: window.to_vec(),
+        };
+        let e =
+            crate::estimate::align::rest_evidence(&data, window.len(), earth::gravity(0.0, 0.0))
+                .first()
+                .copied()?;
+        if e.w_spread > TURNING_RATE || e.w_mean.norm() > TURNING_RATE {
+            self.reference = None;
+            return None;
+        }
+        let step = self.reference.map(|r| (e.f_mean - r).norm()).unwrap_or(0.0);
+        self.reference = Some(e.f_mean);
+        let (t0, t1) = (window[0].t, window[window.len() - 1].t);
+        (e.f_spread > MOVING_F_SPREAD || step > MOVING_F_STEP).then(|| {
+            format!(
+                "{} says the vehicle does not move for the whole run, but the IMU accelerates at {} without turning: \
+                 its 1-s mean specific forces spread by {:.3} m/s² RMS (at rest <= {MOVING_F_SPREAD}) and its mean moved by \
+                 {step:.3} m/s² from the last still window's (<= {MOVING_F_STEP}): aid a moving run with GNSS fixes (--aid), \
+                 or cut the IMU file to the stretch at rest",
+                self.option,
+                span_words(t0, t1, t_first),
+                e.f_spread,
+            )
+        })
+    }
 }
 
 impl WindowJudge {
@@ -453,7 +525,26 @@ impl WindowJudge {
             lat,
             rest_judged: head.is_static,
             gyro_warn_only,
+            rest_claim: None,
+            t_first: head.window_s[0],
         }
+    }
+
+    /// Holds every window to `option`'s claim that the vehicle does not move for the whole
+    /// run (`--zupt`, `--static-aid`; turning in place allowed), the first seconds `head`
+    /// first; the words of the motion found there.
+    pub fn claim_rest(
+        &mut self,
+        option: &'static str,
+        head: &[crate::io::imu::ImuSample],
+    ) -> Option<String> {
+        let mut claim = RestClaim {
+            option,
+            reference: None,
+        };
+        let found = claim.judge(head, self.t_first);
+        self.rest_claim = Some(claim);
+        found
     }
 
     /// The unit, scale or clock slip `window` (consecutive samples, FRD increments) shows, in
@@ -462,6 +553,11 @@ impl WindowJudge {
     pub fn judge(&mut self, window: &[crate::io::imu::ImuSample]) -> Option<(String, bool)> {
         if window.len() < 12 {
             return None;
+        }
+        if let Some(claim) = self.rest_claim.as_mut() {
+            if let Some(p) = claim.judge(window, self.t_first) {
+                return Some((p, false));
+            }
         }
         let data = ImuData {
             samples: window.to_vec(),
@@ -478,7 +574,7 @@ impl WindowJudge {
             // at rest again: only what no calibration error explains
             said.moving(&m);
         }
-        let at = |p: &String| format!("at {t0:.1}–{t1:.1} s: {p}");
+        let at = |p: &String| format!("at {}: {p}", span_words(t0, t1, self.t_first));
         if let Some(p) = said.unit_problems.first() {
             return Some((at(p), false));
         }
