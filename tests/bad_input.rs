@@ -798,3 +798,80 @@ fn a_claim_of_rest_on_data_that_move_is_refused_where_they_move() {
     let (ok, err) = filter(&["--aid", gnss.to_str().unwrap()], "g");
     assert!(ok, "{err}");
 }
+
+/// Gyros in deg/s read as rad/s on a unit with a bias (|ω| at rest 33× Earth rate, outside the
+/// 57.3× band): a navigation- or tactical-grade run is refused with the slip named, a MEMS one
+/// runs (such a bias is a MEMS gyro's), and imu-check says which grade the rate allows.
+#[test]
+fn a_gyro_rate_at_rest_beyond_the_grade_names_the_unit_slip() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = -105.0\neuler_deg = [0.0, 0.0, 30.0]\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[errors]\neps_z = \"10 deg/h\"\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
+    )
+    .unwrap();
+    let o = d.join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let deg = 180.0 / std::f64::consts::PI;
+    let text = std::fs::read_to_string(o.join("imu.txt")).unwrap();
+    let mut out = String::new();
+    for l in text.lines() {
+        if l.starts_with('#') {
+            out.push_str(l);
+        } else {
+            let mut v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            v[1..4].iter_mut().for_each(|x| *x *= deg);
+            let w: Vec<String> = v.iter().map(|x| format!("{x:.15e}")).collect();
+            out.push_str(&w.join(" "));
+        }
+        out.push('\n');
+    }
+    let imu = d.join("dps.txt");
+    std::fs::write(&imu, out).unwrap();
+    let gnss = o.join("gnss.txt");
+    let filter = |grade: Option<&str>, out: &str| {
+        let out = d.join(out);
+        let mut a = vec![
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--aid",
+            gnss.to_str().unwrap(),
+            "--init",
+            "40,-105,0,0,0,30",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if let Some(g) = grade {
+            a.extend_from_slice(&["--grade", g]);
+        }
+        run(&a)
+    };
+    for grade in [None, Some("tactical")] {
+        let (ok, err) = filter(grade, "f");
+        assert!(
+            !ok && err.contains("deg/s read as rad/s") && err.contains("a bias of at least"),
+            "{grade:?}: {err}"
+        );
+    }
+    let (ok, err) = filter(Some("mems"), "m");
+    assert!(ok, "{err}");
+    let (ok, said, err) =
+        common::sinsmodel(&["imu-check", "--imu", imu.to_str().unwrap(), "--lat", "40"]);
+    assert!(ok, "{err}");
+    assert!(
+        said.contains("a MEMS gyro's") && said.contains("deg/s read as rad/s likely"),
+        "{said}"
+    );
+}

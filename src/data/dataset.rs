@@ -154,10 +154,16 @@ impl DataOptions {
                 imu_path.display()
             ));
         }
+        // a gyro bias at rest beyond the stated grade's (unless --prior sets the gyro biases)
+        let eps_given = self.prior.iter().any(|p| p.trim_start().starts_with("eps"));
+        let beyond =
+            crate::estimate::imu_check::gyro_bias_beyond_grade(&check, self.grade.as_deref())
+                .filter(|_| !eps_given);
         let slips: Vec<&String> = check
             .unit_problems
             .iter()
             .chain(check.gyro_unit_problems.iter().filter(|_| !mems))
+            .chain(beyond.iter())
             .collect();
         if let Some(p) = slips.first() {
             if self.force {

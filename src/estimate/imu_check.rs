@@ -611,3 +611,38 @@ pub fn window_check(
     }
     })
 }
+
+/// The smallest gyro bias [deg/h] the static window of `check` shows (|ω̄| − Earth rate); None
+/// when the window is not at rest.
+pub fn least_gyro_bias_deg_h(check: &ImuCheck) -> Option<f64> {
+    check
+        .is_static
+        .then(|| (check.earth_rate_ratio - 1.0).max(0.0) * earth::OMEGA.to_degrees() * 3600.0)
+}
+
+/// A gyro bias at rest beyond what the sensor grade `grade` (None: navigation) has, in words
+/// with its likely cause (deg/s read as rad/s), for the first seconds' check `check`; None
+/// within it, or with a MEMS grade (whose biases reach what a unit slip gives). The limits are
+/// far above the grades' priors: 10 s "at rest" by the specific force can still rock (the
+/// parked RLG log's first seconds turn at 55 deg/h).
+pub fn gyro_bias_beyond_grade(check: &ImuCheck, grade: Option<&str>) -> Option<String> {
+    let (limit, words) = match grade {
+        None => (
+            150.0,
+            "navigation-grade gyro's (the default grade; prior 0.02 deg/h",
+        ),
+        Some("tactical") => (300.0, "tactical-grade gyro's (prior 1 deg/h"),
+        _ => return None,
+    };
+    let b = least_gyro_bias_deg_h(check)?;
+    (b > limit).then(|| {
+        format!(
+            "at rest the gyros read {} deg/h ({}× Earth rate): a bias of at least {} deg/h, beyond a {words}, \
+             at most {limit} deg/h accepted); the gyro values may be deg/s read as rad/s (57.3× the true rate: check gyro_unit), or the \
+             sensor is of a lower grade (--grade tactical or mems, or --prior 'eps_*=…')",
+            crate::io::units::sig3(check.earth_rate_ratio * earth::OMEGA.to_degrees() * 3600.0),
+            crate::io::units::sig3(check.earth_rate_ratio),
+            crate::io::units::sig3(b)
+        )
+    })
+}

@@ -72,8 +72,10 @@ pub fn verdict(c: &ImuCheck) -> String {
                 "Earth rate as expected".to_string()
             } else {
                 format!(
-                    "Earth rate not resolved (the gyro bias makes |ω| {}× Earth rate: gyro units checked only for gross errors)",
-                    sig3(c.earth_rate_ratio)
+                    "Earth rate not resolved (the gyro bias makes |ω| {}× Earth rate, a bias of at least {} deg/h: a MEMS gyro's; \
+                     for a navigation- or tactical-grade unit that is no bias but a unit slip, deg/s read as rad/s likely: check gyro_unit)",
+                    sig3(c.earth_rate_ratio),
+                    sig3(crate::estimate::imu_check::least_gyro_bias_deg_h(c).unwrap_or(0.0))
                 )
             }
         )
