@@ -228,7 +228,7 @@ fn filter_writes_a_navigation_solution_with_sigmas() {
         ]);
         assert!(ok, "{err}");
         let nav = read(&out.join("nav.txt"));
-        assert_eq!(nav.len(), 2200, "220 s at 10 Hz");
+        assert_eq!(nav.len(), 2201, "the start row, then 220 s at 10 Hz");
         // truth layout + sigma_n sigma_e sigma_vn sigma_ve sigma_tilt_n/e/d (no vertical states)
         assert!(nav
             .iter()

@@ -429,8 +429,6 @@ fn priors_line_names_the_priors_the_user_set() {
             "eps_*=0.5 deg/s",
             "--prior",
             "nabla_*=0.5 m/s^2",
-            "--prior",
-            "eps_*=0.4 deg/s",
             "--noise",
             "arw=0.5 deg/sqrt(h), vrw=150 ug/sqrt(Hz)",
         ],

@@ -552,7 +552,7 @@ fn jittered_clock_filters_consistently() {
 /// in place all gave headings tens of degrees off with σ ≈ 2°; now the drive-off's track is
 /// integrated through the turn (the heading comes out right), a late fix is refused or right,
 /// and turning in place is not taken for rest (the run starts moving, at the true heading). Overlapping
-/// outages and a `--nav-rate` that writes no row are refused.
+/// outages are refused; a `--nav-rate` slower than the run writes the start row only, and says so.
 #[test]
 fn init_auto_second_review() {
     let dir = tempfile::tempdir().unwrap();
@@ -665,7 +665,12 @@ fn init_auto_second_review() {
     };
     let (ok, err) = with_truth(&["--outage", "100,20", "--outage", "110,5"], "ov");
     assert!(!ok && err.contains("overlap"), "{err}");
+    // a rate slower than the run: the start row only, and said
     let (ok, err) = with_truth(&["--nav-rate", "0.001"], "nr");
-    assert!(!ok && err.contains("not one row"), "{err}");
-    assert!(!dir.path().join("nr").exists());
+    assert!(
+        ok && err.contains("nav.txt has only the start row"),
+        "{err}"
+    );
+    let rows = std::fs::read_to_string(dir.path().join("nr/nav.txt")).unwrap();
+    assert_eq!(rows.lines().filter(|l| !l.starts_with('#')).count(), 1);
 }

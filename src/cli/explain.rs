@@ -31,7 +31,7 @@ pub struct ExplainArgs {
     #[arg(long)]
     candidates: Option<String>,
     /// Family-wise false-alarm level of the candidate tests (Holm-corrected), in (0, 0.5].
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     alpha: f64,
     /// Output DIRECTORY (not a file; navigate's --out is a file): report.md, report.html,
     /// explain.json, extended.toml, figures.
@@ -41,17 +41,20 @@ pub struct ExplainArgs {
     #[arg(long)]
     json: Option<PathBuf>,
     /// Demo only: length of the simulated run [s] (60 to 14400; default 600).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     demo_seconds: Option<f64>,
     /// Demo only: seed of the simulation (default 1; 0 to 1e12).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
     demo_seed: Option<u64>,
 }
 
 /// Runs the command.
 pub fn run(args: &ExplainArgs) -> Result<()> {
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha <= 0.5) {
-        bail!("--alpha {}: expected a level in (0, 0.5]", args.alpha);
+        bail!(
+            "--alpha {}: expected a level in (0, 0.5]",
+            sinsmodel::io::units::shown_number(args.alpha)
+        );
     }
     let opts = ExplainOptions {
         alpha: args.alpha,
@@ -214,7 +217,10 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let seconds = args.demo_seconds.unwrap_or(600.0);
     let seed = args.demo_seed.unwrap_or(1);
     if !(seconds.is_finite() && (60.0..=14_400.0).contains(&seconds)) {
-        bail!("--demo-seconds {seconds}: expected 60 to 14400 s");
+        bail!(
+            "--demo-seconds {}: expected 60 to 14400 s",
+            sinsmodel::io::units::shown_number(seconds)
+        );
     }
     // P28 with its vertical channel: at the paper's level attitude d_z acts along the vertical,
     // which a fixed-height P28 cannot see (`--model P28` shows that)

@@ -31,7 +31,7 @@ pub struct FilterArgs {
     out: PathBuf,
     /// Rate of the navigation solution nav.txt [Hz] (default: every IMU sample); --out-rate,
     /// navigate's older name, is accepted too.
-    #[arg(long, alias = "out-rate")]
+    #[arg(long, alias = "out-rate", allow_hyphen_values = true)]
     nav_rate: Option<f64>,
     /// Read the whole IMU file before filtering (the pre-streaming path, kept as the baseline
     /// `sinsmodel bench` measures the stream against).
@@ -44,6 +44,9 @@ pub struct FilterArgs {
 /// and the directory appears only when the run succeeded.
 pub fn run(args: &FilterArgs) -> Result<()> {
     let model = Model::parse(&args.model)?;
+    if let Some(r) = args.nav_rate {
+        sinsmodel::nav::free_inertial::check_rate("--nav-rate", r)?;
+    }
     let mut cfg = args.data.config(&model, false)?;
     let inputs = args.data.input_paths();
     let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
@@ -58,12 +61,10 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     let provenance = super::command_line();
     let with_truth = inputs.truth.is_some();
     let mut files = EpochFiles::create(&out, &model, &cfg, &provenance, with_truth)?;
-    if let Some(r) = args.nav_rate {
-        if !(r.is_finite() && r > 0.0 && r <= 1e5) {
-            anyhow::bail!("--nav-rate {r}: expected a rate in (0, 1e5] Hz");
-        }
-    }
     let clock = RowClock::new(start.t, args.nav_rate, inputs.imu.interval());
+    if let Some(n) = clock.capped_note("--nav-rate") {
+        super::data::note(&format!("note: {n}"));
+    }
     let mut nav = NavWriter::create(&out.file("nav.txt"), &model, clock, &provenance)?;
     let run = filter_pass(&model, &cfg, &mut inputs, &mut nav, &mut files)?;
     if let Some(tr) = inputs.truth.take() {
@@ -73,12 +74,13 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
     sinsmodel::data::check_inside(files.errors.len(), inputs.aid.len(), start.t, t_last)?;
     let errors = files.commit(&out, &run, &provenance)?;
-    if nav.rows == 0 {
-        anyhow::bail!(
-            "--nav-rate {}: not one row of nav.txt within the data ({:.3} s of filtering): choose a higher rate",
-            args.nav_rate.unwrap_or(0.0),
+    if let (Some(r), 1) = (args.nav_rate, nav.rows) {
+        super::data::note(&format!(
+            "note: --nav-rate {}: one row every {} s, longer than the {:.3} s filtered; nav.txt has only the start row",
+            sinsmodel::io::units::shown_number(r),
+            sinsmodel::io::units::shown_number(1.0 / r),
             t_last - start.t
-        );
+        ));
     }
     let nav_rows = nav.rows;
     nav.finish(&out.file("nav.png"))?;

@@ -47,7 +47,12 @@ pub struct NavigateArgs {
     vertical: Vertical,
     /// Rate of the navigation solution written to --out [Hz] (the name filter uses for its
     /// nav.txt; --out-rate, the older name, is still accepted).
-    #[arg(long, alias = "out-rate", default_value_t = 10.0)]
+    #[arg(
+        long,
+        alias = "out-rate",
+        default_value_t = 10.0,
+        allow_hyphen_values = true
+    )]
     nav_rate: f64,
     /// Output FILE (a single file, not a directory, unlike the --out of filter, explain,
     /// simulate and reproduce): the navigation solution in the truth layout of DESIGN §9.
@@ -88,6 +93,9 @@ pub fn run(args: &NavigateArgs) -> Result<()> {
     let t0 = data.start_time();
     let start = free_inertial::start_state(t0, init.lat, init.lon, init.h, init.att, init.vel);
     let mut clock = RowClock::new(t0, Some(args.nav_rate), data.interval());
+    if let Some(n) = clock.capped_note("--nav-rate") {
+        super::data::note(&format!("note: {n}"));
+    }
     let row = |s: &NavState| TruthRow {
         t: s.t,
         lat: s.lat,
@@ -152,7 +160,7 @@ fn initial(args: &NavigateArgs) -> Result<Initial> {
             }
             let v = args.vel.clone().unwrap_or_else(|| vec![0.0; 3]);
             if v.len() != 3 {
-                bail!("--vel: expected N,E,D in m/s (three finite comma-separated numbers within ±1e4)");
+                bail!("--vel: expected N,E,D in m/s (three finite comma-separated numbers within ±1000)");
             }
             Initial {
                 lat,
@@ -165,12 +173,7 @@ fn initial(args: &NavigateArgs) -> Result<Initial> {
         }
     };
     check_initial(&init)?;
-    if !(args.nav_rate.is_finite() && args.nav_rate > 0.0 && args.nav_rate <= 1e5) {
-        bail!(
-            "--nav-rate {}: expected a rate in (0, 1e5] Hz",
-            args.nav_rate
-        );
-    }
+    free_inertial::check_rate("--nav-rate", args.nav_rate)?;
     Ok(init)
 }
 
@@ -195,37 +198,26 @@ fn from_init(text: &str) -> Result<Initial> {
     })
 }
 
-/// Refuses a latitude, attitude, velocity, longitude or height out of range.
+/// Refuses a latitude, longitude, height, attitude or velocity out of the range filter's
+/// --init takes ([`sinsmodel::data::init_value_problem`]), with the same words, after the
+/// option it came from.
 fn check_initial(i: &Initial) -> Result<()> {
-    let (lat_o, lon_o, h_o, vel_o) = if i.att_option == "--init" {
-        (
-            "--init: lat",
-            "--init: lon",
-            "--init: h",
-            "--init: velocity",
-        )
-    } else {
-        ("--lat", "--lon", "--h", "--vel")
-    };
-    if i.lat.abs() >= 89.0 || !i.lat.is_finite() {
-        bail!("{lat_o} {} must be within ±89°", i.lat);
-    }
-    use sinsmodel::io::bounds;
-    if bounds::attitude_deg(i.att).is_some() {
-        bail!(
-            "{}{}: expected roll,pitch,yaw in degrees (roll within ±180, pitch within ±90, yaw within ±360)",
-            if i.att_option == "--init" { "--init: attitude " } else { "--att " },
-            i.att.iter().map(|a| a.to_string()).collect::<Vec<_>>().join(",")
-        );
-    }
-    if i.vel.iter().any(|x| !x.is_finite() || x.abs() > 1e4) {
-        bail!("{vel_o}: expected N,E,D in m/s (three finite numbers within ±1e4)");
-    }
-    if let Some(p) = bounds::lon_deg(i.lon) {
-        bail!("{lon_o}: {p}");
-    }
-    if let Some(p) = bounds::height_m(i.h) {
-        bail!("{h_o}: {p}");
+    let mut v = vec![i.lat, i.lon, i.h];
+    v.extend(i.att);
+    v.extend(i.vel);
+    if let Some(why) = sinsmodel::data::init_value_problem(&v) {
+        let option = if i.att_option == "--init" {
+            "--init"
+        } else {
+            match why.split(' ').next().unwrap_or("") {
+                "lat" => "--lat",
+                "lon" => "--lon",
+                "h" => "--h",
+                "roll" | "pitch" | "yaw" => "--att",
+                _ => "--vel",
+            }
+        };
+        bail!("{option}: {why}");
     }
     Ok(())
 }

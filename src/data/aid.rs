@@ -141,7 +141,10 @@ impl DataOptions {
     fn zupt_sigma(&self) -> Result<Option<f64>> {
         if let Some(z) = self.zupt {
             if !(z.is_finite() && z > 0.0 && z < 100.0) {
-                bail!("--zupt {z}: expected a velocity σ in (0, 100) m/s");
+                bail!(
+                    "--zupt {}: expected a velocity σ in (0, 100) m/s",
+                    crate::io::units::shown_number(z)
+                );
             }
         }
         Ok(self.zupt.or(self

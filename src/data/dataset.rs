@@ -118,9 +118,11 @@ impl DataOptions {
         }
         self.check_head(&mut imu, &start.state, note)?;
         check_plan_at_start(&plan, &start.state)?;
+        let aid = plan.after(t0);
+        check_outages_drop_fixes(&aid, &outages, imu.first_t())?;
         Ok(Dataset {
             imu,
-            aid: plan.after(t0),
+            aid,
             truth: truth_reader,
             start: start.state,
             outages,
@@ -290,4 +292,41 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState) -> Result<()> {
 #[cfg(test)]
 pub(crate) fn tests_distance(lat: f64, lon: f64, h: f64, lat2: f64, lon2: f64) -> f64 {
     horizontal_distance_m(lat, lon, h, lat2, lon2)
+}
+
+/// Refuses an `--outage` window that no aiding epoch of `aid` falls inside: nothing is dropped,
+/// so the "drift" at its end would be an ordinary innovation. Names the window and the epochs
+/// around it (`first_t` [s]: the first IMU sample, as --outage counts).
+fn check_outages_drop_fixes(aid: &AidPlan, outages: &[Outage], first_t: f64) -> Result<()> {
+    use crate::io::aiding::time_from_first_sample;
+    'windows: for o in outages {
+        let mut before = None;
+        let mut after = None;
+        for e in aid.epochs() {
+            if e.t >= o.end_s {
+                after = Some(e.t);
+                break;
+            }
+            if e.t >= o.start_s {
+                continue 'windows;
+            }
+            before = Some(e.t);
+        }
+        // no fix after it either: the drift check says so (no position fix after it)
+        let Some(after) = after else { continue };
+        let before = match before {
+            Some(t) => format!(
+                "the last fix before it at {}",
+                time_from_first_sample(t, first_t)
+            ),
+            None => "no fix before it".into(),
+        };
+        bail!(
+            "--outage: no aiding fix falls inside the window {} ({}; the next at {}): it drops nothing, so there is no outage drift to measure; widen it to cover a fix",
+            o.words(first_t),
+            before,
+            time_from_first_sample(after, first_t)
+        );
+    }
+    Ok(())
 }

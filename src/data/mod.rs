@@ -8,7 +8,7 @@ pub mod dataset;
 pub mod options;
 pub mod setup;
 mod start;
-pub use start::init_numbers;
+pub use start::{init_numbers, init_value_problem};
 
 pub use aid::{AidPlan, Outage};
 pub use dataset::{check_inside, Dataset, PassInputs, DEFAULT_STEP_S};
@@ -155,6 +155,137 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("positive"));
+    }
+
+    /// "Nothing lost, nothing silent": a specific `--prior` wins over a wildcard whatever the
+    /// order, a name given twice is refused naming both values, and an attitude prior of 90° or
+    /// more (beyond the small-angle model) is refused with the reason.
+    #[test]
+    fn the_most_specific_prior_wins_and_conflicts_are_refused() {
+        let model = crate::model::Model::parse("P28").unwrap();
+        let (x, y) = (
+            model.index_of("eps_x").unwrap(),
+            model.index_of("eps_y").unwrap(),
+        );
+        let deg_h = 1f64.to_radians() / 3600.0;
+        let mut o = none();
+        for order in [
+            ["eps_x=1 deg/h", "eps_*=10 deg/h"],
+            ["eps_*=10 deg/h", "eps_x=1 deg/h"],
+        ] {
+            o.prior = order.iter().map(|s| s.to_string()).collect();
+            let c = o.config(&model, false).unwrap();
+            assert!((c.prior_sigma[x] / deg_h - 1.0).abs() < 1e-9, "{order:?}");
+            assert!((c.prior_sigma[y] / deg_h - 10.0).abs() < 1e-9, "{order:?}");
+        }
+        // a longer prefix is more specific than a shorter one
+        o.prior = vec!["eps_x*=2 deg/h".into(), "eps*=20 deg/h".into()];
+        let c = o.config(&model, false).unwrap();
+        assert!((c.prior_sigma[x] / deg_h - 2.0).abs() < 1e-9);
+        assert!((c.prior_sigma[y] / deg_h - 20.0).abs() < 1e-9);
+        // explain's term priors follow the same rule
+        o.prior = vec!["eps_x=1 deg/h".into(), "eps_*=10 deg/h".into()];
+        let terms = o.term_priors().unwrap();
+        let t = crate::model::generated::common::TERMS
+            .iter()
+            .position(|t| t.name == "eps_x")
+            .unwrap();
+        let (_, si) = terms.iter().find(|(k, _)| *k == t).unwrap();
+        assert!((si / deg_h - 1.0).abs() < 1e-9);
+        for p in [
+            vec!["eps_x=1 deg/h", "eps_x=2 deg/h"],
+            vec!["eps_*=1 deg/h", " eps_* = 2 deg/h"],
+        ] {
+            o.prior = p.iter().map(|s| s.to_string()).collect();
+            for e in [
+                o.config(&model, false).unwrap_err().to_string(),
+                o.term_priors().unwrap_err().to_string(),
+            ] {
+                assert!(
+                    e.contains("given twice") && e.contains("`1 deg/h`") && e.contains("`2 deg/h`"),
+                    "{e}"
+                );
+            }
+        }
+        o.prior = vec!["phi_d=180 deg".into()];
+        let e = o.config(&model, false).unwrap_err().to_string();
+        assert!(e.contains("phi_d") && e.contains("small"), "{e}");
+        o.prior = vec!["phi_*=1.6 rad".into()];
+        assert!(o.config(&model, false).is_err(), "91.7 deg by a wildcard");
+        o.prior = vec!["phi_d=60 deg".into()];
+        let c = o.config(&model, false).unwrap();
+        let d = model.index_of("phi_d").unwrap();
+        assert!((c.prior_sigma[d] - 60f64.to_radians()).abs() < 1e-12);
+    }
+
+    /// An allan JSON's declared units are honoured (deg/√h is not read as rad/√s), a unit of
+    /// the wrong kind or a missing entry beside others refused naming the key, and a key twice
+    /// refused naming it (serde_json would keep the last).
+    #[test]
+    fn a_noise_file_is_read_in_its_declared_units_and_with_unique_keys() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = |name: &str, white_g: f64, gyro_unit: &str, extra: &str| {
+            let ch = |n: &str, w: f64| format!("\"{n}\": {{\"white\": {w}}}");
+            let fit = ["x", "y", "z"]
+                .iter()
+                .map(|a| {
+                    format!(
+                        "{}, {}",
+                        ch(&format!("gyro_{a}"), white_g),
+                        ch(&format!("accel_{a}"), 1e-4)
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            let units = ["x", "y", "z"]
+                .iter()
+                .filter(|a| !(extra == "no gyro_z unit" && **a == "z"))
+                .map(|a| format!("\"gyro_{a}\": \"{gyro_unit}\", \"accel_{a}\": \"m/s^2 (fit: white m/s/sqrt(s), random_walk m/s^2/sqrt(s))\""))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let dup = if extra == "dup" { "\"fit\": {}, " } else { "" };
+            let p = dir.path().join(name);
+            std::fs::write(
+                &p,
+                format!("{{{dup}\"fit\": {{{fit}}},\n\"units\": {{{units}}}}}"),
+            )
+            .unwrap();
+            p
+        };
+        let deg = file(
+            "deg.json",
+            0.01,
+            "deg/h (fit: white deg/sqrt(h), random_walk deg/h/sqrt(h))",
+            "",
+        );
+        let n = noise_given(&deg).unwrap();
+        let want = 0.01f64.to_radians() / 60.0;
+        assert!((n.arw / want - 1.0).abs() < 1e-12, "{} vs {want}", n.arw);
+        assert!((n.vrw - 1e-4).abs() < 1e-16);
+        let si = file(
+            "si.json",
+            want,
+            "rad/s (fit: white rad/sqrt(s), random_walk rad/s/sqrt(s))",
+            "",
+        );
+        assert!((noise_given(&si).unwrap().arw / want - 1.0).abs() < 1e-12);
+        let alone = file("alone.json", 0.01, "deg/sqrt(h)", "");
+        assert!((noise_given(&alone).unwrap().arw / want - 1.0).abs() < 1e-12);
+        let wrong = file("wrong.json", 0.01, "deg/h", "");
+        let e = noise_given(&wrong).unwrap_err().to_string();
+        assert!(
+            e.contains("wrong.json") && e.contains("units.gyro_x"),
+            "{e}"
+        );
+        let partial = file("partial.json", 0.01, "deg/sqrt(h)", "no gyro_z unit");
+        let e = noise_given(&partial).unwrap_err().to_string();
+        assert!(e.contains("partial.json") && e.contains("gyro_z"), "{e}");
+        let dup = file("dup.json", 0.01, "deg/sqrt(h)", "dup");
+        let e = noise_given(&dup).unwrap_err().to_string();
+        assert!(
+            e.contains("dup.json") && e.contains("key `fit` given twice"),
+            "{e}"
+        );
     }
 
     #[test]

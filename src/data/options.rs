@@ -117,11 +117,14 @@ pub struct DataOptions {
     )]
     pub static_aid: Option<Vec<f64>>,
     /// Prior 1-σ of a state, NAME=QUANTITY with units (repeatable); a trailing `*` matches a
-    /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`.
+    /// prefix: `--prior 'eps_*=1 deg/s' --prior 'nabla_*=20 mg' --prior 'phi_d=5 deg'`. The most
+    /// specific wins whatever the order (`eps_x=…` over `eps_*=…`, a longer prefix over a
+    /// shorter); a name given twice is refused; attitude priors (phi_*) below 90 deg.
     #[cfg_attr(feature = "cli", arg(long))]
     pub prior: Vec<String>,
     /// Sensor white noise instead of the spec defaults: a `sinsmodel allan --json` file (the RMS
-    /// over the three axes of the gyros' ARW, and of the accelerometers' VRW), or inline with units:
+    /// over the three axes of the gyros' ARW, and of the accelerometers' VRW; `fit.*.white` in
+    /// the units its `units` names, SI without them; a key twice is refused), or inline with units:
     /// `'arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)'`; inline may add a bias random walk (bias
     /// instability) `gyro_bias_rw=10 deg/h/sqrt(h), accel_bias_rw=30 ug/sqrt(s)`, which explain
     /// then tests as noise levels too.
@@ -139,16 +142,16 @@ pub struct DataOptions {
     pub init: Option<String>,
     /// With `--init auto`: the GNSS speed [m/s] above which the course gives the heading
     /// [default: 3].
-    #[cfg_attr(feature = "cli", arg(long))]
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub init_speed: Option<f64>,
     /// open (errors estimated only) or closed (fed back).
     #[cfg_attr(feature = "cli", arg(long, default_value = "open"))]
     pub mode: String,
     /// Filter step [s] [default: 0.01, or the IMU's median interval when that is longer].
-    #[cfg_attr(feature = "cli", arg(long))]
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub step: Option<f64>,
     /// Zero-velocity updates with this σ [m/s] at every aiding epoch (vehicle at rest).
-    #[cfg_attr(feature = "cli", arg(long))]
+    #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub zupt: Option<f64>,
     /// Run even when the initial roll and pitch contradict the measured gravity direction or the
     /// first seconds' magnitudes look like a unit slip; it never replaces an output file.

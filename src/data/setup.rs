@@ -208,23 +208,21 @@ impl DataOptions {
         if let Some(g) = grade_table(self.grade.as_deref())? {
             out.extend(g.term_sigma.iter().copied().enumerate());
         }
-        for spec in &self.prior {
-            let (name, value) = prior_parts(spec)?;
-            let pattern = StatePattern::new(name);
-            for (t, info) in common::TERMS.iter().enumerate() {
-                if pattern.matches(info.name) {
-                    let si = crate::io::units::parse_quantity_as(value, info.unit)
-                        .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
-                    if !(si.is_finite() && si > 0.0) {
-                        bail!("--prior `{spec}`: a prior σ must be positive and finite");
-                    }
-                    if let Some(why) = info.beyond_limit(si).or(info.prior_too_small(si)) {
-                        bail!("--prior `{spec}`: {}: {why}", info.name);
-                    }
-                    out.retain(|x| x.0 != t);
-                    out.push((t, si));
-                }
+        check_prior_repeats(&self.prior)?;
+        for (t, info) in common::TERMS.iter().enumerate() {
+            let Some((spec, value)) = prior_for(&self.prior, info.name)? else {
+                continue;
+            };
+            let si = crate::io::units::parse_quantity_as(value, info.unit)
+                .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+            if !(si.is_finite() && si > 0.0) {
+                bail!("--prior `{spec}`: a prior σ must be positive and finite");
             }
+            if let Some(why) = info.beyond_limit(si).or(info.prior_too_small(si)) {
+                bail!("--prior `{spec}`: {}: {why}", info.name);
+            }
+            out.retain(|x| x.0 != t);
+            out.push((t, si));
         }
         Ok(out)
     }
@@ -253,7 +251,10 @@ impl DataOptions {
     pub(crate) fn step_given(&self) -> Result<Option<f64>> {
         match self.step {
             Some(s) if !(s.is_finite() && s > 0.0 && s <= 10.0) => {
-                bail!("--step {s}: expected a filter step in (0, 10] s")
+                bail!(
+                    "--step {}: expected a filter step in (0, 10] s",
+                    crate::io::units::shown_number(s)
+                )
             }
             s => Ok(s),
         }
@@ -291,32 +292,40 @@ impl DataOptions {
         if !model.vertical {
             cfg.vertical = Vertical::Fixed;
         }
+        check_prior_repeats(&args.prior)?;
         for spec in &args.prior {
-            let (name, value) = prior_parts(spec)?;
+            let (name, _) = prior_parts(spec)?;
             let pattern = StatePattern::new(name);
-            let matches: Vec<usize> = (0..model.n())
-                .filter(|&i| pattern.matches(model.names[i]))
-                .collect();
-            if matches.is_empty() && !lenient_priors {
+            if !lenient_priors && !model.names.iter().any(|n| pattern.matches(n)) {
                 bail!(
                     "--prior `{spec}`: no state `{name}` in model {}",
                     model.name
                 );
             }
-            for i in matches {
-                let si = crate::io::units::parse_quantity_as(value, model.unit(i))
-                    .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
-                if !(si.is_finite() && si > 0.0) {
-                    bail!("--prior `{spec}`: a prior σ must be positive and finite");
-                }
-                if let crate::model::catalog::StateRef::Term(t) = model.states[i] {
-                    let info = &crate::model::generated::common::TERMS[t];
-                    if let Some(why) = info.beyond_limit(si).or(info.prior_too_small(si)) {
-                        bail!("--prior `{spec}`: {}: {why}", info.name);
-                    }
-                }
-                cfg.prior_sigma[i] = si;
+        }
+        for i in 0..model.n() {
+            let Some((spec, value)) = prior_for(&args.prior, model.names[i])? else {
+                continue;
+            };
+            let si = crate::io::units::parse_quantity_as(value, model.unit(i))
+                .map_err(|e| anyhow::anyhow!("--prior `{spec}`: {e}"))?;
+            if !(si.is_finite() && si > 0.0) {
+                bail!("--prior `{spec}`: a prior σ must be positive and finite");
             }
+            if let crate::model::catalog::StateRef::Term(t) = model.states[i] {
+                let info = &crate::model::generated::common::TERMS[t];
+                if let Some(why) = info.beyond_limit(si).or(info.prior_too_small(si)) {
+                    bail!("--prior `{spec}`: {}: {why}", info.name);
+                }
+            }
+            if model.names[i].starts_with("phi_") && si >= MAX_ATTITUDE_PRIOR_RAD {
+                bail!(
+                    "--prior `{spec}`: {}: a 1-σ of {:.1} deg is not a small attitude error; the error model is linear in small angles (sin φ ≈ φ) and means nothing at 90° or more: give the attitude in --init (`sinsmodel align`, or --init auto for the heading) and a prior below 90 deg",
+                    model.names[i],
+                    si.to_degrees()
+                );
+            }
+            cfg.prior_sigma[i] = si;
         }
         if let Some(path) = &args.noise {
             let n = noise_given(path)?;
@@ -369,21 +378,25 @@ fn white_noise_of_allan_json(path: &std::path::Path) -> Result<(f64, f64)> {
             path.display()
         )
     })?;
+    crate::io::json_unique::check(&text)
+        .map_err(|e| anyhow::anyhow!("--noise {}: {e}", path.display()))?;
     let white = |names: [&str; 3]| -> Result<f64> {
         let mut s = 0.0;
         for n in names {
             let field = &v["fit"][n]["white"];
-            let w = field.as_f64().with_context(|| {
+            let w_given = field.as_f64().with_context(|| {
                 format!(
                     "--noise {}: fit.{n}.white {} (expected a number: the output of `sinsmodel allan --json`)",
                     path.display(),
                     if field.is_null() { "is missing or null (the fit was not determined)".to_string() } else { format!("is {field}, not a number") }
                 )
             })?;
-            let (min, max) = noise_range(n.starts_with("gyro"));
+            let gyro = n.starts_with("gyro");
+            let w = w_given * white_unit_scale(path, &v, n, gyro)?;
+            let (min, max) = noise_range(gyro);
             if !(w.is_finite() && w >= min && w <= max) {
                 bail!(
-                    "--noise {}: fit.{n}.white = {w} is not a plausible noise density ({min:e} ≤ w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
+                    "--noise {}: fit.{n}.white = {w_given} ({w:e} SI) is not a plausible noise density ({min:e} ≤ w ≤ {max} SI: rad/√s for gyros, m/s/√s for accelerometers)",
                     path.display()
                 );
             }
@@ -395,6 +408,56 @@ fn white_noise_of_allan_json(path: &std::path::Path) -> Result<(f64, f64)> {
         white(["gyro_x", "gyro_y", "gyro_z"])?,
         white(["accel_x", "accel_y", "accel_z"])?,
     ))
+}
+
+/// The factor to SI (rad/√s for a gyro, m/s/√s for an accelerometer) of channel `n`'s white
+/// noise in an allan JSON `v`, from its `units` entry: allan's `rad/s (fit: white rad/sqrt(s),
+/// …)`, the same with other units (`deg/h (fit: white deg/sqrt(h), …)`), or the white noise's
+/// unit alone; 1 (SI, as allan writes) when the file has no `units`. A missing entry beside
+/// others, or a unit that is not a noise density of the channel's kind, is refused, naming the
+/// file and key.
+fn white_unit_scale(
+    path: &std::path::Path,
+    v: &serde_json::Value,
+    n: &str,
+    gyro: bool,
+) -> Result<f64> {
+    let si = if gyro { "rad/sqrt(s)" } else { "m/s/sqrt(s)" };
+    if v["units"].is_null() {
+        return Ok(1.0);
+    }
+    let entry = &v["units"][n];
+    if entry.is_null() {
+        bail!(
+            "--noise {}: units has no entry for {n} while it has some: give every channel's unit (as `sinsmodel allan --json` writes), or none for SI ({si})",
+            path.display()
+        );
+    }
+    let text = entry.as_str().with_context(|| {
+        format!(
+            "--noise {}: units.{n} is {entry}, not a unit (expected e.g. `{si}`)",
+            path.display()
+        )
+    })?;
+    // `… (fit: white UNIT, random_walk …)` or the unit alone
+    let mut unit = match text.split_once("white") {
+        Some((_, rest)) => rest.split(',').next().unwrap_or("").trim(),
+        None => text.trim(),
+    };
+    // the `)` that closes `(fit: …` when white is its last entry
+    while unit.matches(')').count() > unit.matches('(').count() {
+        unit = unit[..unit.len() - 1].trim_end();
+    }
+    crate::io::units::parse_quantity_as(&format!("1 {unit}"), si).map_err(|e| {
+        anyhow::anyhow!(
+            "--noise {}: units.{n} `{}`: the white noise's unit `{}` is not a {} noise density like {si} ({})",
+            path.display(),
+            crate::io::lines::shown(text),
+            crate::io::lines::shown(unit),
+            if gyro { "gyro" } else { "accelerometer" },
+            e.0
+        )
+    })
 }
 
 /// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's;
@@ -471,4 +534,44 @@ fn prior_parts(spec: &str) -> Result<(&str, &str)> {
         bail!("--prior `{spec}`: the quantity is missing after `=` (NAME=QUANTITY, e.g. `{name}=2 ms`)");
     }
     Ok((name, value))
+}
+
+/// Largest attitude prior 1-σ [rad] (90°): the error model is linear in small angles.
+const MAX_ATTITUDE_PRIOR_RAD: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Refuses a `--prior` name (or prefix) given twice, naming both values: which one was meant
+/// is not for the tool to guess.
+fn check_prior_repeats(specs: &[String]) -> Result<()> {
+    for (k, spec) in specs.iter().enumerate() {
+        let (name, value) = prior_parts(spec)?;
+        for earlier in &specs[..k] {
+            let (n0, v0) = prior_parts(earlier)?;
+            if n0 == name {
+                bail!("--prior {name} given twice: `{v0}` and `{value}`; give it once");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The `--prior` (spec, quantity) that sets state `name`: the most specific that matches — the
+/// exact name over any prefix, a longer prefix over a shorter (`eps_x=1 deg/h` wins over
+/// `eps_*=10 deg/h` whatever their order). Names are unique ([`check_prior_repeats`]), so no
+/// two matches are equally specific.
+fn prior_for<'a>(specs: &'a [String], name: &str) -> Result<Option<(&'a str, &'a str)>> {
+    let mut best: Option<(usize, &str, &str)> = None;
+    for spec in specs {
+        let (pattern, value) = prior_parts(spec)?;
+        if !StatePattern::new(pattern).matches(name) {
+            continue;
+        }
+        let specificity = match pattern.strip_suffix('*') {
+            Some(prefix) => prefix.len(),
+            None => usize::MAX,
+        };
+        if best.is_none_or(|b| specificity > b.0) {
+            best = Some((specificity, spec.as_str(), value));
+        }
+    }
+    Ok(best.map(|(_, spec, value)| (spec, value)))
 }

@@ -55,18 +55,32 @@ pub fn init_numbers(text: &str) -> Result<Vec<f64>> {
             v.len()
         );
     }
-    for (x, (name, lo, hi, unit)) in v.iter().zip(INIT_RANGES) {
-        if !(x.is_finite() && (lo..=hi).contains(x)) {
-            bail!("--init: {name} = {x} is outside [{lo}, {hi}] {unit}");
-        }
-    }
-    if v[0].abs() >= 89.9 {
-        bail!(
-            "--init: lat = {} is at a pole (|lat| < 89.9 deg): the navigation frame is not defined there",
-            v[0]
-        );
+    if let Some(why) = init_value_problem(&v) {
+        bail!("--init: {why}");
     }
     Ok(v)
+}
+
+/// What is wrong with initial-state numbers `v` (lat, lon [deg], h [m], roll, pitch, yaw
+/// [deg][, vn, ve, vd m/s]) in words (`lat = 95 is outside [-90, 90] deg`), or None: each
+/// inside its physical range and the latitude off the poles — the bounds of `--init`, which
+/// navigate's --lat --lon --h --att --vel share.
+pub fn init_value_problem(v: &[f64]) -> Option<String> {
+    for (x, (name, lo, hi, unit)) in v.iter().zip(INIT_RANGES) {
+        if !(x.is_finite() && (lo..=hi).contains(x)) {
+            return Some(format!(
+                "{name} = {} is outside [{lo}, {hi}] {unit}",
+                crate::io::units::shown_number(*x)
+            ));
+        }
+    }
+    if v.first().is_some_and(|lat| lat.abs() >= 89.9) {
+        return Some(format!(
+            "lat = {} is at a pole (|lat| < 89.9 deg): the navigation frame is not defined there",
+            v[0]
+        ));
+    }
+    None
 }
 
 /// The navigation state of checked `--init` numbers `v` ([`init_numbers`]) at time `t0` [s].
@@ -211,7 +225,10 @@ impl DataOptions {
         use crate::estimate::init::{self, Blocks, Fix, Found, Priors};
         let speed = self.init_speed.unwrap_or(init::DEFAULT_SPEED);
         if !(speed.is_finite() && (0.5..=100.0).contains(&speed)) {
-            bail!("--init-speed {speed}: expected a speed in [0.5, 100] m/s");
+            bail!(
+                "--init-speed {}: expected a speed in [0.5, 100] m/s",
+                crate::io::units::shown_number(speed)
+            );
         }
         // the bias priors the run will use (grade, --prior)
         let m = Model::parse("P28")?;

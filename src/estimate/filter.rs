@@ -320,8 +320,8 @@ pub trait Observer {
     /// model's A (n×n row-major; non-zeros at `pattern`) used for it.
     fn step(&mut self, _t: f64, _dt: f64, _np: &NavPoint, _a: &[f64], _pattern: &[(usize, usize)]) {
     }
-    /// After every IMU sample: the navigation state, and the error estimate x and covariance P
-    /// (n×n row-major) as of the last propagation step or update.
+    /// At the start and after every IMU sample: the navigation state, and the error estimate x
+    /// and covariance P (n×n row-major) as of the last propagation step or update.
     fn nav_sample(&mut self, _s: &NavState, _x: &[f64], _p: &[f64]) {}
     /// Before a scalar update is applied: its row `h`, gain `k` = P⁻hᵀ/S, innovation ν and
     /// variance S, and which measurement component it is.
@@ -973,6 +973,8 @@ pub fn run_stream(
         next = io.samples.next_sample()?;
     }
     let mut diverged = None;
+    // the start state: the first row of a navigation output
+    obs.nav_sample(&e.nav.state, &e.x, &e.p);
     while let Some(smp) = next {
         next = io.samples.next_sample()?;
         let dt = smp.t - prev_t;

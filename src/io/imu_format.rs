@@ -99,7 +99,7 @@ struct RawFile {
     delimiter: Option<Spanned<String>>,
     header: Option<bool>,
     skip_lines: Option<Spanned<i64>>,
-    comment: Option<String>,
+    comment: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -212,7 +212,7 @@ impl ImuFormat {
         let delimiter = src.delimiter(&file)?;
         let skip_lines = src.skip_lines(&file)?;
         let header = file.header.unwrap_or(false);
-        let comment = file.comment.unwrap_or_else(|| "#".into());
+        let comment = src.comment(&file)?;
 
         let time = src.column(&raw.time.column, header)?;
         let time_to_s = match &raw.time.unit {
@@ -588,6 +588,25 @@ impl Desc<'_> {
                 }
             },
         })
+    }
+
+    /// The comment prefix of `[file] comment` (`#` by default; empty: no comments). A prefix
+    /// that can begin a number (a digit, sign or dot) is refused: it would drop data rows.
+    fn comment(&self, file: &RawFile) -> Result<String> {
+        let Some(c) = &file.comment else {
+            return Ok("#".into());
+        };
+        let text = c.get_ref();
+        if text.starts_with(|ch: char| ch.is_ascii_digit() || "+-.".contains(ch)) {
+            return Err(self.at(
+                c.span(),
+                format!(
+                    "[file] comment `{}`: a comment prefix that can begin a number (a digit, sign or dot) would drop every data row starting with it; use a character no number starts with, such as \"#\", \"%\" or \"//\"",
+                    crate::io::lines::shown(text)
+                ),
+            ));
+        }
+        Ok(text.clone())
     }
 
     /// The lines `[file] skip_lines` skips (0 to 1000000, 0 by default).

@@ -8,6 +8,7 @@ pub mod fixed;
 pub mod imu;
 pub mod imu_format;
 pub mod imu_stream;
+pub mod json_unique;
 pub mod lines;
 pub mod readers;
 pub mod sample_source;

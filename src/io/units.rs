@@ -24,6 +24,18 @@ pub fn sig3(v: f64) -> String {
     }
 }
 
+/// A number from an option or file in a bounded form for messages: as written when that is
+/// short (`0.01`, `-5`, `1e300`), else seven significant digits in exponent form (a 300-digit
+/// `--alpha` is not echoed in full).
+pub fn shown_number(v: f64) -> String {
+    let plain = format!("{v}");
+    if plain.len() <= 16 {
+        return plain;
+    }
+    let r: f64 = format!("{v:.6e}").parse().unwrap_or(v);
+    format!("{r:e}")
+}
+
 /// `a` and `b` each with three significant digits ([`sig3`]), or with as many more as it takes
 /// for their magnitudes to read differently (100.001 against 100, not 100 against 100; −100.001
 /// against 100 likewise).
@@ -58,6 +70,16 @@ pub fn sig_distinct(a: f64, b: f64) -> (String, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shown_numbers_are_bounded() {
+        assert_eq!(shown_number(-5.0), "-5");
+        assert_eq!(shown_number(0.01), "0.01");
+        assert_eq!(shown_number(1e300), "1e300");
+        assert_eq!(shown_number(1.0 / 3.0), "3.333333e-1");
+        assert_eq!(shown_number(f64::INFINITY), "inf");
+        assert!(shown_number(-1.234_567_890_123e200).len() <= 16);
+    }
 
     #[test]
     fn two_values_read_differently_when_they_differ() {

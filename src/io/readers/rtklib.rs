@@ -78,6 +78,50 @@ fn check_time_system(header: &str, file: &str, no: usize) -> Result<()> {
     }
 }
 
+/// What RTKLIB must be told to write latitude and longitude in degrees.
+const ECEF_FIX: &str = "ECEF coordinates: output the solution in lat/lon/height (RTKLIB 'Solution format: Lat/Lon/Height', out-solformat=llh)";
+/// What RTKLIB must be told to write decimal degrees.
+const DMS_FIX: &str = "latitude and longitude in degrees, minutes and seconds (`40 05 47.856`): output them in decimal degrees (RTKLIB 'Lat/Lon format: ddd.ddddddd', out-degform=deg)";
+
+/// Refuses a `.pos` whose column header says its positions are ECEF x/y/z or d-m-s latitude
+/// and longitude: sinsmodel reads latitude and longitude in decimal degrees.
+fn check_coordinates(header: &str, file: &str, no: usize) -> Result<()> {
+    if header.contains("x-ecef") || header.contains("y-ecef") {
+        bail!("{file}:{no}: {ECEF_FIX}");
+    }
+    if header.contains("latitude(d'\")") || header.contains("latitude(dms)") {
+        bail!("{file}:{no}: {DMS_FIX}");
+    }
+    Ok(())
+}
+
+/// The same as [`check_coordinates`] from the values of a row `f` (a file without its header):
+/// x, y, z of Earth's size (|r| 6300 to 6450 km), or whole degrees and minutes before the
+/// seconds of latitude and of longitude.
+fn not_lat_lon_deg(f: &[&str]) -> Option<&'static str> {
+    let num = |k: usize| f.get(k).and_then(|x| x.parse::<f64>().ok());
+    if let (Some(x), Some(y), Some(z)) = (num(2), num(3), num(4)) {
+        let r = (x * x + y * y + z * z).sqrt();
+        if (6.3e6..6.45e6).contains(&r) {
+            return Some(ECEF_FIX);
+        }
+    }
+    let whole = |k: usize, max: f64| {
+        f.get(k).is_some_and(|x| {
+            !x.contains(['.', 'e', 'E']) && x.parse::<f64>().is_ok_and(|v| v.abs() <= max)
+        })
+    };
+    let seconds = |k: usize| num(k).is_some_and(|v| (0.0..60.0).contains(&v));
+    (f.len() >= 17
+        && whole(2, 90.0)
+        && whole(3, 59.0)
+        && seconds(4)
+        && whole(5, 360.0)
+        && whole(6, 59.0)
+        && seconds(7))
+    .then_some(DMS_FIX)
+}
+
 /// Reads a `.pos` file.
 pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
     let mut lines = Lines::open(path, "RTKLIB solution")?;
@@ -86,6 +130,7 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         let l = line.text.trim();
         if let Some(header) = l.strip_prefix('%') {
             check_time_system(header, line.file, line.no)?;
+            check_coordinates(header, line.file, line.no)?;
             continue;
         }
         if l.is_empty() {
@@ -96,6 +141,9 @@ pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
         let f: Vec<&str> = l.split_whitespace().collect();
         if f.len() < 14 {
             bail!("{}: expected at least 14 columns, found {}", at(), f.len());
+        }
+        if let Some(why) = not_lat_lon_deg(&f) {
+            bail!("{}: {why}", at());
         }
         let date: Vec<i64> = f[0].split('/').filter_map(|x| x.parse().ok()).collect();
         let time: Vec<f64> = f[1].split(':').filter_map(|x| x.parse().ok()).collect();

@@ -1,0 +1,331 @@
+//! "Nothing lost, nothing silent": options that were resolved silently, and inputs whose error
+//! named the wrong cause, now say what happened. Data from `sinsmodel simulate`.
+
+mod common;
+
+use common::sinsmodel;
+use std::path::{Path, PathBuf};
+
+fn p(x: &Path) -> &str {
+    x.to_str().unwrap()
+}
+
+/// 60 s at rest at 100 Hz with 1 Hz fixes, simulated into `dir/sim`; with `offset` [s] added to
+/// every time of imu.txt, gnss.txt and truth.txt (an absolute clock such as GPS seconds).
+fn simulated(dir: &Path, offset: f64) -> PathBuf {
+    let sc = dir.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"ns\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n[gnss]\nrate_hz = 1.0\n",
+    )
+    .unwrap();
+    let sim = dir.join("sim");
+    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
+    assert!(ok, "{err}");
+    if offset != 0.0 {
+        for f in ["imu.txt", "gnss.txt", "truth.txt"] {
+            let text = std::fs::read_to_string(sim.join(f)).unwrap();
+            let shifted: String = text
+                .lines()
+                .map(|l| match l.split_once(' ') {
+                    Some((t, rest)) if !l.starts_with('#') => {
+                        format!("{:.6} {rest}\n", t.parse::<f64>().unwrap() + offset)
+                    }
+                    _ => format!("{l}\n"),
+                })
+                .collect();
+            std::fs::write(sim.join(f), shifted).unwrap();
+        }
+    }
+    sim
+}
+
+fn filter(sim: &Path, out: &Path, extra: &[&str]) -> (bool, String) {
+    let (imu, aid, truth) = (
+        sim.join("imu.txt"),
+        sim.join("gnss.txt"),
+        sim.join("truth.txt"),
+    );
+    let mut a = vec![
+        "filter",
+        "--model",
+        "P13",
+        "--imu",
+        p(&imu),
+        "--aid",
+        p(&aid),
+        "--truth",
+        p(&truth),
+        "--out",
+        p(out),
+    ];
+    a.extend_from_slice(extra);
+    let (ok, _, err) = sinsmodel(&a);
+    (ok, err)
+}
+
+/// The times of the rows of a nav.txt (or navigate output).
+fn row_times(path: &Path) -> Vec<f64> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
+        .collect()
+}
+
+/// Rows at t0 + k/rate from the run's start on an absolute clock, the start row always
+/// written, and a rate above the IMU's said on stderr.
+#[test]
+fn the_nav_rate_grid_is_anchored_at_the_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let t_abs = 1_751_000_000.0;
+    let sim = simulated(dir.path(), t_abs);
+    let nav = dir.path().join("nav.txt");
+    let (ok, _, err) = sinsmodel(&[
+        "navigate",
+        "--imu",
+        p(&sim.join("imu.txt")),
+        "--init",
+        "30,110,0,0,0,0",
+        "--nav-rate",
+        "0.1",
+        "--out",
+        p(&nav),
+    ]);
+    assert!(ok, "{err}");
+    // the run starts at the first sample and lasts 59.99 s
+    let t = row_times(&nav);
+    assert_eq!(t.len(), 6, "the start and 10 .. 50 s: {t:?}");
+    for (k, ti) in t.iter().enumerate() {
+        assert!((ti - t[0] - 10.0 * k as f64).abs() < 1e-3, "{t:?}");
+    }
+    // filter: the start row too, on the same grid
+    let out = dir.path().join("f3");
+    let (ok, err) = filter(&sim, &out, &["--nav-rate", "3"]);
+    assert!(ok, "{err}");
+    let t = row_times(&out.join("nav.txt"));
+    assert!(
+        (t[0] - t_abs).abs() < 0.011,
+        "the start row: {}",
+        t[0] - t_abs
+    );
+    assert!(
+        t.windows(2)
+            .all(|w| (w[1] - w[0] - 1.0 / 3.0).abs() < 0.0101),
+        "every interval 1/3 s within a sample: {:?}",
+        &t[..4]
+    );
+    assert!(t.len() >= 180, "{}", t.len());
+    // a rate longer than the run: only the start row, and said
+    let out = dir.path().join("f001");
+    let (ok, err) = filter(&sim, &out, &["--nav-rate", "0.01"]);
+    assert!(ok, "{err}");
+    assert_eq!(row_times(&out.join("nav.txt")).len(), 1);
+    assert!(err.contains("only the start row"), "{err}");
+    // above the IMU's rate: every sample, and said
+    let out = dir.path().join("f1000");
+    let (ok, err) = filter(&sim, &out, &["--nav-rate", "1000"]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("--nav-rate 1000: above the IMU's sample rate (100 Hz)"),
+        "{err}"
+    );
+    assert_eq!(row_times(&out.join("nav.txt")).len(), 6001);
+}
+
+/// An --outage that drops no fix is refused naming the window, not reported as a drift.
+#[test]
+fn an_outage_without_a_fix_inside_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulated(dir.path(), 0.0);
+    let out = dir.path().join("o");
+    // the second window is checked too when the first drops fixes
+    let (ok, err) = filter(&sim, &out, &["--outage", "10,5", "--outage", "50.2,0.5"]);
+    assert!(!ok, "accepted");
+    assert!(
+        err.contains("no aiding fix falls inside the window 50.200 .. 50.700 s")
+            && err.contains("50.000")
+            && err.contains("51.000"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let (ok, err) = filter(&sim, &out, &["--outage", "49.5,1"]);
+    assert!(ok, "{err}");
+    assert!(out.join("outages.json").exists());
+}
+
+/// Negative numbers reach the option's own check (not clap's "unexpected argument"), and a
+/// number is echoed in a bounded form.
+#[test]
+fn negative_and_huge_numbers_get_the_options_own_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulated(dir.path(), 0.0);
+    let imu = sim.join("imu.txt");
+    let nav = dir.path().join("nav.txt");
+    let (ok, _, err) = sinsmodel(&[
+        "navigate",
+        "--imu",
+        p(&imu),
+        "--init",
+        "30,110,0,0,0,0",
+        "--nav-rate",
+        "-5",
+        "--out",
+        p(&nav),
+    ]);
+    assert!(
+        !ok && err.contains("--nav-rate -5: must be positive (Hz)"),
+        "{err}"
+    );
+    let out = dir.path().join("f");
+    for (opt, val, words) in [
+        ("--nav-rate", "-5", "--nav-rate -5: must be positive (Hz)"),
+        ("--step", "-1", "--step -1: expected a filter step"),
+        ("--zupt", "-0.1", "--zupt -0.1: expected a velocity σ"),
+        ("--init-speed", "-3", "--init-speed"),
+    ] {
+        let (ok, err) = filter(&sim, &out, &[opt, val]);
+        assert!(!ok && err.contains(words), "{opt} {val}: {err}");
+        assert!(!err.contains("unexpected argument"), "{err}");
+    }
+    let huge = format!("1{}", "0".repeat(299));
+    for (opt, val, words) in [
+        ("--alpha", "-0.01", "--alpha -0.01: expected a level"),
+        ("--alpha", huge.as_str(), "--alpha 1e299: expected a level"),
+        (
+            "--demo-seconds",
+            "-60",
+            "--demo-seconds -60: expected 60 to 14400 s",
+        ),
+    ] {
+        let (ok, _, err) = sinsmodel(&["explain", opt, val]);
+        assert!(!ok && err.contains(words), "{opt}: {err}");
+        assert!(err.len() < 300, "bounded: {err}");
+    }
+}
+
+/// navigate takes the initial state within filter's bounds, in filter's words: latitude 89 is
+/// accepted by both, 89.95 refused by both as at a pole.
+#[test]
+fn navigate_and_filter_bound_the_start_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulated(dir.path(), 0.0);
+    let imu = sim.join("imu.txt");
+    let nav = dir.path().join("nav.txt");
+    let navigate = |extra: &[&str]| {
+        let mut a = vec!["navigate", "--imu", p(&imu), "--out", p(&nav), "--force"];
+        a.extend_from_slice(extra);
+        sinsmodel(&a)
+    };
+    let (ok, _, err) = navigate(&["--lat", "89", "--lon", "110", "--att", "0,0,0"]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = navigate(&["--init", "89,110,0,0,0,0", "--overwrite"]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = navigate(&["--lat", "89.95", "--lon", "110", "--att", "0,0,0"]);
+    assert!(
+        !ok && err.contains("--lat: lat = 89.95 is at a pole"),
+        "{err}"
+    );
+    let (ok, _, err) = navigate(&["--init", "89.95,110,0,0,0,0"]);
+    assert!(
+        !ok && err.contains("--init: lat = 89.95 is at a pole"),
+        "{err}"
+    );
+    let (ok, err) = filter(
+        &sim,
+        &dir.path().join("f"),
+        &["--init", "89.95,110,0,0,0,0"],
+    );
+    assert!(
+        !ok && err.contains("--init: lat = 89.95 is at a pole"),
+        "{err}"
+    );
+    let (ok, _, err) = navigate(&[
+        "--lat", "30", "--lon", "110", "--att", "0,0,0", "--vel", "2000,0,0",
+    ]);
+    assert!(
+        !ok && err.contains("--vel: vn = 2000 is outside [-1000, 1000] m/s"),
+        "{err}"
+    );
+}
+
+/// A comment prefix that can begin a number would drop data rows: refused when the description
+/// is loaded, naming the file and line.
+#[test]
+fn a_comment_prefix_that_begins_a_number_is_refused() {
+    let desc = |c: &str| {
+        format!("[file]\ndelimiter = \",\"\ncomment = \"{c}\"\n[time]\ncolumn = 1\n[signals]\nkind = \"increment\"\ngyro = [2, 3, 4]\ngyro_unit = \"rad\"\naccel = [5, 6, 7]\naccel_unit = \"m/s\"\n")
+    };
+    use sinsmodel::io::imu_format::ImuFormat;
+    for c in ["0", "1", "-", "+", ".", "9x"] {
+        let e = ImuFormat::parse(&desc(c), "f.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("f.toml:3:") && e.contains("can begin a number"),
+            "{c}: {e}"
+        );
+    }
+    for c in ["#", "//", "%", ""] {
+        assert!(ImuFormat::parse(&desc(c), "f.toml").is_ok(), "{c}");
+    }
+}
+
+/// An ECEF or a degrees-minutes-seconds RTKLIB solution is named as such (with or without its
+/// column header), not read as latitudes of -1277000 or as a vehicle that never moves.
+#[test]
+fn ecef_and_dms_pos_files_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str, text: &str| {
+        let f = dir.path().join(name);
+        std::fs::write(&f, text).unwrap();
+        sinsmodel::io::readers::rtklib::read(&f)
+            .unwrap_err()
+            .to_string()
+    };
+    let ecef_row = "2025/07/08 19:34:18.499  -1277000.0747  -4717237.0937   4087230.1273 1 21 0.0100 0.0100 0.0100 0.0000 0.0000 0.0000 0.00 0.0\n";
+    let ecef_head = "%  GPST                  x-ecef(m)      y-ecef(m)      z-ecef(m)   Q  ns   sdx(m)   sdy(m)   sdz(m)  sdxy(m)  sdyz(m)  sdzx(m) age(s)  ratio\n";
+    let dms_row = "2025/07/08 19:34:18.499 40 05 47.85648 -105 08 50.81388 1601.4740000 1 21 0.0098995 0.0098995 0.0100000 0.0 0.0 0.0 0.00 0.0\n";
+    let dms_head = "%  GPST                   latitude(d'\")   longitude(d'\")  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n";
+    for (name, text, line, words) in [
+        (
+            "ecef.pos",
+            format!("{ecef_head}{ecef_row}"),
+            ":1:",
+            "ECEF coordinates: output the solution in lat/lon/height",
+        ),
+        (
+            "ecef_nh.pos",
+            ecef_row.to_string(),
+            ":1:",
+            "ECEF coordinates",
+        ),
+        (
+            "dms.pos",
+            format!("{dms_head}{dms_row}"),
+            ":1:",
+            "degrees, minutes and seconds",
+        ),
+        (
+            "dms_nh.pos",
+            format!("% x\n{dms_row}"),
+            ":2:",
+            "output them in decimal degrees",
+        ),
+    ] {
+        let e = read(name, &text);
+        assert!(
+            e.contains(&format!("{name}{line}")) && e.contains(words),
+            "{name}: {e}"
+        );
+    }
+    // decimal degrees still read
+    let f = dir.path().join("ok.pos");
+    std::fs::write(
+        &f,
+        "2025/07/08 19:34:18.499 40.0966 -105.1474 1601.474 1 21 0.01 0.01 0.01 0 0 0 0 0\n",
+    )
+    .unwrap();
+    assert_eq!(sinsmodel::io::readers::rtklib::read(&f).unwrap().len(), 1);
+}
