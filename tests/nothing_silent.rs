@@ -329,3 +329,94 @@ fn ecef_and_dms_pos_files_are_named() {
     .unwrap();
     assert_eq!(sinsmodel::io::readers::rtklib::read(&f).unwrap().len(), 1);
 }
+
+/// The aiding file is checked against itself on every run (it was only under `--init auto`):
+/// swapped velocity columns refused, heights in feet refused against the initial height, a
+/// single 100 m outlier dropped with a warning that counts it (and the run then matches the
+/// clean file's), the clean file passes without a word.
+#[test]
+fn the_aiding_file_is_checked_against_itself_on_every_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("drive.toml");
+    std::fs::write(
+        &sc,
+        "name = \"drive\"\nimu_rate_hz = 100.0\nseed = 7\n[start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\n\
+         euler_deg = [0.0, 0.0, 30.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 10.0\n[[segment]]\nkind = \"accelerate\"\n\
+         duration_s = 10.0\naccel_mps2 = 1.5\n[[segment]]\nkind = \"turn\"\nduration_s = 30.0\nyaw_rate_deg_s = 3.0\n\
+         [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
+    )
+    .unwrap();
+    let sim = d.join("sim");
+    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(sim.join("gnss.txt")).unwrap();
+    let rewrite = |name: &str, f: &dyn Fn(usize, &mut Vec<f64>)| {
+        let mut out = String::new();
+        for (k, l) in text.lines().enumerate() {
+            if l.starts_with('#') {
+                out.push_str(l);
+            } else {
+                let mut v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                f(k, &mut v);
+                let w: Vec<String> = v.iter().map(|x| format!("{x:.11}")).collect();
+                out.push_str(&w.join(" "));
+            }
+            out.push('\n');
+        }
+        let path = d.join(name);
+        std::fs::write(&path, out).unwrap();
+        path
+    };
+    let run = |aid: &Path, out: &str| {
+        let out = d.join(out);
+        let (ok, _, err) = sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            p(&sim.join("imu.txt")),
+            "--aid",
+            p(aid),
+            "--init",
+            "40.0966,-105.1474,1601,0,0,30",
+            "--out",
+            p(&out),
+        ]);
+        (ok, err, out)
+    };
+    let (ok, err, clean) = run(&sim.join("gnss.txt"), "clean");
+    assert!(ok && !err.contains("warning"), "{err}");
+    let swapped = rewrite("swapped.txt", &|_, v| v.swap(7, 8));
+    let (ok, err, _) = run(&swapped, "sw");
+    assert!(
+        !ok && err.contains("velocities disagree with its positions"),
+        "{err}"
+    );
+    let feet = rewrite("feet.txt", &|_, v| v[3] *= 3.2808);
+    let (ok, err, _) = run(&feet, "ft");
+    assert!(!ok && err.contains("in feet?"), "{err}");
+    // fix 30 (t = 30 s, in the turn) 100 m north
+    let outlier = rewrite("outlier.txt", &|k, v| {
+        if k == 31 {
+            v[1] += 100.0 / 6.37e6 * 180.0 / std::f64::consts::PI;
+        }
+    });
+    let (ok, err, out) = run(&outlier, "ol");
+    assert!(
+        ok && err.contains("1 of") && err.contains("dropped as outliers"),
+        "{err}"
+    );
+    let epochs = |dir: &Path| {
+        let t = std::fs::read_to_string(dir.join("innovations.txt")).unwrap();
+        let mut times: Vec<String> = t
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+            .collect();
+        times.dedup();
+        times.len()
+    };
+    // the outlier's epoch is gone, every other is there
+    assert_eq!(epochs(&out) + 1, epochs(&clean), "one epoch dropped");
+}

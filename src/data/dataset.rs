@@ -91,7 +91,7 @@ impl DataOptions {
             self.clock_offset,
             note,
         )?;
-        let plan = self.aid_plan(imu.first_t())?;
+        let mut plan = self.aid_plan(imu.first_t())?;
         let mut truth_reader = match &self.truth {
             Some(p) => Some(truth::TruthReader::open(p)?),
             None => None,
@@ -118,6 +118,7 @@ impl DataOptions {
         }
         self.check_head(&mut imu, &start.state, note)?;
         check_plan_at_start(&plan, &start.state)?;
+        check_fixes(&mut plan, imu.first_t(), note)?;
         let aid = plan.after(t0);
         check_outages_drop_fixes(&aid, &outages, imu.first_t())?;
         Ok(Dataset {
@@ -267,6 +268,19 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState) -> Result<()> {
             }
             // the initial position and the first aiding fix must describe the same place
             if let Some(f) = fixes.iter().map(|f| &f.0).find(|f| f.t > t0) {
+                let dh = f.h - start.h;
+                if dh.abs() > 1000.0 {
+                    let feet = (f.h / start.h / 3.2808 - 1.0).abs() < 0.05
+                        || (start.h / f.h / 3.2808 - 1.0).abs() < 0.05;
+                    bail!(
+                        "the initial height {:.1} m is {:.1} m from the first aiding fix's {:.1} m (t = {:.3} s){}: check --init / --aid",
+                        start.h,
+                        dh.abs(),
+                        f.h,
+                        f.t,
+                        if feet { ", 3.28×: one of them in feet?" } else { "" }
+                    );
+                }
                 if let Some(dist) = far(f.lat, f.lon) {
                     bail!(
                         "the initial position is {:.1} km from the first aiding fix (t = {:.3} s): check --init / --static-aid / --aid",
@@ -328,5 +342,99 @@ fn check_outages_drop_fixes(aid: &AidPlan, outages: &[Outage], first_t: f64) -> 
             time_from_first_sample(after, first_t)
         );
     }
+    Ok(())
+}
+
+/// Largest acceleration a vehicle's fix-to-fix track may show [m/s²] (1 g) when fixes are
+/// tested against their neighbours.
+pub const FIX_ACCEL_MAX: f64 = 9.80665;
+
+/// The aiding file against itself, for every run (`--init auto` checked the velocities only
+/// for its own use): the receiver's velocities against the position differences (swapped,
+/// negated or mis-scaled columns refused), and single fixes far off the line through their
+/// neighbours (beyond 10 σ plus what 1 g can do in between: an outlier) dropped with a
+/// warning that counts them (`first_t` [s]: the first IMU sample, for the times said).
+fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> Result<()> {
+    let AidPlan::Fixes(list, _, _) = plan else {
+        return Ok(());
+    };
+    use crate::estimate::init::{self, Fix};
+    let fixes: Vec<Fix> = list
+        .iter()
+        .map(|(p, v)| Fix {
+            t: p.t,
+            pos: [p.lat, p.lon, p.h],
+            sigma_pos: p.sigma[0].max(p.sigma[1]),
+            v: v.map(|v| nalgebra::Vector3::from(v.v_ned)),
+            sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
+            derived: false,
+        })
+        .collect();
+    let receiver: Vec<bool> = list.iter().map(|(_, v)| v.is_some()).collect();
+    init::check_velocities(&fixes, &receiver)?;
+    // each interior fix's distance from the line through its neighbours [m], when off
+    let mut off_by: Vec<Option<f64>> = vec![None; list.len()];
+    for k in 1..list.len().saturating_sub(1) {
+        let (a, p, b) = (&list[k - 1].0, &list[k].0, &list[k + 1].0);
+        let (ta, tb) = (p.t - a.t, b.t - p.t);
+        if !(ta > 0.0 && tb > 0.0 && ta + tb <= 10.0) {
+            continue;
+        }
+        // the fix against the line through its neighbours, north, east and down [m]
+        let w = ta / (ta + tb);
+        let (rm, rn) = (
+            earth::radius_meridian(p.lat) + p.h,
+            earth::radius_transverse(p.lat) + p.h,
+        );
+        let d = [
+            (p.lat - (a.lat + w * (b.lat - a.lat))) * rm,
+            (p.lon - (a.lon + w * (b.lon - a.lon))) * rn * p.lat.cos(),
+            -(p.h - (a.h + w * (b.h - a.h))),
+        ];
+        let room = 0.5 * FIX_ACCEL_MAX * ta * tb;
+        let off = (0..3).any(|i| {
+            let s = p.sigma[i].hypot(a.sigma[i].max(b.sigma[i]));
+            d[i].abs() > 10.0 * s + room
+        });
+        if off {
+            off_by[k] = Some(d[0].hypot(d[1]).hypot(d[2]));
+        }
+    }
+    // an outlier also throws its neighbours' lines off (by about half): the fix further off
+    // than both neighbours is the one
+    let dist = |k: usize| off_by.get(k).copied().flatten().unwrap_or(0.0);
+    let outliers: Vec<(usize, f64)> = (1..list.len().saturating_sub(1))
+        .filter_map(|k| off_by[k].map(|d| (k, d)))
+        .filter(|&(k, d)| d > dist(k - 1) && d > dist(k + 1))
+        .collect();
+    let Some(&(k0, d0)) = outliers.first() else {
+        return Ok(());
+    };
+    // many are no single outliers: said, kept, left to the filter's innovations to show
+    if outliers.len() * 20 > list.len() {
+        note(&format!(
+            "warning: --aid: {} of {} fixes are off the line through their neighbours by more than 10 σ plus what 1 g allows \
+             (the first {} m off, {}): a rough track or σ stated too small; kept",
+            outliers.len(),
+            list.len(),
+            crate::io::units::sig3(d0),
+            crate::io::aiding::time_from_first_sample(list[k0].0.t, first_t)
+        ));
+        return Ok(());
+    }
+    note(&format!(
+        "warning: --aid: {} of {} fixes dropped as outliers, each off the line through its neighbours by more than 10 σ plus what 1 g \
+         allows between them (the first {} off, {})",
+        outliers.len(),
+        list.len(),
+        crate::io::units::sig3(d0) + " m",
+        crate::io::aiding::time_from_first_sample(list[k0].0.t, first_t)
+    ));
+    let drop: std::collections::HashSet<usize> = outliers.iter().map(|o| o.0).collect();
+    let mut k = 0;
+    list.retain(|_| {
+        k += 1;
+        !drop.contains(&(k - 1))
+    });
     Ok(())
 }

@@ -199,7 +199,7 @@ pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
     if checked > 0 && bad.len() * 10 > checked {
         let (k, v, vp) = bad[0];
         bail!(
-            "--init auto: the aiding file's velocities disagree with its positions at {} of {checked} fixes (first at t = {:.3} s: v_n, v_e = {:.2}, {:.2} m/s given, {:.2}, {:.2} m/s from the positions): swapped, negated or mis-scaled velocity columns? (--aid-use pos leaves them out)",
+            "--aid: the aiding file's velocities disagree with its positions at {} of {checked} fixes (first at t = {:.3} s: v_n, v_e = {:.2}, {:.2} m/s given, {:.2}, {:.2} m/s from the positions): swapped, negated or mis-scaled velocity columns? (--aid-use pos leaves them out)",
             bad.len(),
             fixes[k].t,
             v.x,
