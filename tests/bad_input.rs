@@ -84,7 +84,11 @@ fn imu_text_errors_name_file_line_and_problem() {
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains("sinsmodel-partial"))
+        .filter(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .contains("sinsmodel-partial")
+        })
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
