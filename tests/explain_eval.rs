@@ -261,3 +261,43 @@ fn merged_cases_are_checked_like_any_input() {
         std::fs::remove_dir_all(d).unwrap();
     }
 }
+
+/// Under an address-space limit (`ulimit -v` 150 MB) two jobs fit (one malloc arena; they
+/// aborted on a failed allocation, leaving the staging directory), more jobs than fit are refused
+/// before any work naming --jobs, and neither leaves anything beside --out.
+#[test]
+fn jobs_under_an_address_space_limit_fit_or_are_refused() {
+    let dir = tmp("ulimit");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |jobs: &str| {
+        let out = Command::new("bash")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v 150000 && exec \"$0\" explain-eval --cases 2 --seconds 300 --jobs {jobs} --out \"$1\""
+            ))
+            .arg(env!("CARGO_BIN_EXE_sinsmodel"))
+            .arg(dir.join(format!("j{jobs}")))
+            .output()
+            .expect("run bash");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run("2");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(dir.join("j2/eval.json").exists());
+    let (code, err) = run("8");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--jobs 8") && err.contains("ulimit -v") && err.contains("room for"),
+        "{err}"
+    );
+    let mut left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["j2"], "left beside --out");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

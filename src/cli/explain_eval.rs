@@ -30,7 +30,8 @@ pub struct EvalArgs {
     /// Library groups to draw from (default all: d,kaq,kas,kao,kgf,kgq,size).
     #[arg(long, value_delimiter = ',')]
     groups: Option<Vec<String>>,
-    /// Threads (default: all cores).
+    /// Threads (default: all cores, or as many as an address-space limit `ulimit -v` leaves room
+    /// for: about 4 MB + 0.125 MB per simulated second each).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     jobs: Option<u64>,
     /// Simulated seconds per case (300 to 7200).
@@ -106,14 +107,17 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         alpha: args.alpha,
         ..EvalSpec::default()
     };
-    let out = OutputDir::create(&args.out, &[], "explain-eval")?;
+    // --out checked now (its staging made and removed); the staging that holds the result is
+    // made only once the cases are computed, so a run that dies computing leaves none behind
+    drop(OutputDir::create(&args.out, &[], "explain-eval")?);
     let mut opts = explain_eval::default_options();
     opts.broken_selector = args.broken_selector;
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(j) = args.jobs {
-        pool = pool.num_threads(j as usize);
-    }
-    let pool = pool.build()?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = super::address_space::fit_jobs(args.jobs, cores, args.seconds)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .with_context(|| format!("--jobs {jobs}: cannot start {jobs} threads"))?;
     let pb = progress::bar(n as u64, "cases");
     let done = AtomicUsize::new(0);
     let t0 = std::time::Instant::now();
@@ -136,6 +140,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     pb.finish_and_clear();
     let cases: Vec<CaseResult> = results.into_iter().collect::<Result<_>>()?;
     let wall = t0.elapsed().as_secs_f64();
+    let out = OutputDir::create(&args.out, &[], "explain-eval")?;
     write(&out, &spec, &cases, Some(wall))?;
     out.commit()?;
     let s = explain_eval::summarize(&spec, &cases);
