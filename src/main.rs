@@ -59,6 +59,9 @@ fn main() -> ExitCode {
         // instead of the process dying without a word
         libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
+    // under an address-space limit, one malloc arena (before the signal thread makes a second)
+    #[cfg(unix)]
+    cli::address_space::one_arena_under_a_limit();
     #[cfg(unix)]
     interrupts::remove_unfinished_outputs_on_signal();
     // A full disk or a closed file behind stdout/stderr makes println!/eprintln! panic: end with

@@ -75,7 +75,7 @@ fn imu_text_errors_name_file_line_and_problem() {
         !ok && err.contains("cannot read IMU file") && err.contains("missing.txt"),
         "{err}"
     );
-    // a good file navigates and the output appears whole (no .partial left behind)
+    // a good file navigates and the output appears whole (no temporary left behind)
     let p = dir.path().join("good.txt");
     std::fs::write(&p, GOOD).unwrap();
     let (ok, err) = navigate(&p, &out);
@@ -84,7 +84,11 @@ fn imu_text_errors_name_file_line_and_problem() {
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains(".partial"))
+        .filter(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .contains("sinsmodel-partial")
+        })
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
@@ -410,10 +414,18 @@ fn leftovers_of_killed_runs_are_cleaned_and_reruns_replace_whole() {
     )
     .unwrap();
     std::fs::write(d.join(".o.sinsmodel-staging-4194304/states.txt"), "half").unwrap();
-    std::fs::write(d.join("nav.txt.sinsmodel-partial-4194304-0"), "half").unwrap();
+    // a file's temporary: a marked directory holding the half-written file
+    let partial = d.join(".nav.txt.sinsmodel-partial-4194304-0");
+    std::fs::create_dir(&partial).unwrap();
+    std::fs::write(
+        partial.join(".sinsmodel-partial"),
+        "sinsmodel temporary: removed when its file is written\n",
+    )
+    .unwrap();
+    std::fs::write(partial.join("nav.txt"), "half").unwrap();
     let (ok, err) = navigate(&imu, &d.join("nav.txt"));
     assert!(ok, "{err}");
-    assert!(!d.join("nav.txt.sinsmodel-partial-4194304-0").exists());
+    assert!(!partial.exists());
     let sc = d.join("s.toml");
     std::fs::write(
         &sc,

@@ -1,6 +1,6 @@
 //! `sinsmodel explain-eval`: a small campaign's report has its structure and behaves (hidden terms
 //! found, null cases quiet); the same checks fail with a deliberately broken selector; two
-//! half-runs merged equal the whole run.
+//! half-runs merged equal the whole run; merged cases are checked like any input.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -169,4 +169,135 @@ fn small_campaign_structure_behaviour_broken_selector_and_merge() {
     for d in [whole, broken, h1, h2, merged] {
         std::fs::remove_dir_all(d).unwrap();
     }
+}
+
+/// `--merge` checks every stored case like any input: an edited field is refused naming the
+/// shard's file, the case's index and the field (never an `inf %` from a truth of 0), and a
+/// range of indices missing between shards is refused naming it.
+#[test]
+fn merged_cases_are_checked_like_any_input() {
+    let (a, _) = eval("chk_a", &["--cases", "3"]);
+    let (b, _) = eval("chk_b", &["--cases", "2", "--first", "5"]);
+    let merge = |dirs: &[&Path]| {
+        let out = tmp("chk_out");
+        let mut args = vec!["explain-eval", "--merge"];
+        args.extend(dirs.iter().map(|d| d.to_str().unwrap()));
+        args.extend(["--out", out.to_str().unwrap()]);
+        let r = sinsmodel(&args);
+        let _ = std::fs::remove_dir_all(&out);
+        r
+    };
+    // a gap between shards: cases 3–4 were never run
+    let (ok, err) = merge(&[a.as_path(), b.as_path()]);
+    assert!(!ok && err.contains("cases 3–4 are missing"), "{err}");
+    assert!(err.contains("--first 3 --cases 2"), "{err}");
+    // the first detected hidden term of shard a, edited one field at a time
+    let stored = json(&a.join("cases.json"));
+    let k = stored["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|c| c["term"].is_string() && c["detected"] == true && c["sigma"].is_number())
+        .expect("seed 3 finds a hidden term in its first three cases");
+    let index = stored["cases"][k]["index"].as_u64().unwrap();
+    let edited = tmp("chk_edit");
+    let edits: [(&str, serde_json::Value, &str); 11] = [
+        ("lambda", serde_json::json!(-5.0), "lambda -5"),
+        (
+            "lambda",
+            serde_json::json!(1e300),
+            "outside the campaign's range",
+        ),
+        ("group", serde_json::json!("zzz"), "group `zzz`"),
+        (
+            "term",
+            serde_json::json!("nosuch_term"),
+            "term `nosuch_term`",
+        ),
+        ("sigma", serde_json::json!(0.0), "sigma 0"),
+        ("sigma", serde_json::json!(-1.0), "sigma -1"),
+        ("truth", serde_json::json!(0.0), "truth 0"),
+        ("named", serde_json::json!(["no_such"]), "named: `no_such`"),
+        ("named", serde_json::json!([]), "named is empty"),
+        ("noise_named", serde_json::json!(["loud"]), "noise_named"),
+        (
+            "candidates_tested",
+            serde_json::json!(100_000),
+            "candidates_tested",
+        ),
+    ];
+    for (field, value, says) in edits {
+        let mut v = stored.clone();
+        v["cases"][k][field] = value.clone();
+        std::fs::create_dir_all(&edited).unwrap();
+        std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+        let (ok, err) = merge(&[edited.as_path()]);
+        assert!(!ok, "{field} = {value} was merged: {err}");
+        for part in [
+            "chk_edit/cases.json",
+            &format!("case {index} (entry {} of 3)", k + 1),
+            says,
+        ] {
+            assert!(
+                err.contains(part),
+                "{field} = {value}: lacks `{part}`: {err}"
+            );
+        }
+        assert!(!err.contains("inf %"), "{err}");
+    }
+    // contradictory flags: not detected, a wrong term, nothing named
+    let mut v = stored.clone();
+    v["cases"][k]["named"] = serde_json::json!([]);
+    v["cases"][k]["detected"] = serde_json::json!(false);
+    v["cases"][k]["wrong_term"] = serde_json::json!(true);
+    std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+    let (ok, err) = merge(&[edited.as_path()]);
+    assert!(!ok && err.contains("wrong_term = true"), "{err}");
+    // the shards as written merge (with the missing ones run)
+    let (c, _) = eval("chk_c", &["--cases", "2", "--first", "3"]);
+    let (ok, err) = merge(&[a.as_path(), b.as_path(), c.as_path()]);
+    assert!(ok, "{err}");
+    for d in [a, b, c, edited] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
+}
+
+/// Under an address-space limit (`ulimit -v` 150 MB) two jobs fit (one malloc arena; they
+/// aborted on a failed allocation, leaving the staging directory), more jobs than fit are refused
+/// before any work naming --jobs, and neither leaves anything beside --out.
+#[test]
+fn jobs_under_an_address_space_limit_fit_or_are_refused() {
+    let dir = tmp("ulimit");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |jobs: &str| {
+        let out = Command::new("bash")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v 150000 && exec \"$0\" explain-eval --cases 2 --seconds 300 --jobs {jobs} --out \"$1\""
+            ))
+            .arg(env!("CARGO_BIN_EXE_sinsmodel"))
+            .arg(dir.join(format!("j{jobs}")))
+            .output()
+            .expect("run bash");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run("2");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(dir.join("j2/eval.json").exists());
+    let (code, err) = run("8");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--jobs 8") && err.contains("ulimit -v") && err.contains("room for"),
+        "{err}"
+    );
+    let mut left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["j2"], "left beside --out");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

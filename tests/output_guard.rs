@@ -142,11 +142,13 @@ fn the_sweep_of_leftovers_never_takes_a_users_file() {
     let o = simulate(d);
     // pid 4194304 is above Linux's pid_max: never a live process
     let theirs = [
-        "nav.txt.sinsmodel-partial-4194304-0",
+        ".nav.txt.sinsmodel-partial-4194304-0",
         ".o.sinsmodel-staging-4194304",
         ".o.sinsmodel-old-4194304",
     ];
-    std::fs::write(d.join(theirs[0]), "half").unwrap();
+    std::fs::create_dir(d.join(theirs[0])).unwrap();
+    std::fs::write(d.join(theirs[0]).join(".sinsmodel-partial"), PARTIAL_TEXT).unwrap();
+    std::fs::write(d.join(theirs[0]).join("nav.txt"), "half").unwrap();
     std::fs::create_dir(d.join(theirs[1])).unwrap();
     std::fs::write(
         d.join(theirs[1]).join(".sinsmodel-staging"),
@@ -169,6 +171,9 @@ fn the_sweep_of_leftovers_never_takes_a_users_file() {
         ".o.sinsmodel-staging-4194305",
         ".o.sinsmodel-old-4194305",
         "nav.txt.sinsmodel-partial-4194304-x",
+        ".nav.txt.sinsmodel-partial-4194305-0",
+        // a plain file of exactly a temporary's former name
+        "nav.txt.sinsmodel-partial-4194304-0",
     ];
     for u in &users {
         if u.starts_with('.') {
@@ -178,9 +183,15 @@ fn the_sweep_of_leftovers_never_takes_a_users_file() {
             std::fs::write(d.join(u), "keep").unwrap();
         }
     }
+    // a temporary's marked directory that also holds something else is a user's
+    let mixed = ".nav.txt.sinsmodel-partial-4194304-1";
+    std::fs::create_dir(d.join(mixed)).unwrap();
+    std::fs::write(d.join(mixed).join(".sinsmodel-partial"), PARTIAL_TEXT).unwrap();
+    std::fs::write(d.join(mixed).join("notes.txt"), "keep").unwrap();
     let imu = o.join("imu.txt");
     let (ok, err) = navigate(imu.to_str().unwrap(), &d.join("nav.txt"), false);
     assert!(ok, "{err}");
+    assert!(d.join(mixed).join("notes.txt").exists());
     let (ok, err) = simulate_into(d, &o);
     assert!(ok, "{err}");
     let left = names(d);
@@ -190,6 +201,77 @@ fn the_sweep_of_leftovers_never_takes_a_users_file() {
     for u in &users {
         assert!(left.contains(&u.to_string()), "{u} removed: {left:?}");
     }
+}
+
+/// What the marker inside a file's temporary directory holds.
+const PARTIAL_TEXT: &str = "sinsmodel temporary: removed when its file is written\n";
+
+/// A run killed (SIGKILL: no handler runs) while writing `nav.txt` leaves its temporary, which
+/// the next run into the same place sweeps; a user's plain file named exactly like a temporary
+/// (`nav.txt.sinsmodel-partial-999999-1`) survives that run.
+#[test]
+fn a_killed_runs_temporary_is_swept_and_a_users_file_of_its_name_form_is_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let nav = d.join("nav.txt");
+    let users = "nav.txt.sinsmodel-partial-999999-1";
+    std::fs::write(d.join(users), "my notes").unwrap();
+    // a file being written: a temporary directory that holds nav.txt
+    let writing = |d: &Path| {
+        names(d).into_iter().find(|n| {
+            n.starts_with(".nav.txt.sinsmodel-partial-") && d.join(n).join("nav.txt").exists()
+        })
+    };
+    let mut left = None;
+    // (navigate is fast: a longer log until the kill lands while it writes)
+    for hours in [2, 8, 32] {
+        let imu = d.join("imu.txt");
+        let rows: String = (1..=hours * 360_000)
+            .map(|i| format!("{:.2} 0 0 0 0 0 -0.0979\n", i as f64 * 0.01))
+            .collect();
+        std::fs::write(&imu, rows).unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
+            .args(["navigate", "--imu", imu.to_str().unwrap()])
+            .args(["--lat", "30", "--lon", "110", "--att", "0,0,0", "--out"])
+            .arg(&nav)
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let t0 = std::time::Instant::now();
+        while writing(d).is_none() && child.try_wait().unwrap().is_none() {
+            assert!(
+                t0.elapsed().as_secs() < 60,
+                "navigate neither wrote nor ended"
+            );
+        }
+        child.kill().unwrap_or(()); // SIGKILL
+        let status = child.wait().unwrap();
+        if !status.success() {
+            left = writing(d);
+            if left.is_some() {
+                break;
+            }
+        }
+        let _ = std::fs::remove_file(&nav);
+    }
+    let left = left.expect("no run was killed while it wrote nav.txt");
+    assert_eq!(
+        std::fs::read_to_string(d.join(&left).join(".sinsmodel-partial")).unwrap(),
+        PARTIAL_TEXT
+    );
+    assert!(!nav.exists(), "the killed run's output appeared");
+    // the next run sweeps the killed run's temporary and leaves the user's file alone
+    std::fs::write(
+        d.join("imu.txt"),
+        "0.01 0 0 0 0 0 -0.0979\n0.02 0 0 0 0 0 -0.0979\n",
+    )
+    .unwrap();
+    let (ok, err) = navigate(d.join("imu.txt").to_str().unwrap(), &nav, false);
+    assert!(ok, "{err}");
+    let now = names(d);
+    assert!(!now.contains(&left), "{left} not swept: {now:?}");
+    assert_eq!(std::fs::read_to_string(d.join(users)).unwrap(), "my notes");
+    assert!(nav.exists());
 }
 
 /// Single-file outputs: another run's listed result or a file not provably this command's

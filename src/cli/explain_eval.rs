@@ -6,6 +6,7 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
+use sinsmodel::experiment::eval_check::{check_case, missing_ranges};
 use sinsmodel::experiment::explain_eval::{self, CaseResult, EvalSpec, Summary};
 use sinsmodel::io::atomic_file::{self, OutputDir};
 use sinsmodel::report::plot::{self, Scale, Series};
@@ -29,7 +30,8 @@ pub struct EvalArgs {
     /// Library groups to draw from (default all: d,kaq,kas,kao,kgf,kgq,size).
     #[arg(long, value_delimiter = ',')]
     groups: Option<Vec<String>>,
-    /// Threads (default: all cores).
+    /// Threads (default: all cores, or as many as an address-space limit `ulimit -v` leaves room
+    /// for: about 4 MB + 0.125 MB per simulated second each).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     jobs: Option<u64>,
     /// Simulated seconds per case (300 to 7200).
@@ -105,14 +107,17 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         alpha: args.alpha,
         ..EvalSpec::default()
     };
-    let out = OutputDir::create(&args.out, &[], "explain-eval")?;
+    // --out checked now (its staging made and removed); the staging that holds the result is
+    // made only once the cases are computed, so a run that dies computing leaves none behind
+    drop(OutputDir::create(&args.out, &[], "explain-eval")?);
     let mut opts = explain_eval::default_options();
     opts.broken_selector = args.broken_selector;
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(j) = args.jobs {
-        pool = pool.num_threads(j as usize);
-    }
-    let pool = pool.build()?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = super::address_space::fit_jobs(args.jobs, cores, args.seconds)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .with_context(|| format!("--jobs {jobs}: cannot start {jobs} threads"))?;
     let pb = progress::bar(n as u64, "cases");
     let done = AtomicUsize::new(0);
     let t0 = std::time::Instant::now();
@@ -120,7 +125,12 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         (args.first as usize..args.first as usize + n)
             .into_par_iter()
             .map(|i| {
+                // (what --merge would refuse is not written: a bug, said as such)
                 let r = explain_eval::run_case(&spec, i, &opts)
+                    .and_then(|c| match check_case(&spec, &c) {
+                        Ok(()) => Ok(c),
+                        Err(e) => bail!("its result fails the check --merge makes: {e} (a bug)"),
+                    })
                     .with_context(|| format!("case {i} (seed {})", spec.seed));
                 pb.set_position(done.fetch_add(1, Ordering::Relaxed) as u64 + 1);
                 r
@@ -130,6 +140,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     pb.finish_and_clear();
     let cases: Vec<CaseResult> = results.into_iter().collect::<Result<_>>()?;
     let wall = t0.elapsed().as_secs_f64();
+    let out = OutputDir::create(&args.out, &[], "explain-eval")?;
     write(&out, &spec, &cases, Some(wall))?;
     out.commit()?;
     let s = explain_eval::summarize(&spec, &cases);
@@ -190,15 +201,44 @@ fn merge(args: &EvalArgs) -> Result<()> {
                 }
             }
         }
-        for c in stored.cases {
+        let n = stored.cases.len();
+        let sp = spec
+            .as_ref()
+            .context("--merge: no campaign settings read")?;
+        for (k, c) in stored.cases.into_iter().enumerate() {
             if cases.iter().any(|x| x.index == c.index) {
                 bail!("--merge: case {} appears twice ({})", c.index, d.display());
             }
+            // a stored case is input like any other: checked against what its index draws
+            check_case(sp, &c).map_err(|e| {
+                anyhow::anyhow!(
+                    "--merge: {}: case {} (entry {} of {n}): {e}; not merged (edited by hand, damaged, or from another version of sinsmodel?)",
+                    path.display(),
+                    c.index,
+                    k + 1
+                )
+            })?;
             cases.push(c);
         }
     }
     let spec = spec.context("--merge needs at least one directory")?;
     cases.sort_by_key(|c| c.index);
+    let indices: Vec<usize> = cases.iter().map(|c| c.index).collect();
+    if let Some(&(a, b)) = missing_ranges(&indices).first() {
+        bail!(
+            "--merge: {} missing between the shards (the given ones hold {} to {}, each run a contiguous range): merge the shard that holds them too, or run it: explain-eval --seed {} --first {a} --cases {} --seconds {} --out DIR",
+            if a == b {
+                format!("case {a} is")
+            } else {
+                format!("cases {a}–{b} are")
+            },
+            indices[0],
+            indices[indices.len() - 1],
+            spec.seed,
+            b - a + 1,
+            spec.seconds
+        );
+    }
     let inputs: Vec<&Path> = args.merge.iter().map(|p| p.as_path()).collect();
     let out = OutputDir::create(&args.out, &inputs, "explain-eval")?;
     write(&out, &spec, &cases, None)?;
@@ -210,8 +250,12 @@ fn merge(args: &EvalArgs) -> Result<()> {
 }
 
 fn pct(v: Option<f64>) -> String {
-    v.map(|x| format!("{:.1} %", 100.0 * x))
-        .unwrap_or_else(|| "—".into())
+    // (never `inf %`: merged cases are checked, and what slips past is said as such)
+    match v {
+        Some(x) if x.is_finite() => format!("{:.1} %", 100.0 * x),
+        Some(x) => format!("not finite ({x})"),
+        None => "—".into(),
+    }
 }
 
 fn headline(s: &Summary) -> Vec<String> {

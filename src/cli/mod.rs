@@ -1,5 +1,6 @@
 //! Subcommands of the `sinsmodel` binary, one module each.
 
+pub mod address_space;
 pub mod align;
 pub mod allan;
 pub mod bench;

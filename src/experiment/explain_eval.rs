@@ -90,13 +90,18 @@ fn case_rng(seed: u64, index: usize) -> Rng {
     )
 }
 
-/// Runs case `index` of the campaign `spec`.
-pub fn run_case(
-    spec: &EvalSpec,
-    index: usize,
-    opts: &ExplainOptions,
-) -> anyhow::Result<CaseResult> {
-    let t_start = std::time::Instant::now();
+/// What case `index` of campaign `spec` draws before anything is simulated: the hidden case
+/// and, when it hides a term, its noncentrality λ = θ² I.
+pub struct Drawn {
+    /// The hidden-effect case (group, hidden term, scenario, baseline).
+    pub case: crate::sim::hidden::HiddenCase,
+    /// The λ the hidden term is put in at (None for a null case).
+    pub lambda: Option<f64>,
+}
+
+/// Draws case `index` of the campaign `spec` (cheap: no simulation); [`run_case`] runs what
+/// this draws, and a stored case is checked against it ([`check_case`]).
+pub fn draw(spec: &EvalSpec, index: usize) -> anyhow::Result<Drawn> {
     let mut rng = case_rng(spec.seed, index);
     let null = rng.uniform() < spec.null_fraction;
     let kind = if null {
@@ -113,7 +118,25 @@ pub fn run_case(
         .seed
         .wrapping_mul(1_000_003)
         .wrapping_add(index as u64 + 1);
-    let drawn = generate(case_seed, kind, spec.seconds, clear_effect(kind));
+    let case = generate(case_seed, kind, spec.seconds, clear_effect(kind));
+    let lambda = case.hidden.first().map(|_| {
+        let (lo, hi) = (spec.lambda[0].ln(), spec.lambda[1].ln());
+        (lo + (hi - lo) * rng.uniform()).exp()
+    });
+    Ok(Drawn { case, lambda })
+}
+
+/// Runs case `index` of the campaign `spec`.
+pub fn run_case(
+    spec: &EvalSpec,
+    index: usize,
+    opts: &ExplainOptions,
+) -> anyhow::Result<CaseResult> {
+    let t_start = std::time::Instant::now();
+    let Drawn {
+        case: drawn,
+        lambda: drawn_lambda,
+    } = draw(spec, index)?;
     // simulate without the hidden term, then put it in at the drawn λ
     let mut case = drawn.scaled(0.0);
     let (mut sim, aid) = simulate_case(&case)?;
@@ -133,8 +156,8 @@ pub fn run_case(
             start: sim.start,
         };
         let info = signature_information(&baseline, t, &data, &FilterConfig::new(&baseline))?;
-        let (lo, hi) = (spec.lambda[0].ln(), spec.lambda[1].ln());
-        let lam = (lo + (hi - lo) * rng.uniform()).exp();
+        let lam = drawn_lambda
+            .ok_or_else(|| anyhow::anyhow!("case {index}: a hidden term drawn without its λ"))?;
         let theta = reference.signum() * (lam / info.max(f64::MIN_POSITIVE)).sqrt();
         inject(&mut sim.imu, sim.start.t, t, theta);
         case.hidden = vec![(name.clone(), theta)];

@@ -1,8 +1,10 @@
 //! Experiments built on the library: the paper's reproduction (`reproduce`), hidden-effect cases
-//! end to end (`hidden`) and explain's evaluation campaign (`explain_eval`). They use the
+//! end to end (`hidden`) and explain's evaluation campaign (`explain_eval`, its stored cases
+//! checked by `eval_check`). They use the
 //! estimators; the estimators never use them.
 
 pub mod bench;
+pub mod eval_check;
 pub mod explain_data;
 pub mod explain_eval;
 pub mod hidden;

@@ -68,7 +68,8 @@ pub fn write_with_velocity(
             "{:.4} {:.11} {:.11} {:.4} {} {} {}",
             r.t,
             r.lat.to_degrees(),
-            r.lon.to_degrees(),
+            // in [-180, 180): a crossing of 180° writes what the reader takes
+            crate::io::bounds::written_lon_deg(r.lon.to_degrees()),
             r.h,
             r.sigma[0],
             r.sigma[1],

@@ -6,10 +6,18 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard};
 
-/// Tag in the name of every temporary this crate makes (`NAME.sinsmodel-partial-PID-N`,
+/// Tag in the name of every temporary this crate makes (`.NAME.sinsmodel-partial-PID-N`,
 /// `.NAME.sinsmodel-staging-PID`, `.NAME.sinsmodel-old-PID`): the sweep of killed runs'
 /// leftovers takes only names of exactly these forms, never a user's `nav.txt.old-2024`.
 const TEMP_TAG: &str = "sinsmodel";
+
+/// File inside every temporary's directory (`.NAME.sinsmodel-partial-PID-N/`, which holds it and
+/// the file being written, `NAME`), written before the file: a killed run's temporary is swept
+/// only when its directory holds this file with [`PARTIAL_TEXT`] and nothing but the file, so a
+/// user's file or directory that merely has such a name is never taken.
+const PARTIAL_MARKER: &str = ".sinsmodel-partial";
+/// What [`PARTIAL_MARKER`] holds.
+const PARTIAL_TEXT: &str = "sinsmodel temporary: removed when its file is written\n";
 
 /// File inside every staging directory, written when it is created: a directory is swept as a
 /// killed run's staging only when it holds this file with [`STAGING_TEXT`].
@@ -54,24 +62,66 @@ pub fn remove_unfinished() -> (usize, MutexGuard<'static, Vec<PathBuf>>) {
     (n, list)
 }
 
-/// A unique temporary beside `target`: `TARGET.sinsmodel-partial-PID-N` plus `ext` (unique per
-/// process and file, so concurrent runs never share one); registered for removal on a signal.
-pub fn temporary_beside(target: &Path, ext: &str) -> PathBuf {
+/// A unique temporary for `target`: the path `NAME` (plus `ext` unless it already ends so)
+/// inside a new directory `.NAME.sinsmodel-partial-PID-N` beside it (unique per process and
+/// file, so concurrent runs never share one) that holds the [`PARTIAL_MARKER`]; the directory
+/// is registered for removal on a signal, and [`forget_temporary`] removes it. The file itself
+/// is not created.
+pub fn temporary_beside(target: &Path, ext: &str) -> Result<PathBuf> {
     static SERIAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let k = SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let mut tmp = target.as_os_str().to_owned();
-    tmp.push(format!(
-        ".{TEMP_TAG}-partial-{}-{k}{ext}",
+    let (parent, name) = parent_and_name(target);
+    let dir = parent.join(format!(
+        ".{name}.{TEMP_TAG}-partial-{}-{k}",
         std::process::id()
     ));
-    let tmp = PathBuf::from(tmp);
-    register(&tmp);
-    tmp
+    // registered first: a signal at any moment from here removes it
+    register(&dir);
+    // (the marker written directly: an atomic write would need a temporary of its own)
+    let made = std::fs::create_dir(&dir)
+        .and_then(|_| std::fs::write(dir.join(PARTIAL_MARKER), PARTIAL_TEXT));
+    if let Err(e) = made {
+        let _ = std::fs::remove_dir_all(&dir);
+        unregister(&mut unfinished(), &dir);
+        anyhow::bail!(
+            "cannot create the temporary {} for {}: {e}",
+            dir.display(),
+            target.display()
+        );
+    }
+    let file = if name.ends_with(ext) {
+        name
+    } else {
+        format!("{name}{ext}")
+    };
+    Ok(dir.join(file))
 }
 
-/// Forgets a temporary made by [`temporary_beside`] (after it was moved into place or removed).
+/// The directory of a temporary made by this process's [`temporary_beside`], if `tmp` is one.
+fn temporary_dir(tmp: &Path) -> Option<&Path> {
+    let dir = tmp.parent()?;
+    let own = format!(".{TEMP_TAG}-partial-{}-", std::process::id());
+    let n = dir.file_name()?.to_string_lossy();
+    (n.starts_with('.') && n.contains(&own)).then_some(dir)
+}
+
+/// Removes the temporary `tmp` (if still there), its marker and its directory, with the
+/// registry `list` held.
+fn discard_temporary(list: &mut Vec<PathBuf>, tmp: &Path) {
+    let Some(dir) = temporary_dir(tmp) else {
+        return;
+    };
+    let _ = std::fs::remove_file(tmp);
+    let _ = std::fs::remove_file(dir.join(PARTIAL_MARKER));
+    // (never recursive: anything else inside stays, with the directory)
+    let _ = std::fs::remove_dir(dir);
+    unregister(list, dir);
+}
+
+/// Ends a temporary made by [`temporary_beside`] (after it was moved into place, or to drop
+/// it): removes the file if it is still there, its marker and its directory.
 pub fn forget_temporary(tmp: &Path) {
-    unregister(&mut unfinished(), tmp);
+    discard_temporary(&mut unfinished(), tmp);
 }
 
 /// A file being written; it appears at its final path only on [`AtomicFile::commit`].
@@ -133,7 +183,7 @@ impl AtomicFile {
             };
             remove_stale(dir, &name.to_string_lossy());
         }
-        let tmp = temporary_beside(target, "");
+        let tmp = temporary_beside(target, "")?;
         let f = std::fs::File::create(&tmp).with_context(|| {
             forget_temporary(&tmp);
             format!("cannot create {}", tmp.display())
@@ -158,7 +208,6 @@ impl AtomicFile {
         let mut w = self.out.take().expect("not committed");
         if let Err(e) = w.inner.flush().and_then(|_| w.inner.get_ref().sync_all()) {
             drop(w);
-            let _ = std::fs::remove_file(&self.tmp);
             forget_temporary(&self.tmp);
             anyhow::bail!(
                 "cannot write {} (for {}): {e}",
@@ -169,9 +218,9 @@ impl AtomicFile {
         drop(w);
         // (under the registry's lock: a signal arriving now waits for the rename)
         let mut list = unfinished();
-        unregister(&mut list, &self.tmp);
-        std::fs::rename(&self.tmp, &self.target).map_err(|e| {
-            let _ = std::fs::remove_file(&self.tmp);
+        let moved = std::fs::rename(&self.tmp, &self.target);
+        discard_temporary(&mut list, &self.tmp);
+        moved.map_err(|e| {
             anyhow::anyhow!(
                 "cannot move {} to {}: {e}",
                 self.tmp.display(),
@@ -184,7 +233,6 @@ impl AtomicFile {
 impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.out.is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
             forget_temporary(&self.tmp);
         }
     }
@@ -582,23 +630,21 @@ fn pid_alive(pid: u32) -> bool {
 /// temporaries: (kind, pid).
 fn leftover_kind(entry: &str, name: &str) -> Option<(&'static str, u32)> {
     let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    // NAME.sinsmodel-partial-PID-N, optionally .png (a plot's temporary)
-    if let Some(rest) = entry
-        .strip_prefix(name)
-        .and_then(|r| r.strip_prefix(&format!(".{TEMP_TAG}-partial-")))
-    {
-        let rest = rest.strip_suffix(".png").unwrap_or(rest);
-        let (pid, k) = rest.split_once('-')?;
-        if !(digits(pid) && digits(k)) {
-            return None;
-        }
-        return pid.parse().ok().map(|p| ("file", p));
-    }
-    // .NAME.sinsmodel-staging-PID or .NAME.sinsmodel-old-PID
     let rest = entry
         .strip_prefix('.')?
         .strip_prefix(name)?
         .strip_prefix(&format!(".{TEMP_TAG}-"))?;
+    // .NAME.sinsmodel-partial-PID-N (a file's temporary directory)
+    if let Some((pid, k)) = rest
+        .strip_prefix("partial-")
+        .and_then(|r| r.split_once('-'))
+    {
+        if !(digits(pid) && digits(k)) {
+            return None;
+        }
+        return pid.parse().ok().map(|p| ("partial", p));
+    }
+    // .NAME.sinsmodel-staging-PID or .NAME.sinsmodel-old-PID
     for kind in ["staging", "old"] {
         if let Some(pid) = rest.strip_prefix(kind).and_then(|r| r.strip_prefix('-')) {
             if digits(pid) {
@@ -611,8 +657,9 @@ fn leftover_kind(entry: &str, name: &str) -> Option<(&'static str, u32)> {
 
 /// Removes leftovers of killed runs beside output `name` in `dir`: only entries whose name is
 /// exactly one of this crate's temporaries, whose process is gone, and whose content proves it
-/// (a plain file for a file's temporary; a directory holding the staging marker, or an earlier
-/// run's valid [`RUN_MARKER`], for a staging or set-aside directory). Anything else is left.
+/// (for a file's temporary a directory holding only its [`PARTIAL_MARKER`] and the file; a
+/// directory holding the staging marker, or an earlier run's valid [`RUN_MARKER`], for a
+/// staging or set-aside directory). Anything else is left.
 fn remove_stale(dir: &Path, name: &str) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
@@ -630,7 +677,7 @@ fn remove_stale(dir: &Path, name: &str) {
             continue;
         };
         let ours = match kind {
-            "file" => meta.is_file(),
+            "partial" => meta.is_dir() && only_a_temporary(&p, name),
             "staging" => {
                 meta.is_dir()
                     && (std::fs::read_to_string(p.join(STAGING_MARKER))
@@ -647,6 +694,23 @@ fn remove_stale(dir: &Path, name: &str) {
             };
         }
     }
+}
+
+/// True when `dir` holds the [`PARTIAL_MARKER`] with [`PARTIAL_TEXT`] and at most the file being
+/// written for output `name` (`NAME`, or `NAME.png` for a plot): what a killed run's temporary
+/// holds, and nothing a user put there.
+fn only_a_temporary(dir: &Path, name: &str) -> bool {
+    let marked = std::fs::read_to_string(dir.join(PARTIAL_MARKER)).is_ok_and(|t| t == PARTIAL_TEXT);
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return false;
+    };
+    let png = format!("{name}.png");
+    marked
+        && entries.filter_map(|e| e.ok()).all(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n == PARTIAL_MARKER
+                || ((n == name || n == png) && e.file_type().is_ok_and(|t| t.is_file()))
+        })
 }
 
 /// Refuses an output named like `FILE.mat:VARIABLE`: inputs of that form select a variable of a
@@ -862,16 +926,15 @@ fn check_output_path(option: &str, path: &Path, inputs: &[&Path]) -> Result<()> 
             )
         })?;
     }
-    // (a fresh name of this crate's temporary form, never truncating anything that exists)
-    let probe = temporary_beside(path, "");
-    let made = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&probe);
-    if made.is_ok() {
-        let _ = std::fs::remove_file(&probe);
-    }
-    forget_temporary(&probe);
+    // (a fresh temporary of this crate's form, never truncating anything that exists)
+    let made = temporary_beside(path, "").and_then(|probe| {
+        let opened = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&probe);
+        forget_temporary(&probe);
+        Ok(opened?)
+    });
     made.with_context(|| format!("{option} {}: cannot write there", path.display()))?;
     if let Ok(m) = std::fs::metadata(path) {
         if !m.is_file() {
@@ -949,12 +1012,8 @@ mod tests {
     #[test]
     fn only_exact_temporary_names_are_leftovers() {
         assert_eq!(
-            leftover_kind("nav.txt.sinsmodel-partial-12-0", "nav.txt"),
-            Some(("file", 12))
-        );
-        assert_eq!(
-            leftover_kind("a_gyro.png.sinsmodel-partial-12-3.png", "a_gyro.png"),
-            Some(("file", 12))
+            leftover_kind(".nav.txt.sinsmodel-partial-12-0", "nav.txt"),
+            Some(("partial", 12))
         );
         assert_eq!(
             leftover_kind(".o.sinsmodel-staging-7", "o"),
@@ -962,6 +1021,11 @@ mod tests {
         );
         assert_eq!(leftover_kind(".o.sinsmodel-old-7", "o"), Some(("old", 7)));
         for user in [
+            // a plain file of the temporaries' former name form: a user's
+            "nav.txt.sinsmodel-partial-12-0",
+            "a_gyro.png.sinsmodel-partial-12-3.png",
+            ".nav.txt.sinsmodel-partial-12",
+            ".nav.txt.sinsmodel-partial-12-0x",
             "nav.txt.old-2024",
             "nav.txt.partial-12-0",
             "nav.txt.sinsmodel-partial-12",
@@ -971,7 +1035,11 @@ mod tests {
             ".o.sinsmodel-old-7x",
             ".oo.sinsmodel-old-7",
         ] {
-            let name = if user.contains("nav") { "nav.txt" } else { "o" };
+            let name = match user {
+                u if u.contains("nav") => "nav.txt",
+                u if u.contains("gyro") => "a_gyro.png",
+                _ => "o",
+            };
             assert_eq!(leftover_kind(user, name), None, "{user}");
         }
     }

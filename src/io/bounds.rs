@@ -12,6 +12,40 @@ pub fn lon_deg(v: f64) -> Option<String> {
     (!(-180.0..=360.0).contains(&v)).then(|| format!("longitude {v} outside -180 .. 360 deg"))
 }
 
+/// `v` unchanged (to the last bit) when `keep` holds, else wrapped into [−half, half): how a
+/// file writes an angle that a navigator or simulator accumulated (same unit as `half`).
+fn wrapped(v: f64, half: f64, keep: bool) -> f64 {
+    if keep || !v.is_finite() {
+        v
+    } else {
+        (v + half).rem_euclid(2.0 * half) - half
+    }
+}
+
+/// Longitude [deg] as files write it: unchanged inside [−180, 180), else wrapped into it
+/// (a crossing of 180° either way must not write −180.0001 or 360.0001, which readers refuse).
+pub fn written_lon_deg(v: f64) -> f64 {
+    wrapped(v, 180.0, (-180.0..180.0).contains(&v))
+}
+
+/// Longitude [rad] as files write it: unchanged inside [−π, π), else wrapped into it.
+pub fn written_lon_rad(v: f64) -> f64 {
+    use std::f64::consts::PI;
+    wrapped(v, PI, (-PI..PI).contains(&v))
+}
+
+/// Yaw [deg] as files write it: unchanged inside the readers' ±360, else wrapped into
+/// [−180, 180).
+pub fn written_yaw_deg(v: f64) -> f64 {
+    wrapped(v, 180.0, v.abs() <= 360.0)
+}
+
+/// Yaw [rad] as files write it: unchanged inside ±2π, else wrapped into [−π, π).
+pub fn written_yaw_rad(v: f64) -> f64 {
+    use std::f64::consts::PI;
+    wrapped(v, PI, v.abs() <= 2.0 * PI)
+}
+
 /// Height [m]: finite, within ±1e5.
 pub fn height_m(v: f64) -> Option<String> {
     (v.is_nan() || v.abs() > 1e5).then(|| format!("height {v} beyond ±1e5 m"))
@@ -73,5 +107,27 @@ mod tests {
         assert!(specific_force_mps2([0.0, 0.0, -1e308]).is_some());
         assert!(angular_rate_rps([1e3, 0.0, 0.0]).is_none());
         assert!(angular_rate_rps([0.0, f64::INFINITY, 0.0]).is_some());
+    }
+
+    #[test]
+    fn written_angles_are_ones_the_readers_take() {
+        // in range: the same bits
+        assert_eq!(written_lon_deg(-179.999_999_9), -179.999_999_9);
+        assert_eq!(written_yaw_deg(350.0), 350.0);
+        // across 180° either way, and past 360°
+        assert!((written_lon_deg(-180.000_08) - 179.999_92).abs() < 1e-9);
+        assert!((written_lon_deg(360.0001) - 0.0001).abs() < 1e-9);
+        assert!((written_lon_deg(180.0) + 180.0).abs() < 1e-12);
+        assert!((written_yaw_deg(-450.0) + 90.0).abs() < 1e-12);
+        let pi = std::f64::consts::PI;
+        assert!((written_lon_rad(pi + 0.1) - (-pi + 0.1)).abs() < 1e-12);
+        assert!((written_yaw_rad(-2.0 * pi - 0.1) + 0.1).abs() < 1e-12);
+        for v in [-540.0, -180.000_08, 180.0, 359.9, 360.0001, 1e6] {
+            assert!(lon_deg(written_lon_deg(v)).is_none(), "{v}");
+            assert!(
+                attitude_deg([0.0, 0.0, written_yaw_deg(v)]).is_none(),
+                "{v}"
+            );
+        }
     }
 }

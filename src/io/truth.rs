@@ -37,13 +37,8 @@ pub fn create(path: &Path, header: &str) -> Result<AtomicFile> {
 /// Writes one row of the truth layout (`t lat lon h v_n v_e v_d roll pitch yaw`, degrees).
 pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
     let d = 180.0 / std::f64::consts::PI;
-    // longitude written in [-180, 180) whatever the navigator accumulated
-    let lon_deg = r.lon * d;
-    let lon_deg = if (-180.0..180.0).contains(&lon_deg) {
-        lon_deg // unchanged to the last bit
-    } else {
-        (lon_deg + 180.0).rem_euclid(360.0) - 180.0
-    };
+    // longitude in [-180, 180) and yaw within ±360 whatever the navigator accumulated
+    let lon_deg = crate::io::bounds::written_lon_deg(r.lon * d);
     let cols: [(f64, usize); 10] = [
         (r.t, 4),
         (r.lat * d, 11),
@@ -54,7 +49,7 @@ pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
         (r.v.z, 6),
         (r.euler.x * d, 9),
         (r.euler.y * d, 9),
-        (r.euler.z * d, 9),
+        (crate::io::bounds::written_yaw_deg(r.euler.z * d), 9),
     ];
     for (k, (v, dec)) in cols.iter().enumerate() {
         if k > 0 {

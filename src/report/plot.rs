@@ -206,7 +206,7 @@ pub fn line_plot(
     } else {
         0
     };
-    let tmp = crate::io::atomic_file::temporary_beside(path, ".png");
+    let tmp = crate::io::atomic_file::temporary_beside(path, ".png")?;
     {
         let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
@@ -329,7 +329,7 @@ pub fn bar_plot(
     threshold: Option<(f64, &str)>,
 ) -> Result<()> {
     register_font();
-    let tmp = crate::io::atomic_file::temporary_beside(path, ".png");
+    let tmp = crate::io::atomic_file::temporary_beside(path, ".png")?;
     {
         let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
         let root = BitMapBackend::new(&tmp, (1000, 600)).into_drawing_area();
@@ -431,7 +431,6 @@ pub fn bar_plot(
 fn finish(tmp: &Path, path: &Path) -> Result<()> {
     use crate::io::atomic_file;
     let bytes = std::fs::read(tmp);
-    let _ = std::fs::remove_file(tmp);
     atomic_file::forget_temporary(tmp);
     let bytes = bytes.map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
     let marked = atomic_file::png_with_text(&bytes, "Software", atomic_file::PNG_SOFTWARE)

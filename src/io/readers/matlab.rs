@@ -403,8 +403,11 @@ pub fn psins_imu_rows(imu: &ImuData) -> Vec<f64> {
 pub fn psins_avp_rows(truth: &[TruthRow]) -> Vec<f64> {
     let mut rows = Vec::with_capacity(truth.len() * AVP_COLUMNS);
     for r in truth {
-        rows.extend_from_slice(&[r.euler.y, r.euler.x, -r.euler.z, r.v.y, r.v.x, -r.v.z]);
-        rows.extend_from_slice(&[r.lat, r.lon, r.h, r.t]);
+        // longitude and yaw within what read_avp takes, whatever the simulator accumulated
+        let yaw = crate::io::bounds::written_yaw_rad(-r.euler.z);
+        rows.extend_from_slice(&[r.euler.y, r.euler.x, yaw, r.v.y, r.v.x, -r.v.z]);
+        let lon = crate::io::bounds::written_lon_rad(r.lon);
+        rows.extend_from_slice(&[r.lat, lon, r.h, r.t]);
     }
     rows
 }

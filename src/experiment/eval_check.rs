@@ -1,0 +1,198 @@
+//! A stored case of explain's evaluation (an entry of `explain-eval`'s `cases.json`) checked like
+//! any input before `--merge` uses it: what the campaign draws for its index (group, hidden term,
+//! λ) is drawn again and compared, and the outcome must be one a run can produce (finite values,
+//! σ > 0, a truth ≠ 0, flags that agree with what was named, names of the library). And the indices of merged
+//! shards must leave no gap.
+
+use crate::experiment::explain_eval::{draw, CaseResult, EvalSpec};
+use crate::model::generated::common;
+
+/// Noise levels explain names, besides `sigma_<measurement>`.
+const NOISE_LEVELS: [&str; 4] = ["gyro_arw", "accel_vrw", "gyro_bias_rw", "accel_bias_rw"];
+
+/// Why the stored case `c` cannot be one the campaign `spec` produced (the field and what is
+/// wrong with it), or Ok.
+pub fn check_case(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
+    check_draw(spec, c)?;
+    check_outcome(c)?;
+    check_numbers(c)
+}
+
+fn is_term(name: &str) -> bool {
+    common::TERMS.iter().any(|t| t.name == name)
+}
+
+fn shown(term: Option<&str>) -> String {
+    term.map(|t| format!("`{t}`"))
+        .unwrap_or_else(|| "none (a null case)".into())
+}
+
+/// The group, term and λ against what the campaign draws for the case's index.
+fn check_draw(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
+    if c.group != "null" && !spec.groups.contains(&c.group) {
+        return Err(format!(
+            "group `{}` is neither `null` nor one of the campaign's groups ({})",
+            c.group,
+            spec.groups.join(", ")
+        ));
+    }
+    if let Some(t) = c.term.as_deref().filter(|t| !is_term(t)) {
+        return Err(format!(
+            "term `{t}` is not a term of the model spec's library"
+        ));
+    }
+    let d = draw(spec, c.index).map_err(|e| e.to_string())?;
+    let (i, seed) = (c.index, spec.seed);
+    if c.group != d.case.group {
+        return Err(format!(
+            "group `{}`: case {i} of seed {seed} draws `{}`",
+            c.group, d.case.group
+        ));
+    }
+    let want = d.case.hidden.first().map(|h| h.0.as_str());
+    if c.term.as_deref() != want {
+        return Err(format!(
+            "term {}: case {i} of seed {seed} hides {}",
+            shown(c.term.as_deref()),
+            shown(want)
+        ));
+    }
+    let [lo, hi] = spec.lambda;
+    match (c.lambda, d.lambda) {
+        (None, None) => Ok(()),
+        (Some(l), _) if !(l.is_finite() && l > 0.0) => Err(format!(
+            "lambda {l}: a noncentrality λ = θ² I is finite and > 0"
+        )),
+        (Some(l), _) if l < lo * (1.0 - 1e-9) || l > hi * (1.0 + 1e-9) => Err(format!(
+            "lambda {l}: outside the campaign's range [{lo}, {hi}] it is drawn from"
+        )),
+        (Some(l), Some(e)) if (l - e).abs() > 1e-9 * e => {
+            Err(format!("lambda {l}: case {i} of seed {seed} draws λ = {e}"))
+        }
+        (Some(_), Some(_)) => Ok(()),
+        (Some(l), None) => Err(format!("lambda {l}: a null case has none")),
+        (None, Some(e)) => Err(format!(
+            "lambda is missing: case {i} of seed {seed} hides its term at λ = {e}"
+        )),
+    }
+}
+
+/// The truth, estimate and σ, the names, and the flags against what was named.
+fn check_outcome(c: &CaseResult) -> Result<(), String> {
+    let null = c.term.is_none();
+    match c.truth {
+        Some(_) if null => return Err("truth: a null case hides nothing".into()),
+        None if !null => return Err("truth is missing for a hidden term".into()),
+        Some(v) if !v.is_finite() || v == 0.0 => {
+            return Err(format!(
+                "truth {v}: a hidden term is put in at λ > 0, so its true value is finite and never 0 (the coefficient error divides by it)"
+            ))
+        }
+        _ => {}
+    }
+    match (c.estimate, c.sigma) {
+        (None, None) => {}
+        (Some(_), Some(_)) if null => {
+            return Err("estimate: a null case has no hidden term to estimate".into())
+        }
+        (Some(e), Some(s)) => {
+            if !e.is_finite() {
+                return Err(format!("estimate {e}: not finite"));
+            }
+            if !(s.is_finite() && s > 0.0) {
+                return Err(format!("sigma {s}: a standard deviation is finite and > 0"));
+            }
+        }
+        _ => return Err("estimate and sigma: one is given without the other".into()),
+    }
+    if let Some(n) = c.named.iter().find(|n| !is_term(n)) {
+        return Err(format!(
+            "named: `{n}` is not a term of the model spec's library"
+        ));
+    }
+    let level = |n: &str| NOISE_LEVELS.contains(&n) || n.len() > 6 && n.starts_with("sigma_");
+    if let Some(n) = c.noise_named.iter().find(|n| !level(n)) {
+        return Err(format!(
+            "noise_named: `{n}` is not a noise level explain names ({}, sigma_<measurement>)",
+            NOISE_LEVELS.join(", ")
+        ));
+    }
+    if let Some(n) = c
+        .noise_stand_ins
+        .iter()
+        .find(|n| !c.noise_named.contains(n))
+    {
+        return Err(format!("noise_stand_ins: `{n}` is not among noise_named"));
+    }
+    check_flags(c)
+}
+
+/// `detected` and `wrong_term` against `named`, as a run sets them.
+fn check_flags(c: &CaseResult) -> Result<(), String> {
+    let (d, w, nothing) = (c.detected, c.wrong_term, c.named.is_empty());
+    let named = c.named.join(", ");
+    let why = match c.term.as_deref() {
+        None if d => "detected = true in a null case (nothing is hidden)".to_string(),
+        None if w == nothing => format!(
+            "wrong_term = {w} in a null case that named {}: there every named term is a wrong one",
+            if nothing { "nothing" } else { &named }
+        ),
+        _ if d && nothing => "detected = true, yet named is empty (nothing was named)".into(),
+        _ if w && nothing => format!(
+            "wrong_term = true with detected = {d}, yet named is empty: a wrong term is a named one"
+        ),
+        Some(t) if !d && c.named.iter().any(|n| n == t) => {
+            format!("detected = false, yet named holds the hidden term `{t}`")
+        }
+        Some(_) if !d && !w && !nothing => format!(
+            "detected = false and wrong_term = false, yet named holds {named}: a named term is the hidden one (detected) or not (a wrong term)"
+        ),
+        _ => return Ok(()),
+    };
+    Err(why)
+}
+
+/// Gain recovery, candidates tested and the case's time.
+fn check_numbers(c: &CaseResult) -> Result<(), String> {
+    // (a gain recovery has no bound but finiteness: the log-likelihood ratio over an oracle
+    // gain just above 10 reaches 65 in real cases, and a worse fit makes either ratio negative)
+    if let Some(g) = c.gain_recovery.filter(|g| !g.is_finite()) {
+        return Err(format!("gain_recovery {g}: not finite"));
+    }
+    if c.candidates_tested > common::TERM_COUNT {
+        return Err(format!(
+            "candidates_tested {}: more than the {} terms of the library",
+            c.candidates_tested,
+            common::TERM_COUNT
+        ));
+    }
+    if !(c.seconds_taken.is_finite() && c.seconds_taken >= 0.0) {
+        return Err(format!(
+            "seconds_taken {}: a time is finite and ≥ 0",
+            c.seconds_taken
+        ));
+    }
+    Ok(())
+}
+
+/// The runs of indices missing between the smallest and the largest of `sorted` (ascending):
+/// (first, last) of each gap.
+pub fn missing_ranges(sorted: &[usize]) -> Vec<(usize, usize)> {
+    sorted
+        .windows(2)
+        .filter(|w| w[1] > w[0] + 1)
+        .map(|w| (w[0] + 1, w[1] - 1))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gaps_between_indices() {
+        assert_eq!(missing_ranges(&[0, 1, 5, 6, 8]), vec![(2, 4), (7, 7)]);
+        assert!(missing_ranges(&[100, 101, 102]).is_empty());
+        assert!(missing_ranges(&[]).is_empty());
+    }
+}
