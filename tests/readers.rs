@@ -293,3 +293,73 @@ fn a_truncated_time_tag_file_is_refused() {
     assert!(gnss_imu::read(&csv).is_ok());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// One corrupted record of the drive's `.tag` (a tick 5 s back, or a file position 777 bytes
+/// on) had moved the IMU clock silently (by up to 5 s): refused naming the record.
+#[test]
+fn a_corrupted_time_tag_record_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = data("gnss-imu-drive/imu_1934.csv");
+    let tag = std::fs::read(data("gnss-imu-drive/imu_1934.csv.tag")).unwrap();
+    for (name, field, delta) in [("tick", 0usize, -5000i64), ("pos", 4usize, 777i64)] {
+        let d = dir.path().join(name);
+        std::fs::create_dir(&d).unwrap();
+        std::fs::copy(&csv, d.join("imu_1934.csv")).unwrap();
+        let mut t = tag.clone();
+        let at = 76 + 8 * 18_000 + field;
+        let v = u32::from_le_bytes(t[at..at + 4].try_into().unwrap()) as i64 + delta;
+        t[at..at + 4].copy_from_slice(&(v as u32).to_le_bytes());
+        std::fs::write(d.join("imu_1934.csv.tag"), t).unwrap();
+        let e = format!("{:#}", gnss_imu::read(&d.join("imu_1934.csv")).unwrap_err());
+        assert!(
+            e.contains("goes back from record") && e.contains("corrupted"),
+            "{name}: {e}"
+        );
+    }
+    // the intact one reads
+    gnss_imu::read(&csv).unwrap();
+}
+
+/// A `.pos` without its column header is read as GPST with a warning that says so; an IMU
+/// whose clock is 1000× slow (ms read as s: 0.1 Hz) is refused with that cause.
+#[test]
+fn a_pos_without_its_time_system_and_a_slow_clock_are_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let pos = std::fs::read_to_string(data("gnss-imu-drive/gnss_1934_sf.pos")).unwrap();
+    let bare: String = pos
+        .lines()
+        .filter(|l| !l.starts_with('%'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let p = dir.path().join("bare.pos");
+    std::fs::write(&p, bare).unwrap();
+    let imu = dir.path().join("imu.txt");
+    let rows: String = (1..=2000)
+        .map(|k| format!("{} 0 0 0 0 0 -0.0980665\n", k as f64 * 10.0))
+        .collect();
+    std::fs::write(&imu, rows).unwrap();
+    let filter = |imu: &std::path::Path| {
+        common::sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--grade",
+            "mems",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--aid",
+            p.to_str().unwrap(),
+            "--init",
+            "40.0966268,-105.1474483,1601.474,-178.19,6.687,178.97",
+            "--out",
+            dir.path().join("o").to_str().unwrap(),
+        ])
+    };
+    let (_, _, err) = filter(&data("gnss-imu-drive/imu_1934.csv"));
+    assert!(
+        err.contains("bare.pos: no column header") && err.contains("read as GPST"),
+        "{err}"
+    );
+    let (ok, _, err) = filter(&imu);
+    assert!(!ok && err.contains("time in ms read as s"), "{err}");
+}

@@ -21,8 +21,9 @@ pub const HEAD_SECONDS: f64 = 10.0;
 pub const HEAD_MAX_SAMPLES: usize = 200_000;
 /// Fewest samples read ahead, whatever their span (a time in ms read as s makes 10 s hold one).
 pub const HEAD_MIN_SAMPLES: usize = 20;
-/// Plausible median sample interval of an IMU [s]: 10 µs to 10 s.
-pub const INTERVAL_RANGE: (f64, f64) = (1e-5, 10.0);
+/// Plausible median sample interval of a strapdown IMU [s]: 10 µs to 1 s (slower data cannot
+/// follow a vehicle's turns; a 100 Hz clock in ms read as s shows 10 s).
+pub const INTERVAL_RANGE: (f64, f64) = (1e-5, 1.0);
 /// Largest gap between two samples, in median sample intervals.
 pub const MAX_GAP_INTERVALS: f64 = 5.0;
 
@@ -142,10 +143,21 @@ impl ImuStream {
         let interval = d[d.len() / 2];
         if !(INTERVAL_RANGE.0..=INTERVAL_RANGE.1).contains(&interval) {
             bail!(
-                "{name}: median sample interval {interval:.3e} s ({:.3e} Hz) is not an IMU's ({} .. {} s): check {clock_hint}",
+                "--imu {name}: median sample interval {interval:.3e} s ({:.3e} Hz) is not a strapdown IMU's ({} .. {} s): check {clock_hint}{}",
                 1.0 / interval,
                 INTERVAL_RANGE.0,
-                INTERVAL_RANGE.1
+                INTERVAL_RANGE.1,
+                if interval > INTERVAL_RANGE.1 {
+                    format!(
+                        " (a time in ms read as s gives 1000× the interval: {:.3} s, {:.0} Hz, if so)",
+                        interval / 1000.0,
+                        1000.0 / interval
+                    )
+                } else if interval < INTERVAL_RANGE.0 {
+                    " (a time in s read as ms, or µs, gives 1/1000 of the interval)".to_string()
+                } else {
+                    String::new()
+                }
             );
         }
         let mut stream = ImuStream {

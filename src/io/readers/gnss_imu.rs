@@ -182,7 +182,33 @@ fn read_tag(tag: &Path) -> Result<Tag> {
             let fpos = u32::from_le_bytes(r[4..8].try_into().expect("4 bytes")) as usize;
             (tick, fpos)
         })
-        .collect();
+        .collect::<Vec<(f64, usize)>>();
+    // zero padding after the records is no record
+    let mut records = records;
+    while records.last().is_some_and(|r| r.0 == 0.0 && r.1 == 0) {
+        records.pop();
+    }
+    // the logger appends: ticks and file positions never decrease; a record that does is
+    // corrupt and would move the least-latency bound, i.e. the whole clock
+    if let Some(k) = records
+        .windows(2)
+        .position(|w| w[1].0 < w[0].0 || w[1].1 < w[0].1)
+    {
+        let (a, b) = (records[k], records[k + 1]);
+        bail!(
+            "{}: record {} (byte {}) goes back from record {}: tick {} ms and file position {} after tick {} ms and position {} \
+             (ticks and positions only grow as the log is written): a corrupted time-tag file, which would shift the IMU clock; \
+             use an intact .tag, or give --clock-offset SECONDS (GPST - IMU clock)",
+            tag.display(),
+            k + 2,
+            76 + 8 * (k + 1),
+            k + 1,
+            b.0,
+            b.1,
+            a.0,
+            a.1
+        );
+    }
     Ok(Tag {
         start: time + sec,
         records,
@@ -194,17 +220,33 @@ fn read_tag(tag: &Path) -> Result<Tag> {
 /// the offset from above and the smallest bound (least latency) is taken.
 fn clock_offset(tag: &Tag, path: &Path, rows: &[([f64; 7], usize)]) -> Result<f64> {
     let mut best = f64::INFINITY;
+    let mut bounds = Vec::with_capacity(tag.records.len());
     let mut k = 0usize;
     for &(tick, fpos) in &tag.records {
         while k + 1 < rows.len() && rows[k + 1].1 <= fpos {
             k += 1;
         }
         if rows[k].1 <= fpos {
-            best = best.min(tag.start + tick * 1e-3 - rows[k].0[6] * 1e-3);
+            let bound = tag.start + tick * 1e-3 - rows[k].0[6] * 1e-3;
+            best = best.min(bound);
+            bounds.push(bound);
         }
     }
     if !best.is_finite() {
         bail!("{}: no record covers a complete IMU line", path.display());
+    }
+    // the least latency is shared by many records (on the shared drive the 10 smallest bounds
+    // lie within 9 ms): a smallest bound far below the fifth smallest is one bad record
+    if bounds.len() >= 5 {
+        bounds.sort_by(f64::total_cmp);
+        if bounds[4] - bounds[0] > 0.05 {
+            bail!(
+                "{}: the smallest clock bound of its records is {:.3} s below the fifth smallest (the least latency is shared by many \
+                 records): a corrupted record would shift the IMU clock; use an intact .tag, or give --clock-offset SECONDS",
+                path.display(),
+                bounds[4] - bounds[0]
+            );
+        }
     }
     // the logger tags the file as it grows: records that stop well before the log's end are a
     // truncated tag file, whose least-latency bound comes from its early part only (a clock

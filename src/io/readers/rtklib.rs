@@ -50,19 +50,20 @@ pub fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
 
 /// Refuses a `.pos` whose column header (`%  UTC  latitude(deg) …`) says its times are not
 /// GPST: RTKLIB writes UTC or JST (UTC+9) when its time-format option asks for them, and read
-/// as GPST they would put every fix 18 s (or 9 h) early against the IMU.
-fn check_time_system(header: &str, file: &str, no: usize) -> Result<()> {
+/// as GPST they would put every fix 18 s (or 9 h) early against the IMU. True when `header`
+/// is the column header (it names GPST).
+fn check_time_system(header: &str, file: &str, no: usize) -> Result<bool> {
     let mut words = header.split_whitespace();
     let (Some(first), rest) = (words.next(), words.collect::<Vec<_>>().join(" ")) else {
-        return Ok(());
+        return Ok(false);
     };
     if !(rest.contains("latitude") || rest.contains("ecef") || rest.contains("week")) {
-        return Ok(());
+        return Ok(false);
     }
     let upper = first.to_ascii_uppercase();
     let first = upper.as_str();
     match first {
-        "GPST" => Ok(()),
+        "GPST" => Ok(true),
         "UTC" | "JST" => bail!(
             "{file}:{no}: the solution's times are {first} (its column header), sinsmodel reads GPST: \
              read as GPST every fix would sit {} against the IMU. Write the solution in GPST \
@@ -74,7 +75,7 @@ fn check_time_system(header: &str, file: &str, no: usize) -> Result<()> {
         other if other.chars().all(|c| c.is_ascii_alphabetic()) && other.len() <= 5 => bail!(
             "{file}:{no}: unknown time system `{other}` in the column header (expected GPST)"
         ),
-        _ => Ok(()),
+        _ => Ok(false),
     }
 }
 
@@ -126,15 +127,23 @@ fn not_lat_lon_deg(f: &[&str]) -> Option<&'static str> {
 pub fn read(path: &Path) -> Result<Vec<PosEpoch>> {
     let mut lines = Lines::open(path, "RTKLIB solution")?;
     let mut out: Vec<PosEpoch> = Vec::new();
+    let mut gpst_said = false;
     while let Some(line) = lines.next_line()? {
         let l = line.text.trim();
         if let Some(header) = l.strip_prefix('%') {
-            check_time_system(header, line.file, line.no)?;
+            gpst_said |= check_time_system(header, line.file, line.no)?;
             check_coordinates(header, line.file, line.no)?;
             continue;
         }
         if l.is_empty() {
             continue;
+        }
+        if out.is_empty() && !gpst_said {
+            eprintln!(
+                "warning: {}: no column header (`%  GPST  latitude(deg) …`) says the time system before the first fix (line {}): \
+                 read as GPST; a UTC solution would put every fix 18 s early against the IMU (RTKLIB writes the header unless told not to)",
+                line.file, line.no
+            );
         }
         let (file, no) = (line.file, line.no);
         let at = || format!("{file}:{no}");
