@@ -73,6 +73,9 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
     sinsmodel::data::check_inside(files.errors.len(), inputs.aid.len(), start.t, t_last)?;
+    if let Some(w) = files.truth_disagreement() {
+        super::data::note(&format!("warning: {w}"));
+    }
     let errors = files.commit(&out, &run, &provenance)?;
     if let (Some(r), 1) = (args.nav_rate, nav.rows) {
         super::data::note(&format!(

@@ -17,6 +17,10 @@ pub struct EpochFiles {
     pub model_error: Option<AtomicFile>,
     /// t [s] and e north, east [rad] (None where the truth has no row) of every epoch.
     pub errors: Vec<(f64, Option<[f64; 2]>)>,
+    /// The model's indices of phi_n, phi_e, phi_d.
+    phi: [Option<usize>; 3],
+    /// Per axis (north, east, down): |e| [rad] and |e| / σ of every epoch with truth.
+    disagreement: [Vec<(f64, f64)>; 3],
 }
 
 impl EpochFiles {
@@ -63,6 +67,8 @@ impl EpochFiles {
             states,
             model_error,
             errors: Vec::new(),
+            phi: ["phi_n", "phi_e", "phi_d"].map(|n| model.index_of(n)),
+            disagreement: Default::default(),
         })
     }
 
@@ -79,6 +85,11 @@ impl EpochFiles {
         if let (Some(f), Some(p)) = (self.model_error.as_mut(), r.phi_true) {
             let e = r.phi_est - p;
             e_ne = Some([e.x, e.y]);
+            for (k, i) in self.phi.iter().enumerate() {
+                if let Some(i) = *i {
+                    self.disagreement[k].push((e[k].abs(), e[k].abs() / r.sigma[i]));
+                }
+            }
             writeln!(
                 f.writer(),
                 "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
@@ -95,6 +106,40 @@ impl EpochFiles {
         }
         self.errors.push((r.t, e_ne));
         Ok(())
+    }
+
+    /// Where the truth contradicts the filter itself, in words (None when it does not): on
+    /// an axis where the median model error over the epochs with truth exceeds 5° and 10 of
+    /// its σ, the truth is not of this run's attitude (yaw in radians or with the opposite
+    /// sign, another body frame).
+    pub fn truth_disagreement(&self) -> Option<String> {
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(0.0)
+        };
+        let mut said = Vec::new();
+        for (k, axis) in ["north tilt", "east tilt", "heading"].iter().enumerate() {
+            let d = &self.disagreement[k];
+            if d.len() < 10 {
+                continue;
+            }
+            let e = median(&mut d.iter().map(|x| x.0).collect());
+            let z = median(&mut d.iter().map(|x| x.1).collect());
+            if e > 5f64.to_radians() && z > 10.0 {
+                said.push(format!(
+                    "{axis} by a median {:.1}° ({z:.0} σ)",
+                    e.to_degrees()
+                ));
+            }
+        }
+        (!said.is_empty()).then(|| {
+            format!(
+                "--truth: the truth's attitude differs from the filter's estimate in {} over the epochs with truth: \
+                 is the truth's yaw in radians, counted the other way (PSINS: counter-clockwise), or of another body \
+                 frame, its roll and pitch in radians? model_error.txt measures against it",
+                said.join(", ")
+            )
+        })
     }
 
     /// Commits states.txt, innovations.txt (written now from `run`) and model_error.txt;
