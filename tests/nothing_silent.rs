@@ -488,3 +488,44 @@ fn a_truth_that_contradicts_the_filter_is_said() {
         );
     }
 }
+
+/// Aiding fixes a day or 9 h away from the IMU's clock (a wrong date, JST read as GPST) had made
+/// `--init auto` blame "the data start moving": refused naming the offset and its likely cause.
+#[test]
+fn aiding_on_another_day_or_clock_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulated(dir.path(), 0.0);
+    let text = std::fs::read_to_string(sim.join("gnss.txt")).unwrap();
+    for (shift, cause) in [(86400.0, "1 day(s) off"), (32400.0, "9 h off")] {
+        let shifted: String = text
+            .lines()
+            .map(|l| match l.split_once(' ') {
+                Some((t, rest)) if !l.starts_with('#') => {
+                    format!("{:.6} {rest}\n", t.parse::<f64>().unwrap() + shift)
+                }
+                _ => format!("{l}\n"),
+            })
+            .collect();
+        let aid = dir.path().join("late.txt");
+        std::fs::write(&aid, shifted).unwrap();
+        for init in ["auto", "30,110,0,0,0,0"] {
+            let (ok, _, err) = sinsmodel(&[
+                "filter",
+                "--model",
+                "P13",
+                "--imu",
+                p(&sim.join("imu.txt")),
+                "--aid",
+                p(&aid),
+                "--init",
+                init,
+                "--out",
+                p(&dir.path().join("o")),
+            ]);
+            assert!(
+                !ok && err.contains("--aid: the aiding fixes run from") && err.contains(cause),
+                "{init}: {err}"
+            );
+        }
+    }
+}

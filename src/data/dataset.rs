@@ -73,7 +73,7 @@ pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<(
 /// same place from another town).
 fn horizontal_distance_m(lat: f64, lon: f64, h: f64, lat2: f64, lon2: f64) -> f64 {
     let dn = (lat2 - lat) * (earth::radius_meridian(lat) + h);
-    let de = (lon2 - lon) * (earth::radius_transverse(lat) + h) * lat.cos();
+    let de = wrap_pi(lon2 - lon) * (earth::radius_transverse(lat) + h) * lat.cos();
     dn.hypot(de)
 }
 
@@ -92,6 +92,7 @@ impl DataOptions {
             note,
         )?;
         let mut plan = self.aid_plan(imu.first_t())?;
+        check_fix_times(&plan, imu.first_t())?;
         let mut truth_reader = match &self.truth {
             Some(p) => Some(truth::TruthReader::open(p)?),
             None => None,
@@ -116,7 +117,7 @@ impl DataOptions {
                 if self.init_auto() { ", where --init auto found its start" } else { "" }
             );
         }
-        self.check_head(&mut imu, &start.state, note)?;
+        self.check_head(&mut imu, &start.state, &plan, note)?;
         check_plan_at_start(&plan, &start.state)?;
         check_fixes(&mut plan, imu.first_t(), note)?;
         let aid = plan.after(t0);
@@ -140,15 +141,28 @@ impl DataOptions {
         &self,
         imu: &mut ImuStream,
         start: &NavState,
+        plan: &AidPlan,
         note: &mut dyn FnMut(&str),
     ) -> Result<()> {
         let imu_path = self.imu_path()?;
+        let witness = rest_witness(plan);
         let e = start.euler();
         let (roll, pitch) = (e.x, e.y);
         let head = crate::io::imu::ImuData {
             samples: imu.head().to_vec(),
         };
-        let check = crate::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true);
+        let mut check = crate::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true);
+        // a start that moves (its velocity, or a GNSS fix over 1 m/s in the first seconds) may
+        // turn steadily on a smooth curve, which looks like rest to the IMU: no gyro judgment
+        let (h0, h1) = (
+            imu.first_t(),
+            head.samples.last().map_or(imu.first_t(), |x| x.t),
+        );
+        let moving = start.v.norm() > 1.0 || witness.as_ref().is_some_and(|w| w.moving(h0, h1));
+        if moving {
+            check.gyro_unit_problems.clear();
+            check.is_static = false;
+        }
         // a MEMS gyro's bias can reach what a unit slip gives: with --grade mems a warning
         let mems = self.grade.as_deref() == Some("mems");
         for p in check.gyro_unit_problems.iter().filter(|_| mems) {
@@ -181,8 +195,9 @@ impl DataOptions {
                 );
             }
         }
+        // (a moving start's specific force holds its accelerations: a turn tilts it)
         if let Some(p) = crate::estimate::align::attitude_contradicts_gravity(&head, roll, pitch)
-            .filter(|_| !self.init_auto())
+            .filter(|_| !self.init_auto() && !moving)
         {
             if self.force {
                 note(&format!("warning: {p} (--force given)"));
@@ -193,11 +208,21 @@ impl DataOptions {
         // the rest of the run, a window at a time as it is read
         use crate::estimate::imu_check::{window_check, WindowJudge};
         let mut judge = WindowJudge::new(start.lat, &check, mems);
+        if let Some(w) = witness {
+            judge.witness_rest(w);
+        }
         let claim = if self.static_aid.is_some() {
             Some("--static-aid")
         } else {
             self.zupt.map(|_| "--zupt")
         };
+        if let (Some(o), true) = (claim, start.v.norm() > 1.0) {
+            bail!(
+                "{o} says the vehicle does not move, but the initial state moves at {:.2} m/s (--init or the truth's first row): \
+                 aid a moving run with GNSS fixes (--aid)",
+                start.v.norm()
+            );
+        }
         if let Some(p) = claim.and_then(|o| judge.claim_rest(o, imu.head())) {
             if self.force {
                 note(&format!(
@@ -388,7 +413,7 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
         );
         let d = [
             (p.lat - (a.lat + w * (b.lat - a.lat))) * rm,
-            (p.lon - (a.lon + w * (b.lon - a.lon))) * rn * p.lat.cos(),
+            wrap_pi(p.lon - (a.lon + w * wrap_pi(b.lon - a.lon))) * rn * p.lat.cos(),
             -(p.h - (a.h + w * (b.h - a.h))),
         ];
         let room = 0.5 * FIX_ACCEL_MAX * ta * tb;
@@ -437,4 +462,89 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
         !drop.contains(&(k - 1))
     });
     Ok(())
+}
+
+/// Refuses aiding fixes that all come before the IMU's first sample `first_t` [s], or whose
+/// first comes more than an hour after it: another clock or date, with the likely one named
+/// from the offset (a day, JST's 9 h, UTC's 18 leap seconds, ms read as s). Checked before
+/// `--init auto`, which otherwise saw no fix while moving and blamed the start.
+fn check_fix_times(plan: &AidPlan, first_t: f64) -> Result<()> {
+    let AidPlan::Fixes(list, _, _) = plan else {
+        return Ok(());
+    };
+    let (Some(a), Some(b)) = (list.first(), list.last()) else {
+        return Ok(());
+    };
+    let (t_a, t_b) = (a.0.t, b.0.t);
+    if t_b > first_t && t_a < first_t + 3600.0 {
+        return Ok(());
+    }
+    let off = t_a - first_t;
+    let near = |x: f64, tol: f64| (off.abs() - x).abs() <= tol;
+    let days = (off.abs() / 86400.0).round();
+    let hint = if days >= 1.0 && near(days * 86400.0, 120.0) {
+        format!("{days:.0} day(s) off: a wrong date in the aiding file, or its week/day rollover?")
+    } else if near(32400.0, 120.0) || near(32418.0, 2.0) {
+        "9 h off: a solution in JST (UTC + 9 h) read as GPST?".to_string()
+    } else if near(18.0, 2.0) {
+        "18 s off: UTC read as GPST?".to_string()
+    } else if t_a.abs() > 0.0 && (first_t / t_a - 1000.0).abs() < 50.0 {
+        "the IMU's clock is about 1000× the aiding's: one of them in ms read as s?".to_string()
+    } else {
+        "the two files are on different clocks (GPS seconds against seconds since power-up?): --clock-offset for a GNSS_IMU csv, or [time] offset in an --imu-format description".to_string()
+    };
+    bail!(
+        "--aid: the aiding fixes run from t = {t_a:.3} to {t_b:.3} s, {} the IMU's first sample (t = {first_t:.3} s): \
+         they {} — {hint}",
+        if off >= 0.0 {
+            format!("starting {} s after", crate::io::units::sig3(off))
+        } else {
+            format!("starting {} s before", crate::io::units::sig3(-off))
+        },
+        if t_b <= first_t {
+            "all end before the IMU starts"
+        } else {
+            "begin more than an hour after the IMU starts"
+        }
+    )
+}
+
+/// What says, beside the IMU, whether the vehicle stands still: a static vehicle, or the GNSS
+/// fixes' horizontal speeds (the receiver's, else from the neighbouring positions).
+fn rest_witness(plan: &AidPlan) -> Option<crate::estimate::imu_check::RestWitness> {
+    use crate::estimate::imu_check::RestWitness;
+    match plan {
+        AidPlan::Static { .. } => Some(RestWitness::Static),
+        AidPlan::Fixes(list, _, _) => {
+            // the speed less three σ of its noise (a speed from positions carries theirs)
+            let speed = |k: usize| -> Option<f64> {
+                if let Some(v) = list[k].1 {
+                    return Some((v.v_ned[0].hypot(v.v_ned[1]) - 3.0 * v.sigma).max(0.0));
+                }
+                let (a, b) = (&list[k.checked_sub(1)?].0, &list.get(k + 1)?.0);
+                let dt = b.t - a.t;
+                let noise = a.sigma[0].max(a.sigma[1]).hypot(b.sigma[0].max(b.sigma[1])) / dt;
+                (dt > 0.0 && dt <= 5.0).then(|| {
+                    (horizontal_distance_m(a.lat, a.lon, a.h, b.lat, b.lon) / dt - 3.0 * noise)
+                        .max(0.0)
+                })
+            };
+            Some(RestWitness::Speeds(
+                (0..list.len())
+                    .filter_map(|k| speed(k).map(|s| (list[k].0.t, s)))
+                    .collect(),
+            ))
+        }
+    }
+}
+
+/// An angle difference [rad] brought into (−π, π] (longitudes across the antimeridian).
+fn wrap_pi(x: f64) -> f64 {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let r = x.rem_euclid(two_pi);
+    if r > std::f64::consts::PI {
+        r - two_pi
+    } else {
+        r
+    }
 }

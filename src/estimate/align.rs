@@ -286,7 +286,22 @@ pub fn align(
         },
         coarse_lat_deg: (!no_heading).then_some(c.lat * deg),
         gyro_bias_deg_h: [eps[0], eps[1], eps[2]],
-        gyro_bias_sigma_deg_h: [eps_sigma[0], eps_sigma[1], eps_sigma[2]],
+        // a horizontal gyro bias and the heading error are one unknown at rest (ε_E = Ω cos L
+        // δψ): the x and y biases are no better known than the heading lets them be (with no
+        // heading, up to the whole horizontal Earth rate)
+        gyro_bias_sigma_deg_h: {
+            let psi = if no_heading {
+                1.0
+            } else {
+                fine.heading_sigma.min(1.0)
+            };
+            let coupled = crate::nav::earth::OMEGA * lat_used.cos() * psi.sin() * deg_h;
+            [
+                eps_sigma[0].hypot(coupled),
+                eps_sigma[1].hypot(coupled),
+                eps_sigma[2],
+            ]
+        },
     })
 }
 

@@ -447,6 +447,48 @@ pub struct WindowJudge {
     rest_claim: Option<RestClaim>,
     /// Time of the run's first sample [s] (times are said from it).
     t_first: f64,
+    /// What says the vehicle is at rest, beside the IMU (whose steady turn on a smooth curve
+    /// looks like rest): None, nothing (the gyros of later windows are not judged).
+    rest_witness: Option<RestWitness>,
+}
+
+/// What says, beside the IMU, that the vehicle stands still in a stretch.
+#[derive(Debug, Clone)]
+pub enum RestWitness {
+    /// A static vehicle is given (`--static-aid`).
+    Static,
+    /// GNSS speeds: (t [s], horizontal speed [m/s]) of every fix.
+    Speeds(Vec<(f64, f64)>),
+}
+
+/// Fastest a GNSS fix may show in a stretch taken as at rest [m/s].
+pub const REST_SPEED_MAX: f64 = 0.3;
+
+impl RestWitness {
+    /// True when the witness says the vehicle stands still from `t0` to `t1` [s] (static, or
+    /// at least one GNSS fix there and none faster than [`REST_SPEED_MAX`]).
+    pub fn at_rest(&self, t0: f64, t1: f64) -> bool {
+        match self {
+            RestWitness::Static => true,
+            RestWitness::Speeds(v) => {
+                let inside: Vec<f64> = v
+                    .iter()
+                    .filter(|x| x.0 >= t0 && x.0 <= t1)
+                    .map(|x| x.1)
+                    .collect();
+                !inside.is_empty() && inside.iter().all(|s| *s <= REST_SPEED_MAX)
+            }
+        }
+    }
+
+    /// True when the witness says the vehicle moves from `t0` to `t1` [s] (a GNSS fix there
+    /// faster than 1 m/s).
+    pub fn moving(&self, t0: f64, t1: f64) -> bool {
+        match self {
+            RestWitness::Static => false,
+            RestWitness::Speeds(v) => v.iter().any(|x| x.0 >= t0 && x.0 <= t1 && x.1 > 1.0),
+        }
+    }
 }
 
 /// The stretch `t0`–`t1` [s] of a run whose first sample is at `t_first` [s], in words: on the
@@ -469,8 +511,9 @@ pub const MOVING_F_SPREAD: f64 = 0.3;
 /// between [m/s²] (a constant acceleration begun or ended).
 pub const MOVING_F_STEP: f64 = 0.3;
 /// A window turns when its 1-s mean angular rates spread by more than this, or its mean rate
-/// exceeds it [rad/s] (2 deg/s: above an uncalibrated MEMS gyro's bias).
-pub const TURNING_RATE: f64 = 2.0 * std::f64::consts::PI / 180.0;
+/// differs by more than this from the first window's [rad/s] (0.2 deg/s: a slow turntable
+/// tilt turns; a gyro's bias, in both, cancels).
+pub const TURNING_RATE: f64 = 0.2 * std::f64::consts::PI / 180.0;
 
 /// What a claim of rest holds a run to, window by window: translation shows in the specific
 /// force of windows that do not turn (turning in place is allowed).
@@ -480,6 +523,8 @@ pub struct RestClaim {
     option: &'static str,
     /// Mean specific force of the last window that did not turn, FRD [m/s²]; None after a turn.
     reference: Option<Vector3<f64>>,
+    /// Mean angular rate of the first window, FRD [rad/s] (the gyro bias, at rest).
+    w_first: Option<Vector3<f64>>,
 }
 
 impl RestClaim {
@@ -496,7 +541,9 @@ impl RestClaim {
             crate::estimate::align::rest_evidence(&data, window.len(), earth::gravity(0.0, 0.0))
                 .first()
                 .copied()?;
-        if e.w_spread > TURNING_RATE || e.w_mean.norm() > TURNING_RATE {
+        // turning: against the first window's mean rate (a MEMS gyro's bias cancels)
+        let w0 = *self.w_first.get_or_insert(e.w_mean);
+        if e.w_spread > TURNING_RATE || (e.w_mean - w0).norm() > TURNING_RATE {
             self.reference = None;
             return None;
         }
@@ -527,7 +574,15 @@ impl WindowJudge {
             gyro_warn_only,
             rest_claim: None,
             t_first: head.window_s[0],
+            rest_witness: None,
         }
+    }
+
+    /// Lets the gyros of the first later window at rest be judged where `witness` confirms
+    /// the rest (without one only the specific force of later windows is judged: a steady turn
+    /// on a smooth curve looks like rest to the IMU and reads like a gyro bias or a unit slip).
+    pub fn witness_rest(&mut self, witness: RestWitness) {
+        self.rest_witness = Some(witness);
     }
 
     /// Holds every window to `option`'s claim that the vehicle does not move for the whole
@@ -541,6 +596,7 @@ impl WindowJudge {
         let mut claim = RestClaim {
             option,
             reference: None,
+            w_first: None,
         };
         let found = claim.judge(head, self.t_first);
         self.rest_claim = Some(claim);
@@ -567,7 +623,12 @@ impl WindowJudge {
         let mut said = Said::default();
         if !m.is_static {
             said.moving(&m);
-        } else if !self.rest_judged {
+        } else if !self.rest_judged
+            && self
+                .rest_witness
+                .as_ref()
+                .is_some_and(|w| w.at_rest(t0, t1))
+        {
             self.rest_judged = true;
             said.at_rest(&m, true);
         } else if !(0.5..2.0).contains(&m.gravity_ratio) {

@@ -44,7 +44,7 @@ pub fn lines(a: &Alignment, lat_given: bool) -> Vec<String> {
         )
     };
     v.push(format!(
-        "gyro bias estimates x y z [deg/h], with 1-σ from the fine alignment: {}, {}, {}",
+        "gyro bias estimates x y z [deg/h], with 1-σ (fine alignment; x and y also the heading's): {}, {}, {}",
         b(0),
         b(1),
         b(2)
