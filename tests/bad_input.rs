@@ -26,6 +26,39 @@ fn navigate(imu: &Path, out: &Path) -> (bool, String) {
     ])
 }
 
+/// Simulates the scenario `toml` into `d/o` (its text in `d/s.toml`); returns `d/o`.
+fn simulated(d: &Path, toml: &str) -> std::path::PathBuf {
+    let sc = d.join("s.toml");
+    std::fs::write(&sc, toml).unwrap();
+    let o = d.join("o");
+    let (ok, err) = run(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    o
+}
+
+/// Writes the IMU text `text` to `path` with `f` applied to each data row's values (its index
+/// among the lines, the values t dθ dv), comments kept.
+fn rewrite_imu(text: &str, path: &Path, f: &dyn Fn(usize, &mut Vec<f64>)) {
+    let mut out = String::new();
+    for (k, l) in text.lines().enumerate() {
+        if l.starts_with('#') {
+            out.push_str(l);
+        } else {
+            let mut v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            f(k, &mut v);
+            let w: Vec<String> = v.iter().map(|x| format!("{x:.15e}")).collect();
+            out.push_str(&w.join(" "));
+        }
+        out.push('\n');
+    }
+    std::fs::write(path, out).unwrap();
+}
+
 const GOOD: &str = "# t dth dv\n0.01 0 0 0 0 0 -0.098\n0.02 0 0 0 0 0 -0.098\n0.03 0 0 0 0 0 -0.098\n0.04 0 0 0 0 0 -0.098\n";
 
 #[test]
@@ -507,40 +540,11 @@ fn a_scenario_that_would_take_hours_is_refused_with_its_estimate() {
 fn imu_unit_and_clock_slips_are_refused_with_their_cause() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("s.toml");
-    std::fs::write(
-        &sc,
-        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
-    )
-    .unwrap();
-    let o = d.join("o");
-    let (ok, err) = run(&[
-        "simulate",
-        sc.to_str().unwrap(),
-        "--out",
-        o.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let o = simulated(d, "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n");
     let text = std::fs::read_to_string(o.join("imu.txt")).unwrap();
     let rewrite = |name: &str, f: &dyn Fn(&[f64]) -> Vec<f64>| {
-        let mut out = String::new();
-        for l in text.lines() {
-            if l.starts_with('#') {
-                out.push_str(l);
-            } else {
-                let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-                let w = f(&v);
-                out.push_str(
-                    &w.iter()
-                        .map(|x| format!("{x:.15e}"))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                );
-            }
-            out.push('\n');
-        }
         let p = d.join(name);
-        std::fs::write(&p, out).unwrap();
+        rewrite_imu(&text, &p, &|_, v| *v = f(v));
         p
     };
     let g = 9.80665;
@@ -658,40 +662,17 @@ fn imu_unit_and_clock_slips_are_refused_with_their_cause() {
 fn imu_slips_after_the_first_seconds_are_found_where_the_data_show_them() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("s.toml");
-    std::fs::write(
-        &sc,
-        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
-    )
-    .unwrap();
-    let o = d.join("o");
-    let (ok, err) = run(&[
-        "simulate",
-        sc.to_str().unwrap(),
-        "--out",
-        o.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let o = simulated(d, "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n");
     let text = std::fs::read_to_string(o.join("imu.txt")).unwrap();
     // the first 20 s shaken (±2 m/s² alternating on x: the mean stays, the spread is 2 m/s²)
     let rewrite = |name: &str, f: &dyn Fn(&mut [f64])| {
-        let mut out = String::new();
-        for (k, l) in text.lines().enumerate() {
-            if l.starts_with('#') {
-                out.push_str(l);
-            } else {
-                let mut v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-                if v[0] < 20.0 {
-                    v[4] += if k % 2 == 0 { 0.02 } else { -0.02 };
-                }
-                f(&mut v);
-                let w: Vec<String> = v.iter().map(|x| format!("{x:.15e}")).collect();
-                out.push_str(&w.join(" "));
-            }
-            out.push('\n');
-        }
         let p = d.join(name);
-        std::fs::write(&p, out).unwrap();
+        rewrite_imu(&text, &p, &|k, v| {
+            if v[0] < 20.0 {
+                v[4] += if k % 2 == 0 { 0.02 } else { -0.02 };
+            }
+            f(v)
+        });
         p
     };
     let deg = 180.0 / std::f64::consts::PI;
@@ -756,21 +737,8 @@ fn imu_slips_after_the_first_seconds_are_found_where_the_data_show_them() {
 fn a_claim_of_rest_on_data_that_move_is_refused_where_they_move() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("s.toml");
-    std::fs::write(
-        &sc,
-        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 25.0\n\
-         [[segment]]\nkind = \"accelerate\"\nduration_s = 20.0\naccel_mps2 = 1.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
-    )
-    .unwrap();
-    let o = d.join("o");
-    let (ok, err) = run(&[
-        "simulate",
-        sc.to_str().unwrap(),
-        "--out",
-        o.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let o = simulated(d, "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\n[[segment]]\nkind = \"rest\"\nduration_s = 25.0\n\
+         [[segment]]\nkind = \"accelerate\"\nduration_s = 20.0\naccel_mps2 = 1.0\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n");
     let imu = o.join("imu.txt");
     let filter = |extra: &[&str], out: &str| {
         let out = d.join(out);
@@ -822,37 +790,14 @@ fn a_claim_of_rest_on_data_that_move_is_refused_where_they_move() {
 fn a_gyro_rate_at_rest_beyond_the_grade_names_the_unit_slip() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("s.toml");
-    std::fs::write(
-        &sc,
-        "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = -105.0\neuler_deg = [0.0, 0.0, 30.0]\n\
-         [[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[errors]\neps_z = \"10 deg/h\"\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n",
-    )
-    .unwrap();
-    let o = d.join("o");
-    let (ok, err) = run(&[
-        "simulate",
-        sc.to_str().unwrap(),
-        "--out",
-        o.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let o = simulated(d, "name = \"s\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = -105.0\neuler_deg = [0.0, 0.0, 30.0]\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[errors]\neps_z = \"10 deg/h\"\n[gnss]\nrate_hz = 1.0\nsigma_ne = \"0.5 m\"\nsigma_d = \"1 m\"\n");
     let deg = 180.0 / std::f64::consts::PI;
     let text = std::fs::read_to_string(o.join("imu.txt")).unwrap();
-    let mut out = String::new();
-    for l in text.lines() {
-        if l.starts_with('#') {
-            out.push_str(l);
-        } else {
-            let mut v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            v[1..4].iter_mut().for_each(|x| *x *= deg);
-            let w: Vec<String> = v.iter().map(|x| format!("{x:.15e}")).collect();
-            out.push_str(&w.join(" "));
-        }
-        out.push('\n');
-    }
     let imu = d.join("dps.txt");
-    std::fs::write(&imu, out).unwrap();
+    rewrite_imu(&text, &imu, &|_, v| {
+        v[1..4].iter_mut().for_each(|x| *x *= deg)
+    });
     let gnss = o.join("gnss.txt");
     let filter = |grade: Option<&str>, out: &str| {
         let out = d.join(out);
