@@ -73,7 +73,7 @@ pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<(
 /// same place from another town).
 fn horizontal_distance_m(lat: f64, lon: f64, h: f64, lat2: f64, lon2: f64) -> f64 {
     let dn = (lat2 - lat) * (earth::radius_meridian(lat) + h);
-    let de = wrap_pi(lon2 - lon) * (earth::radius_transverse(lat) + h) * lat.cos();
+    let de = earth::lon_difference(lon2, lon) * (earth::radius_transverse(lat) + h) * lat.cos();
     dn.hypot(de)
 }
 
@@ -386,14 +386,7 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
     use crate::estimate::init::{self, Fix};
     let fixes: Vec<Fix> = list
         .iter()
-        .map(|(p, v)| Fix {
-            t: p.t,
-            pos: [p.lat, p.lon, p.h],
-            sigma_pos: p.sigma[0].max(p.sigma[1]),
-            v: v.map(|v| nalgebra::Vector3::from(v.v_ned)),
-            sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
-            derived: false,
-        })
+        .map(|(p, v)| Fix::from_aiding(p, v.as_ref()))
         .collect();
     let receiver: Vec<bool> = list.iter().map(|(_, v)| v.is_some()).collect();
     init::check_velocities(&fixes, &receiver)?;
@@ -413,7 +406,9 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
         );
         let d = [
             (p.lat - (a.lat + w * (b.lat - a.lat))) * rm,
-            wrap_pi(p.lon - (a.lon + w * wrap_pi(b.lon - a.lon))) * rn * p.lat.cos(),
+            earth::lon_difference(p.lon, a.lon + w * earth::lon_difference(b.lon, a.lon))
+                * rn
+                * p.lat.cos(),
             -(p.h - (a.h + w * (b.h - a.h))),
         ];
         let room = 0.5 * FIX_ACCEL_MAX * ta * tb;
@@ -535,16 +530,5 @@ fn rest_witness(plan: &AidPlan) -> Option<crate::estimate::imu_check::RestWitnes
                     .collect(),
             ))
         }
-    }
-}
-
-/// An angle difference [rad] brought into (−π, π] (longitudes across the antimeridian).
-fn wrap_pi(x: f64) -> f64 {
-    let two_pi = 2.0 * std::f64::consts::PI;
-    let r = x.rem_euclid(two_pi);
-    if r > std::f64::consts::PI {
-        r - two_pi
-    } else {
-        r
     }
 }

@@ -247,14 +247,7 @@ impl DataOptions {
                 let kept: Vec<_> = list.iter().filter(|(p, _)| outside(p.t)).collect();
                 (
                     kept.iter()
-                        .map(|(p, v)| Fix {
-                            t: p.t,
-                            pos: [p.lat, p.lon, p.h],
-                            sigma_pos: p.sigma[0].max(p.sigma[1]),
-                            v: v.map(|v| Vector3::from(v.v_ned)),
-                            sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
-                            derived: false,
-                        })
+                        .map(|(p, v)| Fix::from_aiding(p, v.as_ref()))
                         .collect::<Vec<_>>(),
                     None,
                     kept.iter().map(|(_, v)| v.is_some()).collect::<Vec<_>>(),

@@ -377,12 +377,11 @@ pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>,
             let (lat, lon, h, sig) = ep.pos?;
             // the fix's longitude as the turn nearest the state's (across the antimeridian a
             // fix at −179.9° is 0.2° from a state at 179.9°, not 359.8°)
-            let lon = if (lon - s.lon).abs() > std::f64::consts::PI {
-                let two_pi = 2.0 * std::f64::consts::PI;
-                s.lon + (lon - s.lon + std::f64::consts::PI).rem_euclid(two_pi)
-                    - std::f64::consts::PI
-            } else {
+            // (a fix within half a turn is taken as it is, to the last bit)
+            let lon = if (s.lon - lon).abs() <= std::f64::consts::PI {
                 lon
+            } else {
+                s.lon - earth::lon_difference(s.lon, lon)
             };
             (aid.lat, aid.lon, aid.h) = (lat, lon, h);
             (aid.sigma_n, aid.sigma_e, aid.sigma_d) = (sig[0], sig[1], sig[2]);
@@ -698,12 +697,8 @@ impl<'a> Engine<'a> {
         let pos_err_ne = truth_row.map(|row| {
             [
                 (s.lat - row.lat) * (earth::radius_meridian(row.lat) + row.h),
-                if (s.lon - row.lon).abs() > std::f64::consts::PI {
-                    (s.lon - row.lon + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
-                        - std::f64::consts::PI
-                } else {
-                    s.lon - row.lon
-                } * (earth::radius_transverse(row.lat) + row.h)
+                earth::lon_difference(s.lon, row.lon)
+                    * (earth::radius_transverse(row.lat) + row.h)
                     * row.lat.cos(),
             ]
         });

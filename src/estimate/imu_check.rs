@@ -471,12 +471,8 @@ impl RestWitness {
         match self {
             RestWitness::Static => true,
             RestWitness::Speeds(v) => {
-                let inside: Vec<f64> = v
-                    .iter()
-                    .filter(|x| x.0 >= t0 && x.0 <= t1)
-                    .map(|x| x.1)
-                    .collect();
-                !inside.is_empty() && inside.iter().all(|s| *s <= REST_SPEED_MAX)
+                let mut inside = v.iter().filter(|x| x.0 >= t0 && x.0 <= t1).peekable();
+                inside.peek().is_some() && inside.all(|x| x.1 <= REST_SPEED_MAX)
             }
         }
     }
@@ -494,11 +490,14 @@ impl RestWitness {
 /// The stretch `t0`–`t1` [s] of a run whose first sample is at `t_first` [s], in words: on the
 /// data's clock when that starts near 0, else from the first sample and on the data's clock.
 pub fn span_words(t0: f64, t1: f64, t_first: f64) -> String {
-    let rel = format!("{:.1}–{:.1} s", t0 - t_first, t1 - t_first);
     if t_first.abs() < 1.0 {
         format!("{t0:.1}–{t1:.1} s")
     } else {
-        format!("{rel} from the first IMU sample (t = {t0:.1} s on the data's clock)")
+        format!(
+            "{:.1}–{:.1} s from the first IMU sample (t = {t0:.1} s on the data's clock)",
+            t0 - t_first,
+            t1 - t_first
+        )
     }
 }
 
@@ -528,19 +527,16 @@ pub struct RestClaim {
 }
 
 impl RestClaim {
-    /// Judges `window` (consecutive samples, FRD increments; its first at `t_first` [s] from
-    /// the run's first sample): the claim and the motion that contradicts it, in words.
-    fn judge(&mut self, window: &[crate::io::imu::ImuSample], t_first: f64) -> Option<String> {
+    /// Judges the window `data` (consecutive samples, FRD increments; times said from the run's
+    /// first sample at `t_first` [s]): the claim and the motion that contradicts it, in words.
+    fn judge(&mut self, data: &ImuData, t_first: f64) -> Option<String> {
+        let window = &data.samples;
         if window.len() < 12 {
             return None;
         }
-        let data = ImuData {
-            samples: window.to_vec(),
-        };
-        let e =
-            crate::estimate::align::rest_evidence(&data, window.len(), earth::gravity(0.0, 0.0))
-                .first()
-                .copied()?;
+        let e = crate::estimate::align::rest_evidence(data, window.len(), earth::gravity(0.0, 0.0))
+            .first()
+            .copied()?;
         // turning: against the first window's mean rate (a MEMS gyro's bias cancels)
         let w0 = *self.w_first.get_or_insert(e.w_mean);
         if e.w_spread > TURNING_RATE || (e.w_mean - w0).norm() > TURNING_RATE {
@@ -598,7 +594,10 @@ impl WindowJudge {
             reference: None,
             w_first: None,
         };
-        let found = claim.judge(head, self.t_first);
+        let head = ImuData {
+            samples: head.to_vec(),
+        };
+        let found = claim.judge(&head, self.t_first);
         self.rest_claim = Some(claim);
         found
     }
@@ -610,14 +609,14 @@ impl WindowJudge {
         if window.len() < 12 {
             return None;
         }
-        if let Some(claim) = self.rest_claim.as_mut() {
-            if let Some(p) = claim.judge(window, self.t_first) {
-                return Some((p, false));
-            }
-        }
         let data = ImuData {
             samples: window.to_vec(),
         };
+        if let Some(claim) = self.rest_claim.as_mut() {
+            if let Some(p) = claim.judge(&data, self.t_first) {
+                return Some((p, false));
+            }
+        }
         let (t0, t1) = (window[0].t, window[window.len() - 1].t);
         let m = Seen::of(&data, Some(self.lat), t0, t1 - t0);
         let mut said = Said::default();
@@ -656,20 +655,20 @@ pub fn window_check(
 ) -> crate::io::imu_stream::WindowCheck {
     let mut warned = false;
     Box::new(move |w| {
-        match judge.judge(w) {
-        Some((p, warn_only)) if warn_only || force => {
-            if !warned {
-                warned = true;
-                let why = if force { "--force given" } else { why_warn };
-                eprintln!("warning: --imu {name}: {p} ({why})");
-            }
-            Ok(())
+        let Some((p, warn_only)) = judge.judge(w) else {
+            return Ok(());
+        };
+        if !(warn_only || force) {
+            anyhow::bail!(
+                "--imu {name}: {p} (after the first 10 s: `sinsmodel imu-check --skip S` shows that stretch; --force runs anyway)"
+            );
         }
-        Some((p, _)) => anyhow::bail!(
-            "--imu {name}: {p} (after the first 10 s: `sinsmodel imu-check --skip S` shows that stretch; --force runs anyway)"
-        ),
-        None => Ok(()),
-    }
+        if !warned {
+            warned = true;
+            let why = if force { "--force given" } else { why_warn };
+            eprintln!("warning: --imu {name}: {p} ({why})");
+        }
+        Ok(())
     })
 }
 
@@ -690,15 +689,15 @@ pub fn gyro_bias_beyond_grade(check: &ImuCheck, grade: Option<&str>) -> Option<S
     let (limit, words) = match grade {
         None => (
             150.0,
-            "navigation-grade gyro's (the default grade; prior 0.02 deg/h",
+            "a navigation-grade gyro's (the default grade; prior 0.02 deg/h",
         ),
-        Some("tactical") => (300.0, "tactical-grade gyro's (prior 1 deg/h"),
+        Some("tactical") => (300.0, "a tactical-grade gyro's (prior 1 deg/h"),
         _ => return None,
     };
     let b = least_gyro_bias_deg_h(check)?;
     (b > limit).then(|| {
         format!(
-            "at rest the gyros read {} deg/h ({}× Earth rate): a bias of at least {} deg/h, beyond a {words}, \
+            "at rest the gyros read {} deg/h ({}× Earth rate): a bias of at least {} deg/h, beyond {words}, \
              at most {limit} deg/h accepted); the gyro values may be deg/s read as rad/s (57.3× the true rate: check gyro_unit), or the \
              sensor is of a lower grade (--grade tactical or mems, or --prior 'eps_*=…')",
             crate::io::units::sig3(check.earth_rate_ratio * earth::OMEGA.to_degrees() * 3600.0),

@@ -122,6 +122,21 @@ pub struct Fix {
 }
 
 impl Fix {
+    /// A fix from an aiding file's position `p` and its receiver velocity `v`, when it has one.
+    pub fn from_aiding(
+        p: &crate::io::aiding::PositionFix,
+        v: Option<&crate::io::aiding::VelocityFix>,
+    ) -> Fix {
+        Fix {
+            t: p.t,
+            pos: [p.lat, p.lon, p.h],
+            sigma_pos: p.sigma[0].max(p.sigma[1]),
+            v: v.map(|v| Vector3::from(v.v_ned)),
+            sigma_v: v.map(|v| v.sigma).unwrap_or(0.0),
+            derived: false,
+        }
+    }
+
     fn speed(&self) -> f64 {
         self.v.map(|v| v.x.hypot(v.y)).unwrap_or(0.0)
     }

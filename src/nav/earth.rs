@@ -42,6 +42,19 @@ fn gamma0(lat: f64) -> f64 {
     GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / (1.0 - E2 * s2).sqrt()
 }
 
+/// Longitude difference `a − b` [rad] as the shorter way round, in (−π, π]: across the
+/// antimeridian 179.9° − (−179.9°) is −0.2°, not 359.8°. Unchanged to the last bit when it
+/// is already within ±π.
+pub fn lon_difference(a: f64, b: f64) -> f64 {
+    let d = a - b;
+    if d.abs() <= std::f64::consts::PI {
+        d
+    } else {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        -((-d + std::f64::consts::PI).rem_euclid(two_pi) - std::f64::consts::PI)
+    }
+}
+
 /// Normal gravity magnitude γ(lat, h) [m/s²], pointing down in NED.
 pub fn gravity(lat: f64, h: f64) -> f64 {
     gamma0(lat) * free_air(lat, h)
@@ -143,6 +156,16 @@ impl LocalEarth {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn lon_difference_is_the_shorter_way_round() {
+        let d = std::f64::consts::PI / 180.0;
+        assert!((super::lon_difference(179.9 * d, -179.9 * d) + 0.2 * d).abs() < 1e-12);
+        assert!((super::lon_difference(-179.9 * d, 179.9 * d) - 0.2 * d).abs() < 1e-12);
+        // within half a turn: the plain difference, to the last bit
+        let (a, b) = (1.234_567_891, -0.987_654_321);
+        assert_eq!(super::lon_difference(a, b).to_bits(), (a - b).to_bits());
+    }
+
     use super::*;
 
     #[test]
