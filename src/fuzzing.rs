@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 /// Names of the targets, as `fuzz/fuzz_targets/NAME.rs` and `fuzz/corpus/NAME/` use them.
-pub const TARGETS: [&str; 12] = [
+pub const TARGETS: [&str; 15] = [
     "spec",
     "units",
     "scenario",
@@ -28,6 +28,9 @@ pub const TARGETS: [&str; 12] = [
     "aiding",
     "truth",
     "matlab",
+    "dataset",
+    "noise",
+    "eval_case",
 ];
 
 /// The target function of a name in [`TARGETS`]; `spec` is the spec compiler's own
@@ -46,6 +49,9 @@ pub fn target(name: &str) -> Option<fn(&[u8])> {
         "aiding" => Some(aiding),
         "truth" => Some(truth),
         "matlab" => Some(matlab),
+        "dataset" => Some(dataset),
+        "noise" => Some(noise),
+        "eval_case" => Some(eval_case),
         _ => None,
     }
 }
@@ -203,12 +209,16 @@ fn scratch() -> &'static Path {
     })
 }
 
-/// Writes each (file name, bytes) into the scratch directory and returns their paths.
+/// Writes each (file name, bytes) into the scratch directory (a subdirectory per thread, so
+/// that targets run side by side in one test process do not share files) and returns their
+/// paths.
 fn files(items: &[(&str, &[u8])]) -> Vec<std::path::PathBuf> {
+    let dir = scratch().join(format!("{:?}", std::thread::current().id()).replace(['(', ')'], ""));
+    std::fs::create_dir_all(&dir).expect("scratch directory of a thread");
     items
         .iter()
         .map(|(name, bytes)| {
-            let p = scratch().join(name);
+            let p = dir.join(name);
             std::fs::write(&p, bytes).expect("write a fuzz input");
             p
         })
@@ -385,4 +395,158 @@ pub fn matlab(data: &[u8]) {
             );
         }
     }
+}
+
+/// A whole data set as `filter`, `navigate` and `explain` open it
+/// ([`crate::data::DataOptions::open`], then the IMU read to its end): an IMU text file and a
+/// position aiding file (the input after its first byte, split in two). The first byte picks the
+/// options: bit 0 `--init auto` (else `--init 28.22,112.99,0,0,0,0`, where the seed corpus
+/// lies), bit 1 `--static-aid 28.22,112.99,0` instead of the aiding file, bit 2 `--zupt 0.01`,
+/// bit 3 `--grade mems`, bit 4 `--force`, bit 5 `--mode closed`. So every check of a run's
+/// inputs runs on it: the first seconds' and every later 10-s window's magnitudes (unit, scale
+/// and clock slips), a rest claim against the motion, the GNSS fixes against themselves and
+/// against the IMU's clock, the start against the first fix. Property: an accepted data set has
+/// finite samples with time increasing and finite aiding epochs with σ > 0 inside the IMU data.
+pub fn dataset(data: &[u8]) {
+    let _ = dataset_outcome(data);
+}
+
+/// The body of [`dataset`], with what became of the input: None when it holds no two files,
+/// else whether the data set was accepted (read to its end) or refused, and why.
+pub fn dataset_outcome(data: &[u8]) -> Option<anyhow::Result<()>> {
+    let (&flags, rest) = data.split_first()?;
+    let (imu, aid) = split2(rest)?;
+    let p = files(&[("ds_imu.txt", imu), ("ds_aid.txt", aid)]);
+    let mut o = crate::data::DataOptions::none();
+    o.imu = Some(p[0].clone());
+    o.init = Some(
+        if flags & 1 != 0 {
+            "auto"
+        } else {
+            "28.22,112.99,0,0,0,0"
+        }
+        .into(),
+    );
+    if flags & 2 != 0 {
+        o.static_aid = Some(vec![28.22, 112.99, 0.0]);
+    } else {
+        o.aid = Some(p[1].clone());
+    }
+    o.zupt = (flags & 4 != 0).then_some(0.01);
+    o.grade = (flags & 8 != 0).then(|| "mems".to_string());
+    o.force = flags & 16 != 0;
+    if flags & 32 != 0 {
+        o.mode = "closed".into();
+    }
+    let mut ds = match o.open(&mut |_| {}) {
+        Ok(ds) => ds,
+        Err(e) => return Some(Err(e)),
+    };
+    finite(ds.step_s, "filter step");
+    let mut prev = f64::NEG_INFINITY;
+    let mut last = ds.start.t;
+    loop {
+        let s = match ds.imu.next() {
+            Ok(Some(s)) => s,
+            Ok(None) => break,
+            Err(e) => return Some(Err(e)),
+        };
+        finite(s.t, "sample time");
+        s.dtheta
+            .iter()
+            .chain(s.dv.iter())
+            .for_each(|v| finite(*v, "increment"));
+        assert!(s.t > prev, "accepted time {} after {prev}", s.t);
+        prev = s.t;
+        last = s.t;
+    }
+    for e in ds.aid.epochs().take_while(|e| e.t <= last) {
+        finite(e.t, "aiding time");
+        if let Some((v, sigma)) = e.vel {
+            v.iter().for_each(|x| finite(*x, "aiding velocity"));
+            assert!(
+                sigma.is_finite() && sigma > 0.0,
+                "accepted velocity σ {sigma}"
+            );
+        }
+        if let Some((lat, lon, h, sigma)) = e.pos {
+            [lat, lon, h]
+                .iter()
+                .for_each(|x| finite(*x, "aiding position"));
+            assert!(
+                lat.abs() <= std::f64::consts::FRAC_PI_2,
+                "accepted latitude {lat}"
+            );
+            assert!(
+                sigma.iter().all(|s| s.is_finite() && *s > 0.0),
+                "accepted position σ {sigma:?}"
+            );
+        }
+    }
+    Some(Ok(()))
+}
+
+/// The noise levels `--noise` gives: the input as an `allan --json` file, and as the option's
+/// inline text (`arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`). Property: accepted white noises
+/// are finite and > 0, accepted bias random walks finite and >= 0.
+pub fn noise(data: &[u8]) {
+    let p = files(&[("noise.json", data)]);
+    let check = |n: crate::data::NoiseGiven| {
+        for (v, what) in [(n.arw, "arw"), (n.vrw, "vrw")] {
+            assert!(v.is_finite() && v > 0.0, "accepted {what} {v}");
+        }
+        for (v, what) in [
+            (n.gyro_bias_rw, "gyro_bias_rw"),
+            (n.accel_bias_rw, "accel_bias_rw"),
+        ] {
+            assert!(v.is_finite() && v >= 0.0, "accepted {what} {v}");
+        }
+    };
+    if let Ok(n) = crate::data::noise_given(&p[0]) {
+        check(n);
+    }
+    if let Ok(n) = crate::data::setup::noise_inline(&String::from_utf8_lossy(data)) {
+        check(n);
+    }
+}
+
+/// One stored case of an `explain-eval` campaign (a `cases.json` entry, JSON), checked as
+/// `explain-eval --merge` checks it against the published campaign's settings
+/// (`docs/explain-eval/cases.json`: seed 7, seven groups, 600 s). Property: an accepted case has
+/// finite numbers (λ > 0, σ > 0, a truth ≠ 0) and flags that agree with what it named.
+pub fn eval_case(data: &[u8]) {
+    use crate::experiment::explain_eval::{CaseResult, EvalSpec};
+    let Ok(c) = serde_json::from_slice::<CaseResult>(data) else {
+        return;
+    };
+    let spec = EvalSpec {
+        seed: 7,
+        groups: ["d", "kaq", "kas", "kao", "kgf", "kgq", "size"]
+            .map(String::from)
+            .to_vec(),
+        ..EvalSpec::default()
+    };
+    if crate::experiment::eval_check::check_case(&spec, &c).is_err() {
+        return;
+    }
+    if let Some(l) = c.lambda {
+        assert!(l.is_finite() && l > 0.0, "accepted lambda {l}");
+    }
+    if let Some(t) = c.truth {
+        assert!(t.is_finite() && t != 0.0, "accepted truth {t}");
+    }
+    if let Some(e) = c.estimate {
+        finite(e, "estimate");
+    }
+    if let Some(s) = c.sigma {
+        assert!(s.is_finite() && s > 0.0, "accepted sigma {s}");
+    }
+    if let Some(g) = c.gain_recovery {
+        finite(g, "gain_recovery");
+    }
+    assert!(
+        !(c.detected && c.named.is_empty()),
+        "detected with nothing named"
+    );
+    assert!(!(c.term.is_none() && c.detected), "a null case detected");
 }

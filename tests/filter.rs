@@ -263,6 +263,8 @@ fn a_nan_or_negative_variance_stops_the_run_instead_of_printing_sigma_zero() {
         nonfinite_updates: 0,
         first_nonfinite_t: None,
         diverged: None,
+        gated: Vec::new(),
+        gate_passed: 0,
     };
     assert!(run(0.5).check().is_ok());
     let err = run(f64::NAN).check().unwrap_err();

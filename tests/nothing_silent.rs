@@ -375,23 +375,27 @@ fn the_aiding_file_is_checked_against_itself_on_every_run() {
         std::fs::write(&path, out).unwrap();
         path
     };
-    let run = |aid: &Path, out: &str| {
+    let imu = sim.join("imu.txt");
+    let run_with = |aid: &Path, out: &str, extra: &[&str]| {
         let out = d.join(out);
-        let (ok, _, err) = sinsmodel(&[
+        let mut a = vec![
             "filter",
             "--model",
             "P13",
             "--imu",
-            p(&sim.join("imu.txt")),
+            p(&imu),
             "--aid",
             p(aid),
             "--init",
             "40.0966,-105.1474,1601,0,0,30",
             "--out",
             p(&out),
-        ]);
+        ];
+        a.extend_from_slice(extra);
+        let (ok, _, err) = sinsmodel(&a);
         (ok, err, out)
     };
+    let run = |aid: &Path, out: &str| run_with(aid, out, &[]);
     let (ok, err, clean) = run(&sim.join("gnss.txt"), "clean");
     assert!(ok && !err.contains("warning"), "{err}");
     let swapped = rewrite("swapped.txt", &|_, v| v.swap(7, 8));
@@ -426,6 +430,54 @@ fn the_aiding_file_is_checked_against_itself_on_every_run() {
     };
     // the outlier's epoch is gone, every other is there
     assert_eq!(epochs(&out) + 1, epochs(&clean), "one epoch dropped");
+    // a burst (fixes 30–32 s 100 m north) passes the neighbours' check in part; the filter's
+    // innovation gate rejects what is left, counts it and lists it; without the gate the NIS
+    // explodes
+    let burst = rewrite("burst.txt", &|k, v| {
+        if (31..=33).contains(&k) {
+            v[1] += 100.0 / 6.37e6 * 180.0 / std::f64::consts::PI;
+        }
+    });
+    let (ok, err, out) = run_with(&burst, "burst", &["--gate", "10"]);
+    assert!(
+        ok && err.contains("scalar updates rejected (|nu| > 10 sigma)"),
+        "{err}"
+    );
+    let listed = std::fs::read_to_string(out.join("innovations.txt")).unwrap();
+    assert!(
+        listed.contains("# rejected by the innovation gate"),
+        "{listed}"
+    );
+    let mean_nis = |dir: &Path, meas: &str| {
+        let t = std::fs::read_to_string(dir.join("innovations.txt")).unwrap();
+        let v: Vec<f64> = t
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| l.split_whitespace().collect::<Vec<_>>())
+            .filter(|w| w[1] == meas && w[2] == "0")
+            .map(|w| w[3].parse::<f64>().unwrap().powi(2) / w[4].parse::<f64>().unwrap())
+            .collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let (gated, clean_nis) = (mean_nis(&out, "pos_ne"), mean_nis(&clean, "pos_ne"));
+    assert!(
+        gated < 3.0 * clean_nis.max(1.0),
+        "gated {gated}, clean {clean_nis}"
+    );
+    let (ok, err, off) = run_with(&burst, "off", &[]);
+    assert!(
+        ok && !err.contains("rejected"),
+        "the gate is off by default: {err}"
+    );
+    assert!(
+        mean_nis(&off, "pos_ne") > 100.0 * gated,
+        "without the gate the burst enters"
+    );
+    let (ok, err, _) = run_with(&burst, "g2", &["--gate", "2"]);
+    assert!(
+        !ok && err.contains("--gate 2: a gate is between 3 and 1e6"),
+        "{err}"
+    );
 }
 
 /// A truth file whose yaw is in radians, or counted the other way, contradicts the filter's own

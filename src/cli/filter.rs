@@ -37,6 +37,29 @@ pub struct FilterArgs {
     /// `sinsmodel bench` measures the stream against).
     #[arg(long, hide = true)]
     in_memory: bool,
+    /// Innovation gate: a scalar update whose innovation exceeds this many of its predicted σ
+    /// (√S), e.g. 10, is not applied, and is counted in the summary and listed at the end of
+    /// innovations.txt; after 3 epochs of a component rejected in a row the next is applied
+    /// [default: off: every update applied; single outlying fixes are dropped before the run].
+    #[arg(long, default_value = "off", allow_hyphen_values = true)]
+    gate: String,
+}
+
+/// The `--gate` value: a number of σ in [3, 1e6], or None for `off`.
+fn gate(text: &str) -> Result<Option<f64>> {
+    if text.trim() == "off" {
+        return Ok(None);
+    }
+    match text.trim().parse::<f64>() {
+        Ok(g) if (3.0..=1e6).contains(&g) => Ok(Some(g)),
+        Ok(g) => anyhow::bail!(
+            "--gate {}: a gate is between 3 and 1e6 σ (below 3 it rejects good fixes: 0.3 % of honest innovations lie beyond 3 σ), or `off`",
+            sinsmodel::io::units::shown_number(g)
+        ),
+        Err(_) => anyhow::bail!(
+            "--gate `{text}`: expected a number of σ (e.g. 10) or `off`"
+        ),
+    }
 }
 
 /// Runs the command: one streamed pass (memory does not grow with the IMU or truth file);
@@ -48,6 +71,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         sinsmodel::nav::free_inertial::check_rate("--nav-rate", r)?;
     }
     let mut cfg = args.data.config(&model, false)?;
+    cfg.gate = gate(&args.gate)?;
     let inputs = args.data.input_paths();
     let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     let out = OutputDir::create(&args.out, &refs, "filter")?;
@@ -177,10 +201,46 @@ fn print_summary(
         run.innovations.len(),
     );
     eprint!("{}", nis_table(run));
+    if let Some(w) = gated_line(run, cfg.gate) {
+        eprintln!("{w}");
+    }
     eprint!("{}", outage_table(outage_rows, t_first));
     if let Some(errors) = errors {
         eprint!("{}", model_error_line(errors));
     }
+}
+
+/// The summary's line on the fixes the innovation gate `gate` [σ] rejected (None when it
+/// rejected none), with a warning when they are more than 1 % of the updates: then the model or
+/// the stated noise misses something, rather than the fixes being outliers.
+fn gated_line(run: &FilterRun, gate: Option<f64>) -> Option<String> {
+    let (g, first) = (gate?, run.gated.first()?);
+    let k = run.gated.len();
+    let all = k + run.innovations.len();
+    let mut epochs: Vec<f64> = run.gated.iter().map(|i| i.t).collect();
+    epochs.dedup();
+    let mut line = format!(
+        "gate: {k} of {all} scalar updates rejected (|nu| > {} sigma), at {} epochs, the first at t = {:.3} s ({} component {}); listed at the end of innovations.txt",
+        sinsmodel::io::units::shown_number(g),
+        epochs.len(),
+        first.t,
+        first.meas,
+        first.component
+    );
+    if run.gate_passed > 0 {
+        line.push_str(&format!(
+            "\nwarning: {} updates beyond the gate were applied all the same, each after {} epochs of its component rejected in a row: there the filter, not the fixes, was off",
+            run.gate_passed,
+            sinsmodel::estimate::filter::GATE_RUN
+        ));
+    }
+    if k * 100 > all {
+        line.push_str(&format!(
+            "\nwarning: the gate rejected {:.1} % of the updates: more than outliers do; the model or the stated noise misses something (the NIS above leaves them out: --gate off shows the filter that takes them)",
+            100.0 * k as f64 / all as f64
+        ));
+    }
+    Some(line)
 }
 
 /// The files of the output directory (model_error.txt `with_truth`, outages.json

@@ -19,31 +19,6 @@ pub use setup::{apply_opened, noise_given, NoiseGiven};
 mod tests {
     use super::*;
 
-    /// Options with nothing given (the command line's defaults).
-    fn none() -> DataOptions {
-        DataOptions {
-            imu: None,
-            imu_format: None,
-            clock_offset: None,
-            aid: None,
-            aid_use: None,
-            static_aid: None,
-            prior: Vec::new(),
-            noise: None,
-            truth: None,
-            init: None,
-            init_speed: None,
-            mode: "open".into(),
-            step: None,
-            zupt: None,
-            force: false,
-            grade: None,
-            outage: Vec::new(),
-            gnss_delay: None,
-            lever_arm: None,
-        }
-    }
-
     #[test]
     fn noise_states_a_bias_random_walk_inline_with_units_checked() {
         let p = std::path::Path::new(
@@ -78,7 +53,7 @@ mod tests {
 
     #[test]
     fn outages_are_sorted_from_the_first_sample_and_overlaps_refused() {
-        let mut o = none();
+        let mut o = DataOptions::none();
         o.outage = vec!["100,20".into(), "10,5".into()];
         let w = o.outages(1000.0).unwrap();
         assert_eq!(w.len(), 2);
@@ -98,7 +73,7 @@ mod tests {
 
     #[test]
     fn a_static_aid_is_checked_and_starts_at_the_next_whole_second() {
-        let mut o = none();
+        let mut o = DataOptions::none();
         o.static_aid = Some(vec![40.0, -105.0, 1600.0]);
         match o.aid_plan(12.3).unwrap() {
             AidPlan::Static { first_s, zupt, fix } => {
@@ -128,7 +103,7 @@ mod tests {
     #[test]
     fn priors_by_pattern_override_the_grade_and_are_checked() {
         let model = crate::model::Model::parse("P28").unwrap();
-        let mut o = none();
+        let mut o = DataOptions::none();
         let nav = o.config(&model, false).unwrap();
         o.grade = Some("mems".into());
         let mems = o.config(&model, false).unwrap();
@@ -168,7 +143,7 @@ mod tests {
             model.index_of("eps_y").unwrap(),
         );
         let deg_h = 1f64.to_radians() / 3600.0;
-        let mut o = none();
+        let mut o = DataOptions::none();
         for order in [
             ["eps_x=1 deg/h", "eps_*=10 deg/h"],
             ["eps_*=10 deg/h", "eps_x=1 deg/h"],

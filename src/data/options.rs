@@ -181,6 +181,31 @@ pub struct DataOptions {
 }
 
 impl DataOptions {
+    /// Options with nothing given (the command line's defaults).
+    pub fn none() -> DataOptions {
+        DataOptions {
+            imu: None,
+            imu_format: None,
+            clock_offset: None,
+            aid: None,
+            aid_use: None,
+            static_aid: None,
+            prior: Vec::new(),
+            noise: None,
+            truth: None,
+            init: None,
+            init_speed: None,
+            mode: "open".into(),
+            step: None,
+            zupt: None,
+            force: false,
+            grade: None,
+            outage: Vec::new(),
+            gnss_delay: None,
+            lever_arm: None,
+        }
+    }
+
     /// True when any data option was given (explain runs its embedded demo when none is).
     pub fn any_given(&self) -> bool {
         self.imu.is_some()

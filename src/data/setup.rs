@@ -462,7 +462,7 @@ fn white_unit_scale(
 
 /// `arw=0.3 deg/sqrt(h), vrw=150 ug/sqrt(Hz)`: both required, each checked like the file's;
 /// `gyro_bias_rw`, `accel_bias_rw` optional.
-fn noise_inline(text: &str) -> Result<NoiseGiven> {
+pub(crate) fn noise_inline(text: &str) -> Result<NoiseGiven> {
     let [arw, vrw, g, a] = noise_inline_all(text)?;
     match (arw, vrw) {
         (Some(arw), Some(vrw)) => Ok(NoiseGiven {

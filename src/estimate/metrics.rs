@@ -154,18 +154,25 @@ pub struct OutageDrift {
 /// For each outage, the pos_ne innovation (computed − fix, before the update) at the first
 /// fix after it: the drift of the filter's solution over the outage. `t_first`, `t_last`: the
 /// first and last IMU sample [s].
-pub fn outage_drifts(
+pub fn outage_drifts<'a>(
     outages: &[Outage],
-    run: &FilterRun,
+    run: &'a FilterRun,
     t_first: f64,
     t_last: f64,
 ) -> Result<Vec<OutageDrift>> {
     let mut out = Vec::new();
     for o in outages {
+        // the first fix after the outage, applied or rejected by the innovation gate (a drift
+        // beyond the gate is the drift all the same)
         let after = |c: usize| {
-            run.innovations
-                .iter()
-                .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
+            let first = |v: &'a [super::filter::Innovation]| {
+                v.iter()
+                    .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
+            };
+            [first(&run.innovations), first(&run.gated)]
+                .into_iter()
+                .flatten()
+                .min_by(|a, b| a.t.total_cmp(&b.t))
         };
         let (Some(n), Some(e)) = (after(0), after(1)) else {
             bail!(

@@ -162,6 +162,19 @@ impl EpochFiles {
                 i.t, i.meas, i.component, i.nu, i.s
             )?;
         }
+        if !run.gated.is_empty() {
+            writeln!(
+                w,
+                "# rejected by the innovation gate (not applied, not above): t measurement component nu S"
+            )?;
+            for i in &run.gated {
+                writeln!(
+                    w,
+                    "# {:.4} {} {} {:.6e} {:.6e}",
+                    i.t, i.meas, i.component, i.nu, i.s
+                )?;
+            }
+        }
         f.commit()?;
         if let Some(f) = self.model_error {
             f.commit()?;

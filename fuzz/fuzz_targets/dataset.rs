@@ -1,0 +1,7 @@
+//! libFuzzer target `dataset`: the body is `sinsmodel::fuzzing::dataset`, shared with the stable
+//! corpus test (`tests/fuzz_corpus.rs`).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| sinsmodel::fuzzing::dataset(data));
