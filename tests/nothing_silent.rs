@@ -581,3 +581,61 @@ fn aiding_on_another_day_or_clock_is_named() {
         }
     }
 }
+
+/// An aiding file whose clock is 30 s late against the IMU's: while the IMU turns at 12 deg/s
+/// the fixes stamped then still stand (they describe the rest 30 s before). Said as a likely
+/// clock offset (a warning: a vehicle can turn in place); the same data on one clock say
+/// nothing.
+#[test]
+fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("clk.toml");
+    std::fs::write(
+        &sc,
+        "name = \"clk\"\nimu_rate_hz = 100.0\nseed = 3\n[start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 2.0\naccel_mps2 = 1.0\n\
+         [[segment]]\nkind = \"turn\"\nduration_s = 20.0\nyaw_rate_deg_s = 15.0\n[[segment]]\nkind = \"cruise\"\nduration_s = 20.0\n\
+         [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
+    )
+    .unwrap();
+    let sim = d.join("sim");
+    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
+    assert!(ok, "{err}");
+    let late: String = std::fs::read_to_string(sim.join("gnss.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| match l.split_once(' ') {
+            Some((t, rest)) if !l.starts_with('#') => {
+                format!("{:.4} {rest}\n", t.parse::<f64>().unwrap() + 30.0)
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(d.join("late.txt"), late).unwrap();
+    let run = |aid: &Path, out: &str| {
+        let (ok, _, err) = sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            p(&sim.join("imu.txt")),
+            "--aid",
+            p(aid),
+            "--init",
+            "40.0966,-105.1474,1601,0,0,0",
+            "--out",
+            p(&d.join(out)),
+        ]);
+        assert!(ok, "{err}");
+        err
+    };
+    let err = run(&sim.join("gnss.txt"), "clean");
+    assert!(!err.contains("warning"), "{err}");
+    let err = run(&d.join("late.txt"), "late");
+    assert!(
+        err.contains("at 40.1–50.1 s: the IMU turns")
+            && err.contains("the aiding's clock is likely off against the IMU's"),
+        "{err}"
+    );
+}

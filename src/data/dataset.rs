@@ -218,9 +218,13 @@ impl DataOptions {
         };
         if let (Some(o), true) = (claim, start.v.norm() > 1.0) {
             bail!(
-                "{o} says the vehicle does not move, but the initial state moves at {:.2} m/s (--init or the truth's first row): \
-                 aid a moving run with GNSS fixes (--aid)",
-                start.v.norm()
+                "{o} says the vehicle does not move, but the initial state moves at {:.2} m/s (--init or the truth's first row): {}",
+                start.v.norm(),
+                if o == "--zupt" {
+                    "leave out --zupt (it adds a zero-velocity update at every aiding epoch)"
+                } else {
+                    "aid a moving run with GNSS fixes (--aid)"
+                }
             );
         }
         if let Some(p) = claim.and_then(|o| judge.claim_rest(o, imu.head())) {

@@ -261,6 +261,25 @@ mod tests {
             e.contains("dup.json") && e.contains("key `fit` given twice"),
             "{e}"
         );
+        // a file without `units` is read in SI, and the run says so
+        let bare = dir.path().join("bare.json");
+        let fit = ["gyro", "accel"]
+            .iter()
+            .flat_map(|k| ["x", "y", "z"].map(|a| format!("\"{k}_{a}\": {{\"white\": 1e-4}}")))
+            .collect::<Vec<_>>()
+            .join(", ");
+        std::fs::write(&bare, format!("{{\"fit\": {{{fit}}}}}")).unwrap();
+        let said = |path: &std::path::Path| {
+            let mut o = DataOptions::none();
+            o.noise = Some(path.to_path_buf());
+            o.noise_lines().unwrap().join("\n")
+        };
+        let lines = said(&bare);
+        assert!(
+            lines.contains("warning: --noise") && lines.contains("no `units` entry"),
+            "{lines}"
+        );
+        assert!(!said(&si).contains("warning"), "{}", said(&si));
     }
 
     #[test]

@@ -183,6 +183,12 @@ impl DataOptions {
                 vrw,
                 vrw / crate::io::units::STANDARD_GRAVITY * 1e6
             ));
+            if path.exists() && !states_units(path) {
+                lines.push(format!(
+                    "warning: --noise {}: no `units` entry: its white noises were read in SI (rad/sqrt(s), m/s/sqrt(s)), as `sinsmodel allan --json` writes them; a file in deg/sqrt(h) or ug/sqrt(Hz) must say so in `units` (the values above passed the plausibility range in SI)",
+                    path.display()
+                ));
+            }
             // rad/s/√s → deg/h/√h: × 180/π × 3600 × 60; m/s²/√s → µg/√s: ÷ g × 1e6
             if g > 0.0 {
                 lines.push(format!(
@@ -365,6 +371,14 @@ pub fn noise_given(path: &std::path::Path) -> Result<NoiseGiven> {
         gyro_bias_rw: 0.0,
         accel_bias_rw: 0.0,
     })
+}
+
+/// True when the noise file at `path` (read and checked already) has a `units` entry.
+fn states_units(path: &std::path::Path) -> bool {
+    crate::io::lines::read_small_text(path, "--noise")
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .is_some_and(|v| !v["units"].is_null())
 }
 
 /// Gyro ARW [rad/√s] and accelerometer VRW [m/s/√s] of an `allan --json` file (the RMS over

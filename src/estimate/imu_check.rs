@@ -245,7 +245,7 @@ impl Said {
         if !(0.5..2.0).contains(&gravity_ratio) {
             let p = format!(
                 "mean specific force |f| = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
-                 while moving too: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong{}",
+                 which no vehicle averages over seconds, at rest or moving: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong{}",
                 crate::io::units::sig3(f.norm()),
                 crate::io::units::sig3(gravity_ratio),
                 unit_hint(g / f.norm())
@@ -550,11 +550,15 @@ impl RestClaim {
             format!(
                 "{} says the vehicle does not move for the whole run, but the IMU accelerates at {} without turning: \
                  its 1-s mean specific forces spread by {:.3} m/s² RMS (at rest <= {MOVING_F_SPREAD}) and its mean moved by \
-                 {step:.3} m/s² from the last still window's (<= {MOVING_F_STEP}): aid a moving run with GNSS fixes (--aid), \
-                 or cut the IMU file to the stretch at rest",
+                 {step:.3} m/s² from the last still window's (<= {MOVING_F_STEP}): {}",
                 self.option,
                 span_words(t0, t1, t_first),
                 e.f_spread,
+                if self.option == "--zupt" {
+                    "leave out --zupt (it adds a zero-velocity update at every aiding epoch), or cut the IMU file to the stretch at rest"
+                } else {
+                    "aid a moving run with GNSS fixes (--aid), or cut the IMU file to the stretch at rest"
+                }
             )
         })
     }
@@ -641,8 +645,41 @@ impl WindowJudge {
         said.gyro_unit_problems
             .first()
             .map(|p| (at(p), self.gyro_warn_only))
+            .or_else(|| self.turns_while_gnss_stands(window).map(|p| (p, true)))
     }
 }
+
+impl WindowJudge {
+    /// The aiding's clock against the IMU's, in words, when the window (consecutive samples)
+    /// turns at over [`CLOCK_TURN_RATE`] on average while every GNSS fix in it stands still: a
+    /// fix then describes another moment than its stamp says (a late or early aiding file,
+    /// another time system). A warning only: a vehicle can turn in place.
+    fn turns_while_gnss_stands(&self, window: &[crate::io::imu::ImuSample]) -> Option<String> {
+        let Some(RestWitness::Speeds(_)) = &self.rest_witness else {
+            return None;
+        };
+        let (t0, t1) = (window[0].t, window[window.len() - 1].t);
+        let span = t1 - t0 + (t1 - t0) / (window.len() - 1) as f64;
+        let turned: Vector3<f64> = window.iter().map(|s| s.dtheta).sum();
+        let rate = turned.norm() / span;
+        (rate > CLOCK_TURN_RATE && self.rest_witness.as_ref()?.at_rest(t0, t1)).then(|| {
+            format!(
+                "at {}: the IMU turns {:.0}° at {:.1} deg/s on average while every GNSS fix there stands still (under {REST_SPEED_MAX} m/s): \
+                 the aiding's clock is likely off against the IMU's (a late or early aiding file, another time system or --clock-offset), \
+                 unless the vehicle turns in place",
+                span_words(t0, t1, self.t_first),
+                turned.norm().to_degrees(),
+                rate.to_degrees()
+            )
+        })
+    }
+}
+
+/// A window whose mean angular rate is over this [rad/s] (10 deg/s: 100° in a 10-s window) turns,
+/// whatever a gyro bias adds (a MEMS gyro's is a few deg/s at most), faster than a car can at
+/// the speed of a GNSS fix taken as at rest ([`REST_SPEED_MAX`] plus 3 σ of its noise: 0.6 m/s
+/// on a 5-m radius is 6.9 deg/s).
+pub const CLOCK_TURN_RATE: f64 = 10.0 * std::f64::consts::PI / 180.0;
 
 /// The stream's check of each window after the head with `judge`: a slip ends the run with an
 /// error naming the IMU file `name` and the window, unless `force` (then, like a warning-only
@@ -665,7 +702,13 @@ pub fn window_check(
         }
         if !warned {
             warned = true;
-            let why = if force { "--force given" } else { why_warn };
+            let why = if force {
+                "--force given"
+            } else if p.contains("the aiding's clock") {
+                "not refused"
+            } else {
+                why_warn
+            };
             eprintln!("warning: --imu {name}: {p} ({why})");
         }
         Ok(())
