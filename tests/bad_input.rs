@@ -784,8 +784,9 @@ fn a_claim_of_rest_on_data_that_move_is_refused_where_they_move() {
 }
 
 /// Gyros in deg/s read as rad/s on a unit with a bias (|ω| at rest 33× Earth rate, outside the
-/// 57.3× band): a navigation- or tactical-grade run is refused with the slip named, a MEMS one
-/// runs (such a bias is a MEMS gyro's), and imu-check says which grade the rate allows.
+/// 57.3× band): a navigation- or tactical-grade run is refused with the slip named (also with a
+/// tight gyro-bias prior given), a MEMS one runs (such a bias is a MEMS gyro's), as does one
+/// whose prior allows it, and imu-check says which grade the rate allows.
 #[test]
 fn a_gyro_rate_at_rest_beyond_the_grade_names_the_unit_slip() {
     let dir = tempfile::tempdir().unwrap();
@@ -799,7 +800,7 @@ fn a_gyro_rate_at_rest_beyond_the_grade_names_the_unit_slip() {
         v[1..4].iter_mut().for_each(|x| *x *= deg)
     });
     let gnss = o.join("gnss.txt");
-    let filter = |grade: Option<&str>, out: &str| {
+    let filter_with = |grade: Option<&str>, out: &str, extra: &[&str]| {
         let out = d.join(out);
         let mut a = vec![
             "filter",
@@ -817,8 +818,10 @@ fn a_gyro_rate_at_rest_beyond_the_grade_names_the_unit_slip() {
         if let Some(g) = grade {
             a.extend_from_slice(&["--grade", g]);
         }
+        a.extend_from_slice(extra);
         run(&a)
     };
+    let filter = |grade: Option<&str>, out: &str| filter_with(grade, out, &[]);
     for grade in [None, Some("tactical")] {
         let (ok, err) = filter(grade, "f");
         assert!(
@@ -827,6 +830,15 @@ fn a_gyro_rate_at_rest_beyond_the_grade_names_the_unit_slip() {
         );
     }
     let (ok, err) = filter(Some("mems"), "m");
+    assert!(ok, "{err}");
+    // a gyro-bias prior says what bias is plausible: a tight one keeps the refusal (it had
+    // turned the check off), a MEMS-sized one (0.5 deg/s) allows the 573 deg/h
+    let (ok, err) = filter_with(None, "p1", &["--prior", "eps_z=10 deg/h"]);
+    assert!(
+        !ok && err.contains("deg/s read as rad/s") && err.contains("--prior eps"),
+        "{err}"
+    );
+    let (ok, err) = filter_with(None, "p2", &["--prior", "eps_*=0.5 deg/s"]);
     assert!(ok, "{err}");
     let (ok, said, err) =
         common::sinsmodel(&["imu-check", "--imu", imu.to_str().unwrap(), "--lat", "40"]);

@@ -639,3 +639,59 @@ fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
         "{err}"
     );
 }
+
+/// Heights at a low site: fixes in feet (100 m read as 328) are refused naming feet, though the
+/// heights differ by less than the 1000 m that had been the only bound; a height 80 m off is
+/// warned as two datums (ellipsoidal against mean sea level); the clean run says neither.
+#[test]
+fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("low.toml");
+    std::fs::write(
+        &sc,
+        "name = \"low\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\nh_m = 100.0\n[[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[gnss]\nrate_hz = 1.0\n",
+    )
+    .unwrap();
+    let sim = d.join("sim");
+    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(sim.join("gnss.txt")).unwrap();
+    let heights = |name: &str, f: &dyn Fn(f64) -> f64| {
+        let out: String = text
+            .lines()
+            .map(|l| {
+                if l.starts_with('#') {
+                    return format!("{l}\n");
+                }
+                let mut v: Vec<String> = l.split_whitespace().map(str::to_string).collect();
+                v[3] = format!("{:.4}", f(v[3].parse().unwrap()));
+                format!("{}\n", v.join(" "))
+            })
+            .collect();
+        let path = d.join(name);
+        std::fs::write(&path, out).unwrap();
+        path
+    };
+    let run = |aid: &Path, out: &str| {
+        sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            p(&sim.join("imu.txt")),
+            "--aid",
+            p(aid),
+            "--init",
+            "30,110,100,0,0,0",
+            "--out",
+            p(&d.join(out)),
+        ])
+    };
+    let (ok, _, err) = run(&sim.join("gnss.txt"), "clean");
+    assert!(ok && !err.contains("warning"), "{err}");
+    let (ok, _, err) = run(&heights("feet.txt", &|h| h * 3.2808), "feet");
+    assert!(!ok && err.contains("one of them in feet?"), "{err}");
+    let (ok, _, err) = run(&heights("datum.txt", &|h| h + 80.0), "datum");
+    assert!(ok && err.contains("heights on two datums?"), "{err}");
+}

@@ -118,7 +118,7 @@ impl DataOptions {
             );
         }
         self.check_head(&mut imu, &start.state, &plan, note)?;
-        check_plan_at_start(&plan, &start.state)?;
+        check_plan_at_start(&plan, &start.state, note)?;
         check_fixes(&mut plan, imu.first_t(), note)?;
         let aid = plan.after(t0);
         check_outages_drop_fixes(&aid, &outages, imu.first_t())?;
@@ -172,10 +172,20 @@ impl DataOptions {
             ));
         }
         // a gyro bias at rest beyond the stated grade's (unless --prior sets the gyro biases)
-        let eps_given = self.prior.iter().any(|p| p.trim_start().starts_with("eps"));
-        let beyond =
-            crate::estimate::imu_check::gyro_bias_beyond_grade(&check, self.grade.as_deref())
-                .filter(|_| !eps_given);
+        // the largest gyro-bias prior given [deg/h] (the priors are checked where they are
+        // applied; one that does not parse is left to that check)
+        let eps_prior = self
+            .prior
+            .iter()
+            .filter_map(|p| p.split_once('='))
+            .filter(|(name, _)| name.trim().starts_with("eps"))
+            .filter_map(|(_, q)| crate::io::units::parse_quantity_as(q, "deg/h").ok())
+            .reduce(f64::max);
+        let beyond = crate::estimate::imu_check::gyro_bias_beyond_grade(
+            &check,
+            self.grade.as_deref(),
+            eps_prior,
+        );
         let slips: Vec<&String> = check
             .unit_problems
             .iter()
@@ -279,8 +289,9 @@ impl DataOptions {
 }
 
 /// The aiding must go on after the start (at least 10 epochs) and begin where the start is
-/// (within 20 km of it).
-fn check_plan_at_start(plan: &AidPlan, start: &NavState) -> Result<()> {
+/// (within 20 km of it; a height 3.28× the other's beyond what 10 s of climbing allows refused
+/// as feet, any height over 60 m off warned as two datums).
+fn check_plan_at_start(plan: &AidPlan, start: &NavState, note: &mut dyn FnMut(&str)) -> Result<()> {
     let t0 = start.t;
     let far = |lat: f64, lon: f64| {
         let d = horizontal_distance_m(start.lat, start.lon, start.h, lat, lon);
@@ -298,9 +309,11 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState) -> Result<()> {
             // the initial position and the first aiding fix must describe the same place
             if let Some(f) = fixes.iter().map(|f| &f.0).find(|f| f.t > t0) {
                 let dh = f.h - start.h;
-                if dh.abs() > 1000.0 {
-                    let feet = (f.h / start.h / 3.2808 - 1.0).abs() < 0.05
-                        || (start.h / f.h / 3.2808 - 1.0).abs() < 0.05;
+                let feet = (f.h / start.h / 3.2808 - 1.0).abs() < 0.05
+                    || (start.h / f.h / 3.2808 - 1.0).abs() < 0.05;
+                // beyond what 10 s of climbing (10 m/s) and the fix's noise allow
+                let allowed = 30.0 + 5.0 * f.sigma[2] + 10.0 * (f.t - t0).max(0.0);
+                if dh.abs() > 1000.0 || (feet && dh.abs() > allowed) {
                     bail!(
                         "the initial height {:.1} m is {:.1} m from the first aiding fix's {:.1} m (t = {:.3} s){}: check --init / --aid",
                         start.h,
@@ -309,6 +322,18 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState) -> Result<()> {
                         f.t,
                         if feet { ", 3.28×: one of them in feet?" } else { "" }
                     );
+                }
+                if dh.abs() > allowed.max(60.0) {
+                    note(&format!(
+                        "warning: the initial height {:.1} m is {:.1} m from the first aiding fix's {:.1} m (t = {:.3} s, σ {:.2} m): \
+                         heights on two datums? (ellipsoidal heights, as GNSS gives them, and heights above mean sea level differ by \
+                         the geoid's undulation, up to ±100 m); check --init / --aid",
+                        start.h,
+                        dh.abs(),
+                        f.h,
+                        f.t,
+                        f.sigma[2]
+                    ));
                 }
                 if let Some(dist) = far(f.lat, f.lon) {
                     bail!(

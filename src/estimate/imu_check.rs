@@ -723,19 +723,42 @@ pub fn least_gyro_bias_deg_h(check: &ImuCheck) -> Option<f64> {
         .then(|| (check.earth_rate_ratio - 1.0).max(0.0) * earth::OMEGA.to_degrees() * 3600.0)
 }
 
-/// A gyro bias at rest beyond what the sensor grade `grade` (None: navigation) has, in words
+/// A gyro bias at rest beyond what the sensor grade `grade` (None: navigation) has, or five σ
+/// of the largest gyro-bias prior given (`prior_deg_h`) when that is more, in words
 /// with its likely cause (deg/s read as rad/s), for the first seconds' check `check`; None
 /// within it, or with a MEMS grade (whose biases reach what a unit slip gives). The limits are
 /// far above the grades' priors: 10 s "at rest" by the specific force can still rock (the
 /// parked RLG log's first seconds turn at 55 deg/h).
-pub fn gyro_bias_beyond_grade(check: &ImuCheck, grade: Option<&str>) -> Option<String> {
+pub fn gyro_bias_beyond_grade(
+    check: &ImuCheck,
+    grade: Option<&str>,
+    prior_deg_h: Option<f64>,
+) -> Option<String> {
     let (limit, words) = match grade {
         None => (
             150.0,
-            "a navigation-grade gyro's (the default grade; prior 0.02 deg/h",
+            "a navigation-grade gyro's (the default grade; prior 0.02 deg/h".to_string(),
         ),
-        Some("tactical") => (300.0, "a tactical-grade gyro's (prior 1 deg/h"),
+        Some("tactical") => (300.0, "a tactical-grade gyro's (prior 1 deg/h".to_string()),
         _ => return None,
+    };
+    // a gyro-bias prior given says what bias is plausible: five of its σ, not below the grade's
+    let (limit, words) = match prior_deg_h {
+        Some(p) if 5.0 * p > limit => (
+            5.0 * p,
+            format!(
+                "five σ of the gyro-bias prior given (--prior eps…: {} deg/h",
+                crate::io::units::sig3(p)
+            ),
+        ),
+        Some(p) => (
+            limit,
+            format!(
+                "{words} and --prior eps… {} deg/h",
+                crate::io::units::sig3(p)
+            ),
+        ),
+        None => (limit, words),
     };
     let b = least_gyro_bias_deg_h(check)?;
     (b > limit).then(|| {
