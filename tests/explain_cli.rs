@@ -613,3 +613,84 @@ fn a_lever_arm_standing_in_for_a_withheld_time_offset_says_so() {
     }
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// explain keeps about what `filter` keeps per aiding epoch (it had held ~2.9 KB, then ~0.8 KB,
+/// against the filter's ~0.4 KB: every pass's record of every epoch, and a string per
+/// innovation): the growth of peak memory from 3000 to 15000 epochs (10 Hz fixes with
+/// velocities, P13), per epoch, within 1.5× the filter's and under 1 KB.
+#[test]
+fn explain_keeps_about_what_filter_keeps_per_epoch() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let peak = |args: &[&str]| -> f64 {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_sinsmodel"))
+            .args(args)
+            .env("SINSMODEL_REPORT_PEAK_RSS", "1")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        err.lines()
+            .find_map(|l| l.strip_prefix("peak-rss-kib "))
+            .expect("the peak is reported")
+            .trim()
+            .parse::<f64>()
+            .unwrap()
+            * 1024.0
+    };
+    let mut used = Vec::new();
+    for seconds in [300, 1500] {
+        let sc = d.join(format!("m{seconds}.toml"));
+        std::fs::write(
+            &sc,
+            format!(
+                "name = \"m\"\nimu_rate_hz = 50.0\nseed = 5\n[start]\nlat_deg = 40.0\nlon_deg = -105.0\nh_m = 1600.0\n\
+                 [[segment]]\nkind = \"rest\"\nduration_s = 20.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = 1.0\n\
+                 [[segment]]\nkind = \"turn\"\nduration_s = {}\nyaw_rate_deg_s = 2.0\n\
+                 [gnss]\nrate_hz = 10.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
+                seconds - 30
+            ),
+        )
+        .unwrap();
+        let sim = d.join(format!("sim{seconds}"));
+        let (ok, _, err) = sinsmodel(&[
+            "simulate",
+            sc.to_str().unwrap(),
+            "--out",
+            sim.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        let (imu, aid) = (sim.join("imu.txt"), sim.join("gnss.txt"));
+        let common = [
+            "--model",
+            "P13",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--aid",
+            aid.to_str().unwrap(),
+            "--init",
+            "40,-105,1600,0,0,0",
+        ];
+        let out_f = d.join(format!("f{seconds}"));
+        let out_e = d.join(format!("e{seconds}"));
+        let mut f = vec![
+            "filter",
+            "--nav-rate",
+            "1",
+            "--out",
+            out_f.to_str().unwrap(),
+        ];
+        f.extend(common);
+        let mut e = vec!["explain", "--out", out_e.to_str().unwrap()];
+        e.extend(common);
+        used.push((peak(&f), peak(&e)));
+    }
+    let epochs = 12_000.0;
+    let per_filter = (used[1].0 - used[0].0) / epochs;
+    let per_explain = (used[1].1 - used[0].1) / epochs;
+    eprintln!("bytes per epoch: filter {per_filter:.0}, explain {per_explain:.0}");
+    assert!(
+        per_explain < 1.5 * per_filter.max(100.0) && per_explain < 1024.0,
+        "explain {per_explain:.0} B per epoch, filter {per_filter:.0}"
+    );
+}

@@ -998,7 +998,8 @@ pub struct StreamIo<'a> {
 }
 
 /// The filter over streamed input: every record goes to `on_record` as it is made (and is kept in
-/// the returned run only with `keep_records`), so memory does not grow with the input; a read
+/// the returned run only with `keep_records`; without, the last one only), so memory does not
+/// grow with the input; a read
 /// error of the input, or of `on_record`, ends the run with that error.
 #[allow(clippy::too_many_arguments)]
 pub fn run_stream(
@@ -1015,6 +1016,7 @@ pub fn run_stream(
     let mut e = Engine::new(model, cfg, start);
     let mut aiding = io.aiding.peekable();
     let mut records = Vec::new();
+    let mut last = None;
     let mut prev_t = start.t;
     let mut k = 0u64;
     let mut next = io.samples.next_sample()?;
@@ -1056,6 +1058,8 @@ pub fn run_stream(
             on_record(&rec)?;
             if keep_records {
                 records.push(rec);
+            } else {
+                last = Some(rec);
             }
             if cfg.mode == Mode::ClosedLoop {
                 e.feedback();
@@ -1066,6 +1070,7 @@ pub fn run_stream(
         }
     }
     progress(1.0);
+    records.extend(last);
     Ok(FilterRun {
         names: model.names.clone(),
         records,
@@ -1174,4 +1179,6 @@ fn joseph_update(
     }
 }
 
-pub use super::metrics::{channel_name, model_error_rms_arcsec, nis_by_channel, ChannelNis};
+pub use super::metrics::{
+    channel_name, channel_str, model_error_rms_arcsec, nis_by_channel, ChannelNis,
+};

@@ -39,6 +39,33 @@ pub fn channel_name(meas: &str, component: usize) -> String {
     }
 }
 
+/// [`channel_name`] as a static string (what explain keeps per innovation: no allocation each),
+/// from a table of the spec's measurements built once; `?` for a component no measurement has.
+pub fn channel_str(meas: &'static str, component: usize) -> &'static str {
+    static TABLE: std::sync::OnceLock<Vec<(&'static str, usize, &'static str)>> =
+        std::sync::OnceLock::new();
+    if !meas.ends_with("_ne") {
+        return meas;
+    }
+    TABLE
+        .get_or_init(|| {
+            crate::model::generated::common::MEASUREMENTS
+                .iter()
+                .filter(|m| m.name.ends_with("_ne"))
+                .flat_map(|m| {
+                    (0..2).map(move |c| {
+                        let name: &'static str =
+                            Box::leak(channel_name(m.name, c).into_boxed_str());
+                        (m.name, c, name)
+                    })
+                })
+                .collect()
+        })
+        .iter()
+        .find(|x| x.0 == meas && x.1 == component)
+        .map_or("?", |x| x.2)
+}
+
 /// Mean normalised innovation squared (NIS) of one scalar channel against what a consistent
 /// filter gives (1, with the 95 % band of the mean of `count` χ²₁ values).
 #[derive(Debug, Clone, serde::Serialize)]

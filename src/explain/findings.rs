@@ -286,10 +286,10 @@ pub struct Explanation {
     pub baseline_priors_gain: Option<f64>,
     /// Normalised innovations (t, channel, ν/√S) of the baseline and extended passes, for plots.
     #[serde(skip)]
-    pub innovations_before: Vec<(f64, String, f64)>,
+    pub innovations_before: Vec<(f64, &'static str, f64)>,
     /// Same for the extended pass.
     #[serde(skip)]
-    pub innovations_after: Vec<(f64, String, f64)>,
+    pub innovations_after: Vec<(f64, &'static str, f64)>,
     /// Model error series (t [s], e_n, e_e [arcsec]) before and after (with truth).
     #[serde(skip)]
     pub model_error_before: Vec<(f64, f64, f64)>,

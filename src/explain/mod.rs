@@ -43,7 +43,7 @@ pub use findings::{
 pub use selection::prior_sigma;
 pub use words::{finding_line, separation_hint, share_percent, sig3, verdict};
 
-use crate::estimate::filter::{self, channel_name, AidingEpoch, FilterConfig, FilterRun};
+use crate::estimate::filter::{self, channel_str, AidingEpoch, FilterConfig, FilterRun};
 use crate::estimate::stats;
 use crate::io::imu::ImuData;
 use crate::io::truth::TruthRow;
@@ -352,7 +352,8 @@ fn run_pass(
         &mut |_| {},
         &mut sig,
         &mut |_| Ok(()),
-        true,
+        // every epoch's record only for the truth's checks; else the last (the estimates)
+        data.truth.is_some(),
     )?;
     run.check()
         .map_err(|e| anyhow::anyhow!("{} pass: {e}", model.name))?;
@@ -640,7 +641,7 @@ const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
 /// The baseline pass and the selection rounds on it.
 struct Stage {
     base_stats: PassStats,
-    innovations_before: Vec<(f64, String, f64)>,
+    innovations_before: Vec<(f64, &'static str, f64)>,
     model_error_before: Vec<(f64, f64, f64)>,
     tests: Vec<CandidateTest>,
     not_testable: Vec<String>,
@@ -1259,10 +1260,10 @@ fn regressor_stats(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<Re
         .collect())
 }
 
-fn normalised(run: &FilterRun) -> Vec<(f64, String, f64)> {
+fn normalised(run: &FilterRun) -> Vec<(f64, &'static str, f64)> {
     run.innovations
         .iter()
-        .map(|i| (i.t, channel_name(i.meas, i.component), i.nu / i.s.sqrt()))
+        .map(|i| (i.t, channel_str(i.meas, i.component), i.nu / i.s.sqrt()))
         .collect()
 }
 

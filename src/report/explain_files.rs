@@ -92,16 +92,16 @@ fn innovations(
             &e.innovations_after,
         ),
     ] {
-        let mut channels: Vec<String> = Vec::new();
+        let mut channels: Vec<&str> = Vec::new();
         for (_, c, _) in series.iter() {
             if !channels.contains(c) {
-                channels.push(c.clone());
+                channels.push(c);
             }
         }
         let curves: Vec<Series> = channels
             .iter()
             .map(|c| Series {
-                label: c.clone(),
+                label: c.to_string(),
                 points: series
                     .iter()
                     .filter(|(_, ch, _)| ch == c)
