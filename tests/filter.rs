@@ -265,6 +265,7 @@ fn a_nan_or_negative_variance_stops_the_run_instead_of_printing_sigma_zero() {
         diverged: None,
         gated: Vec::new(),
         gate_passed: 0,
+        pos_ne_prior: Vec::new(),
     };
     assert!(run(0.5).check().is_ok());
     let err = run(f64::NAN).check().unwrap_err();

@@ -478,6 +478,28 @@ fn the_aiding_file_is_checked_against_itself_on_every_run() {
         !ok && err.contains("--gate 2: a gate is between 3 and 1e6"),
         "{err}"
     );
+    // a step that stays (every fix from 30 s on 100 m north) is no outlier burst: after 5
+    // rejected epochs in a row the gate takes the fixes again and says so, instead of keeping
+    // the filter off them for good
+    let step = rewrite("step.txt", &|k, v| {
+        if k >= 31 {
+            v[1] += 100.0 / 6.37e6 * 180.0 / std::f64::consts::PI;
+        }
+    });
+    let (ok, err, out) = run_with(&step, "step", &["--gate", "10"]);
+    assert!(
+        ok && err.contains("were applied all the same, each after 5 epochs"),
+        "{err}"
+    );
+    let listed = std::fs::read_to_string(out.join("innovations.txt")).unwrap();
+    // fixes 30–34 s rejected (line 31 of the file is the fix at 30 s), the sixth (35 s) applied
+    for t in 30..=34 {
+        assert!(
+            listed.contains(&format!("# {t}.0000 pos_ne 0")),
+            "{t} s:\n{listed}"
+        );
+    }
+    assert!(!listed.contains("# 35.0000 pos_ne 0"), "{listed}");
 }
 
 /// A truth file whose yaw is in radians, or counted the other way, contradicts the filter's own
@@ -673,7 +695,7 @@ fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
         std::fs::write(&path, out).unwrap();
         path
     };
-    let run = |aid: &Path, out: &str| {
+    let run_from = |aid: &Path, out: &str, init: &str| {
         sinsmodel(&[
             "filter",
             "--model",
@@ -683,15 +705,141 @@ fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
             "--aid",
             p(aid),
             "--init",
-            "30,110,100,0,0,0",
+            init,
             "--out",
             p(&d.join(out)),
         ])
     };
+    let run = |aid: &Path, out: &str| run_from(aid, out, "30,110,100,0,0,0");
     let (ok, _, err) = run(&sim.join("gnss.txt"), "clean");
     assert!(ok && !err.contains("warning"), "{err}");
     let (ok, _, err) = run(&heights("feet.txt", &|h| h * 3.2808), "feet");
     assert!(!ok && err.contains("one of them in feet?"), "{err}");
     let (ok, _, err) = run(&heights("datum.txt", &|h| h + 80.0), "datum");
     assert!(ok && err.contains("heights on two datums?"), "{err}");
+    // a sea-level start of 20 m under ellipsoidal fixes at 66.5 m (northern Germany's geoid) is
+    // no feet, though 3.3× apart: it runs (it had been refused)
+    let geoid = heights("geoid.txt", &|h| h - 33.5);
+    let (ok, _, err) = run_from(&geoid, "geoid", "30,110,20,0,0,0");
+    assert!(ok && !err.contains("feet"), "{err}");
+    // 600 m off is beyond any datum: warned as such, not as two datums
+    let (ok, _, err) = run(&heights("far.txt", &|h| h + 600.0), "far");
+    assert!(
+        ok && err.contains("more than two height datums differ by"),
+        "{err}"
+    );
+}
+
+/// A turntable that tumbles a full turn about a level axis in one 10-s window: the window's mean
+/// specific-force vector nearly cancels, but |f| is 1 g throughout (the check takes |f| of 1-s
+/// means); it had been refused as "0.050× local gravity … g read as m/s²".
+#[test]
+fn a_tumble_about_a_level_axis_is_no_unit_slip() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sc = d.join("tt.toml");
+    std::fs::write(
+        &sc,
+        "name = \"tt\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = -105.0\nh_m = 1600.0\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 360.0\nduration_s = 10.0\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 20.0\n",
+    )
+    .unwrap();
+    let sim = d.join("sim");
+    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = sinsmodel(&[
+        "filter",
+        "--model",
+        "P13",
+        "--imu",
+        p(&sim.join("imu.txt")),
+        "--static-aid",
+        "40,-105,1600",
+        "--init",
+        "40,-105,1600,0,0,0",
+        "--out",
+        p(&d.join("f")),
+    ]);
+    assert!(ok && !err.contains("local gravity"), "{err}");
+}
+
+/// `--zupt` beside GNSS fixes that move (a drive-off too gentle for the IMU's window test) is
+/// refused by the fixes' own speeds; at rest the same option runs.
+#[test]
+fn zupt_is_held_to_the_fixes_speeds() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let moving = drive(d);
+    let (ok, err) = filter(
+        &moving,
+        &d.join("m"),
+        &[
+            "--init",
+            "40.0966,-105.1474,1601,0,0,30",
+            "--zupt",
+            "0.01",
+            "--aid-use",
+            "pos",
+        ],
+    );
+    assert!(
+        !ok && err.contains("--zupt says the vehicle does not move, but the aiding fixes move"),
+        "{err}"
+    );
+    let rest_dir = d.join("rest");
+    std::fs::create_dir_all(&rest_dir).unwrap();
+    let still = simulated(&rest_dir, 0.0);
+    let (ok, err) = filter(&still, &d.join("s"), &["--zupt", "0.01"]);
+    assert!(ok, "{err}");
+}
+
+/// An outage's drift is the first fix's residual before any of its updates: the same whether the
+/// innovation gate rejects that fix's north component or not (the east one had been taken after
+/// the north update, so the gate changed it: −0.39 against −0.43 m).
+#[test]
+fn the_outage_drift_does_not_depend_on_the_gate() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sim = d.join("sim");
+    let (ok, _, err) = sinsmodel(&[
+        "simulate",
+        p(&root.join("scenarios/drive.toml")),
+        "--out",
+        p(&sim),
+    ]);
+    assert!(ok, "{err}");
+    let drift = |gate: &str| {
+        let out = d.join(format!("g{gate}"));
+        let (ok, _, err) = sinsmodel(&[
+            "filter",
+            "--model",
+            "P28",
+            "--imu",
+            p(&sim.join("imu.txt")),
+            "--aid",
+            p(&sim.join("gnss.txt")),
+            "--truth",
+            p(&sim.join("truth.txt")),
+            "--outage",
+            "80,20",
+            "--gate",
+            gate,
+            "--out",
+            p(&out),
+        ]);
+        assert!(ok, "{err}");
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("outages.json")).unwrap())
+                .unwrap();
+        (err, v["outages"][0].clone())
+    };
+    let (_, off) = drift("off");
+    let (err, gated) = drift("10");
+    assert!(
+        err.contains("gate: 1 of"),
+        "the gate rejects the fix after the outage: {err}"
+    );
+    assert_eq!(off, gated);
 }

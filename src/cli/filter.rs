@@ -39,8 +39,8 @@ pub struct FilterArgs {
     in_memory: bool,
     /// Innovation gate: a scalar update whose innovation exceeds this many of its predicted σ
     /// (√S), e.g. 10, is not applied, and is counted in the summary and listed at the end of
-    /// innovations.txt; after 3 epochs of a component rejected in a row the next is applied
-    /// [default: off: every update applied; single outlying fixes are dropped before the run].
+    /// innovations.txt; after 5 epochs of a component rejected in a row the next is applied.
+    /// `off` applies every update (single outlying fixes are dropped before the run all the same).
     #[arg(long, default_value = "off", allow_hyphen_values = true)]
     gate: String,
 }
@@ -52,9 +52,9 @@ fn gate(text: &str) -> Result<Option<f64>> {
     }
     match text.trim().parse::<f64>() {
         Ok(g) if (3.0..=1e6).contains(&g) => Ok(Some(g)),
-        Ok(g) => anyhow::bail!(
+        Ok(_) => anyhow::bail!(
             "--gate {}: a gate is between 3 and 1e6 σ (below 3 it rejects good fixes: 0.3 % of honest innovations lie beyond 3 σ), or `off`",
-            sinsmodel::io::units::shown_number(g)
+            sinsmodel::io::lines::shown(text.trim())
         ),
         Err(_) => anyhow::bail!(
             "--gate `{text}`: expected a number of σ (e.g. 10) or `off`"
@@ -210,26 +210,33 @@ fn print_summary(
     }
 }
 
-/// The summary's line on the fixes the innovation gate `gate` [σ] rejected (None when it
-/// rejected none), with a warning when they are more than 1 % of the updates: then the model or
+/// The summary's line on the fixes the innovation gate `gate` [σ] rejected (None without a
+/// gate), with a warning when they are more than 1 % of the updates: then the model or
 /// the stated noise misses something, rather than the fixes being outliers.
 fn gated_line(run: &FilterRun, gate: Option<f64>) -> Option<String> {
-    let (g, first) = (gate?, run.gated.first()?);
+    let g = gate?;
     let k = run.gated.len();
     let all = k + run.innovations.len();
+    let Some(first) = run.gated.first() else {
+        return Some(format!(
+            "gate: none of {all} scalar updates rejected (|nu| > {} sigma)",
+            sinsmodel::io::units::shown_number(g)
+        ));
+    };
     let mut epochs: Vec<f64> = run.gated.iter().map(|i| i.t).collect();
     epochs.dedup();
     let mut line = format!(
-        "gate: {k} of {all} scalar updates rejected (|nu| > {} sigma), at {} epochs, the first at t = {:.3} s ({} component {}); listed at the end of innovations.txt",
+        "gate: {k} of {all} scalar updates rejected (|nu| > {} sigma), at {} epoch{}, the first at t = {:.3} s ({} component {}); listed at the end of innovations.txt",
         sinsmodel::io::units::shown_number(g),
         epochs.len(),
+        if epochs.len() == 1 { "" } else { "s" },
         first.t,
         first.meas,
         first.component
     );
     if run.gate_passed > 0 {
         line.push_str(&format!(
-            "\nwarning: {} updates beyond the gate were applied all the same, each after {} epochs of its component rejected in a row: there the filter, not the fixes, was off",
+            "\nwarning: {} updates beyond the gate were applied all the same, each after {} epochs of its component rejected in a row: a longer run than outlier bursts have, so a step in the fixes that stays or a filter that is off there (the listed innovations show which)",
             run.gate_passed,
             sinsmodel::estimate::filter::GATE_RUN
         ));

@@ -5,6 +5,7 @@
 use super::aid::{AidPlan, Outage};
 use super::DataOptions;
 use crate::estimate::filter::AidingEpoch;
+use crate::io::aiding::PositionFix;
 use crate::io::imu_stream::ImuStream;
 use crate::io::truth::{self, TruthRow};
 use crate::nav::earth;
@@ -172,15 +173,24 @@ impl DataOptions {
             ));
         }
         // a gyro bias at rest beyond the stated grade's (unless --prior sets the gyro biases)
-        // the largest gyro-bias prior given [deg/h] (the priors are checked where they are
-        // applied; one that does not parse is left to that check)
-        let eps_prior = self
-            .prior
-            .iter()
-            .filter_map(|p| p.split_once('='))
-            .filter(|(name, _)| name.trim().starts_with("eps"))
-            .filter_map(|(_, q)| crate::io::units::parse_quantity_as(q, "deg/h").ok())
-            .reduce(f64::max);
+        // the gyro-bias prior given for each axis [deg/h] (the most specific --prior, as where
+        // they are applied; one that does not parse is left to that check)
+        let eps_prior = ["eps_x", "eps_y", "eps_z"].map(|state| {
+            self.prior
+                .iter()
+                .filter_map(|p| p.split_once('='))
+                .filter_map(|(name, q)| {
+                    let name = name.trim();
+                    let rank = match name.strip_suffix('*') {
+                        Some(prefix) if state.starts_with(prefix) => prefix.len(),
+                        None if name == state => usize::MAX,
+                        _ => return None,
+                    };
+                    Some((rank, q))
+                })
+                .max_by_key(|x| x.0)
+                .and_then(|(_, q)| crate::io::units::parse_quantity_as(q, "deg/h").ok())
+        });
         let beyond = crate::estimate::imu_check::gyro_bias_beyond_grade(
             &check,
             self.grade.as_deref(),
@@ -218,6 +228,7 @@ impl DataOptions {
         // the rest of the run, a window at a time as it is read
         use crate::estimate::imu_check::{window_check, WindowJudge};
         let mut judge = WindowJudge::new(start.lat, &check, mems);
+        let witness_for_claim = witness.clone();
         if let Some(w) = witness {
             judge.witness_rest(w);
         }
@@ -236,6 +247,19 @@ impl DataOptions {
                     "aid a moving run with GNSS fixes (--aid)"
                 }
             );
+        }
+        // the GNSS fixes beside --zupt say whether the vehicle stands (speed less 3σ)
+        if let (Some("--zupt"), Some(crate::estimate::imu_check::RestWitness::Speeds(v))) =
+            (claim, witness_for_claim.as_ref())
+        {
+            if let Some((t, sp)) = v.iter().find(|x| x.0 > start.t && x.1 > 1.0) {
+                bail!(
+                    "--zupt says the vehicle does not move, but the aiding fixes move: {:.2} m/s (less 3 σ of its noise) at {}: \
+                     leave out --zupt (it adds a zero-velocity update at every aiding epoch), or cut the files to the stretch at rest",
+                    sp,
+                    crate::io::aiding::time_from_first_sample(*t, imu.first_t())
+                );
+            }
         }
         if let Some(p) = claim.and_then(|o| judge.claim_rest(o, imu.head())) {
             if self.force {
@@ -289,8 +313,9 @@ impl DataOptions {
 }
 
 /// The aiding must go on after the start (at least 10 epochs) and begin where the start is
-/// (within 20 km of it; a height 3.28× the other's beyond what 10 s of climbing allows refused
-/// as feet, any height over 60 m off warned as two datums).
+/// (within 20 km of it; a height 3.28× the other's beyond what the geoid and 10 s of climbing
+/// allow refused as feet, or over 1000 m off; over 60 m off warned as two datums, over 150 m as
+/// more than that).
 fn check_plan_at_start(plan: &AidPlan, start: &NavState, note: &mut dyn FnMut(&str)) -> Result<()> {
     let t0 = start.t;
     let far = |lat: f64, lon: f64| {
@@ -311,9 +336,11 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState, note: &mut dyn FnMut(&s
                 let dh = f.h - start.h;
                 let feet = (f.h / start.h / 3.2808 - 1.0).abs() < 0.05
                     || (start.h / f.h / 3.2808 - 1.0).abs() < 0.05;
-                // beyond what 10 s of climbing (10 m/s) and the fix's noise allow
-                let allowed = 30.0 + 5.0 * f.sigma[2] + 10.0 * (f.t - t0).max(0.0);
-                if dh.abs() > 1000.0 || (feet && dh.abs() > allowed) {
+                // beyond what the geoid (±100 m between ellipsoidal and sea-level heights), 10 s
+                // of climbing (10 m/s) and the fix's noise allow
+                let climb = 5.0 * f.sigma[2] + 10.0 * (f.t - t0).max(0.0);
+                let beyond_datum = dh.abs() > 150.0 + climb;
+                if dh.abs() > 1000.0 || (feet && beyond_datum) {
                     bail!(
                         "the initial height {:.1} m is {:.1} m from the first aiding fix's {:.1} m (t = {:.3} s){}: check --init / --aid",
                         start.h,
@@ -323,11 +350,20 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState, note: &mut dyn FnMut(&s
                         if feet { ", 3.28×: one of them in feet?" } else { "" }
                     );
                 }
-                if dh.abs() > allowed.max(60.0) {
+                if dh.abs() > 60.0 + climb {
+                    let why = if beyond_datum {
+                        "more than two height datums differ by (ellipsoidal and mean-sea-level heights differ by the geoid's \
+                         undulation, within ±100 m): a wrong initial height, or fixes from elsewhere?"
+                            .to_string()
+                    } else {
+                        format!(
+                            "heights on two datums? (ellipsoidal heights, as GNSS gives them, and heights above mean sea level \
+                             differ by the geoid's undulation, up to ±100 m){}",
+                            if feet { ", or one of them in feet (3.28×)" } else { "" }
+                        )
+                    };
                     note(&format!(
-                        "warning: the initial height {:.1} m is {:.1} m from the first aiding fix's {:.1} m (t = {:.3} s, σ {:.2} m): \
-                         heights on two datums? (ellipsoidal heights, as GNSS gives them, and heights above mean sea level differ by \
-                         the geoid's undulation, up to ±100 m); check --init / --aid",
+                        "warning: the initial height {:.1} m is {:.1} m from the first aiding fix's {:.1} m (t = {:.3} s, σ {:.2} m): {why}; check --init / --aid",
                         start.h,
                         dh.abs(),
                         f.h,
@@ -405,9 +441,10 @@ pub const FIX_ACCEL_MAX: f64 = 9.80665;
 
 /// The aiding file against itself, for every run (`--init auto` checked the velocities only
 /// for its own use): the receiver's velocities against the position differences (swapped,
-/// negated or mis-scaled columns refused), and single fixes far off the line through their
-/// neighbours (beyond 10 σ plus what 1 g can do in between: an outlier) dropped with a
-/// warning that counts them (`first_t` [s]: the first IMU sample, for the times said).
+/// negated or mis-scaled columns refused), and single fixes (or pairs) far off the line through
+/// their neighbours and off the tracks of the two fixes before and the two after (beyond 10 σ
+/// plus what 1 g can do in between: an outlier) dropped with a warning that counts them
+/// (`first_t` [s]: the first IMU sample, for the times said).
 fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> Result<()> {
     let AidPlan::Fixes(list, _, _) = plan else {
         return Ok(());
@@ -419,16 +456,15 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
         .collect();
     let receiver: Vec<bool> = list.iter().map(|(_, v)| v.is_some()).collect();
     init::check_velocities(&fixes, &receiver)?;
-    // each interior fix's distance from the line through its neighbours [m], when off
-    let mut off_by: Vec<Option<f64>> = vec![None; list.len()];
-    for k in 1..list.len().saturating_sub(1) {
-        let (a, p, b) = (&list[k - 1].0, &list[k].0, &list[k + 1].0);
-        let (ta, tb) = (p.t - a.t, b.t - p.t);
-        if !(ta > 0.0 && tb > 0.0 && ta + tb <= 10.0) {
-            continue;
+    // how far fix p is from the line through fixes a and b at its time [m] (interpolated
+    // between them or extrapolated beyond), when beyond 10 σ plus what 1 g allows
+    let off = |p: &PositionFix, a: &PositionFix, b: &PositionFix| -> Option<f64> {
+        let (ta, tb) = (p.t - a.t, p.t - b.t);
+        let span = b.t - a.t;
+        if !(span > 0.0 && ta.abs().max(tb.abs()) <= 10.0) {
+            return None;
         }
-        // the fix against the line through its neighbours, north, east and down [m]
-        let w = ta / (ta + tb);
+        let w = ta / span;
         let (rm, rn) = (
             earth::radius_meridian(p.lat) + p.h,
             earth::radius_transverse(p.lat) + p.h,
@@ -440,21 +476,27 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
                 * p.lat.cos(),
             -(p.h - (a.h + w * (b.h - a.h))),
         ];
-        let room = 0.5 * FIX_ACCEL_MAX * ta * tb;
-        let off = (0..3).any(|i| {
-            let s = p.sigma[i].hypot(a.sigma[i].max(b.sigma[i]));
-            d[i].abs() > 10.0 * s + room
-        });
-        if off {
-            off_by[k] = Some(d[0].hypot(d[1]).hypot(d[2]));
-        }
-    }
-    // an outlier also throws its neighbours' lines off (by about half): the fix further off
-    // than both neighbours is the one
-    let dist = |k: usize| off_by.get(k).copied().flatten().unwrap_or(0.0);
-    let outliers: Vec<(usize, f64)> = (1..list.len().saturating_sub(1))
-        .filter_map(|k| off_by[k].map(|d| (k, d)))
-        .filter(|&(k, d)| d > dist(k - 1) && d > dist(k + 1))
+        let room = 0.5 * FIX_ACCEL_MAX * (ta * tb).abs();
+        (0..3)
+            .any(|i| {
+                let s = p.sigma[i].hypot(a.sigma[i].max(b.sigma[i]));
+                d[i].abs() > 10.0 * s + room
+            })
+            .then(|| d[0].hypot(d[1]).hypot(d[2]))
+    };
+    // an outlier is off the line through its neighbours, and off the tracks its two
+    // predecessors and its two successors make (where it has them): a clean fix beside an
+    // outlier is off the first line but on one of the tracks, and a burst of shifted fixes
+    // lies on its own track (left to the filter's innovations and --gate)
+    let n = list.len();
+    let outliers: Vec<(usize, f64)> = (1..n.saturating_sub(1))
+        .filter_map(|k| {
+            let f = |i: usize| &list[i].0;
+            let d = off(f(k), f(k - 1), f(k + 1))?;
+            let before = k < 2 || off(f(k), f(k - 2), f(k - 1)).is_some();
+            let after = k + 2 >= n || off(f(k), f(k + 1), f(k + 2)).is_some();
+            (before && after).then_some((k, d))
+        })
         .collect();
     let Some(&(k0, d0)) = outliers.first() else {
         return Ok(());
@@ -472,8 +514,9 @@ fn check_fixes(plan: &mut AidPlan, first_t: f64, note: &mut dyn FnMut(&str)) -> 
         return Ok(());
     }
     note(&format!(
-        "warning: --aid: {} of {} fixes dropped as outliers, each off the line through its neighbours by more than 10 σ plus what 1 g \
-         allows between them (the first {} off, {})",
+        "warning: --aid: {} of {} fixes dropped as outliers, each off the line through its neighbours and off the tracks of the two \
+         fixes before it and the two after it, by more than 10 σ plus what 1 g allows (the first {} off, {}); a longer burst of shifted \
+         fixes is kept (its own track): --gate takes it out in the filter",
         outliers.len(),
         list.len(),
         crate::io::units::sig3(d0) + " m",

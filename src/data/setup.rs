@@ -527,10 +527,13 @@ fn noise_inline_all(text: &str) -> Result<[Option<f64>; 4]> {
 /// Plausible white-noise densities (SI): gyro ARW 1e-9 ..= 1 rad/√s (the best ring-laser gyros
 /// are near 3e-7), accelerometer VRW 1e-7 ..= 100 m/s/√s (0.01 µg/√Hz upward).
 fn noise_range(gyro: bool) -> (f64, f64) {
+    // the worst MEMS parts: a few deg/√h, a few hundred µg/√Hz; the bounds are 100× beyond
+    // (0.1 rad/√s = 344 deg/√h, 1 m/s/√s = 102 mg/√Hz), so a value in µg/√Hz or deg/√h read
+    // as SI is refused
     if gyro {
-        (1e-9, 1.0)
+        (1e-9, 0.1)
     } else {
-        (1e-7, 100.0)
+        (1e-7, 1.0)
     }
 }
 

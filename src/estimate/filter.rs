@@ -286,15 +286,20 @@ pub struct FilterRun {
     /// `innovations`.
     pub gated: Vec<Innovation>,
     /// Updates beyond the gate that were applied all the same, because the gate had rejected
-    /// [`GATE_RUN`] epochs of that component in a row (the filter, not the fixes, was off).
+    /// [`GATE_RUN`] epochs of that component in a row (a step in the fixes that stays, or a
+    /// filter that is off: either way no outlier burst).
     pub gate_passed: usize,
+    /// Each position epoch's horizontal residual z − H x⁻ before any of its components is
+    /// applied: (t [s], [north, east] [m]) (an outage's drift against the first fix after it).
+    pub pos_ne_prior: Vec<(f64, [f64; 2])>,
 }
 
 /// Epochs in a row the innovation gate rejects of one measurement component before it lets the
-/// next through: outliers come alone or in short bursts; a longer run means the filter is off,
-/// and a gate would keep it off (on the shared MEMS drive a 10-σ gate without this limit
-/// rejected 20 % of the updates, where 0.3 % lie beyond 10 σ without a gate).
-pub const GATE_RUN: u32 = 3;
+/// next through: outliers come alone or in short bursts (a 6-fix burst keeps 4 after the fix
+/// check drops its ends); a longer run is a step that stays or a filter that is off, and a gate
+/// would keep it off (on the shared MEMS drive a 10-σ gate without this limit rejected 20 % of
+/// the updates, where 0.3 % lie beyond 10 σ without a gate).
+pub const GATE_RUN: u32 = 5;
 
 impl FilterRun {
     /// An error when the run cannot support an answer: non-finite updates or states, or no
@@ -431,6 +436,8 @@ struct Engine<'a> {
     gated: Vec<Innovation>,
     /// Epochs in a row the gate rejected, per (measurement, component).
     gate_runs: Vec<(&'static str, usize, u32)>,
+    /// (t [s], north and east pos_ne residual [m] before the epoch's updates).
+    pos_ne_prior: Vec<(f64, [f64; 2])>,
     /// Updates beyond the gate applied because the gate had rejected GATE_RUN epochs in a row.
     gate_passed: usize,
     model: &'a Model,
@@ -541,6 +548,7 @@ impl<'a> Engine<'a> {
             first_nonfinite_t: None,
             gated: Vec::new(),
             gate_runs: Vec::new(),
+            pos_ne_prior: Vec::new(),
             gate_passed: 0,
         }
     }
@@ -661,15 +669,26 @@ impl<'a> Engine<'a> {
             self.model
                 .fill_h(name, &np, h)
                 .expect("the model supports the measurements it lists");
+            // GNSS terms fed back (closed loop) are known values: z − H θ_fed
+            for (comp, zc) in z.iter_mut().enumerate() {
+                let h_row = &self.h[comp * n..(comp + 1) * n];
+                *zc -= self
+                    .gnss_terms
+                    .iter()
+                    .map(|&i| h_row[i] * self.correction[i])
+                    .sum::<f64>();
+            }
+            // the horizontal position residual before any of its components is applied (an
+            // outage's drift; the sequential update changes the east one after the north)
+            if name == "pos_ne" && rows == 2 {
+                let prior = |c: usize| {
+                    let h_row = &self.h[c * n..(c + 1) * n];
+                    z[c] - h_row.iter().zip(&self.x).map(|(h, x)| h * x).sum::<f64>()
+                };
+                self.pos_ne_prior.push((ep.t, [prior(0), prior(1)]));
+            }
             for (comp, (&zc, &sc)) in z.iter().zip(&sigma).enumerate() {
                 let h_row = &self.h[comp * n..(comp + 1) * n];
-                // GNSS terms fed back (closed loop) are known values: z − H θ_fed
-                let zc = zc
-                    - self
-                        .gnss_terms
-                        .iter()
-                        .map(|&i| h_row[i] * self.correction[i])
-                        .sum::<f64>();
                 if !(zc.is_finite() && sc.is_finite()) {
                     self.nonfinite += 1;
                     self.first_nonfinite_t.get_or_insert(ep.t);
@@ -1081,6 +1100,7 @@ pub fn run_stream(
         diverged,
         gated: e.gated,
         gate_passed: e.gate_passed,
+        pos_ne_prior: e.pos_ne_prior,
     })
 }
 

@@ -175,6 +175,10 @@ impl Seen {
         // means with each sample's own interval (the first sample's interval is unknown: skipped)
         let (mut sdv, mut sdth, mut sdt) = (Vector3::zeros(), Vector3::zeros(), 0.0);
         let mut rates: Vec<Vector3<f64>> = Vec::new();
+        // |f| of 1-s means: vibration averages out inside one, and a body that turns over (a
+        // turntable tumbling about a level axis) keeps |f| = g in each, where the window's mean
+        // vector shrinks towards zero
+        let (mut bdv, mut bdt, mut blocks) = (Vector3::zeros(), 0.0, Vec::new());
         for w in s.windows(2) {
             let (a, b) = (&w[0], &w[1]);
             if b.t <= w0 || b.t > w1 {
@@ -185,6 +189,15 @@ impl Seen {
             sdth += b.dtheta;
             sdt += dt;
             rates.push(b.dv / dt);
+            bdv += b.dv;
+            bdt += dt;
+            if bdt >= 1.0 {
+                blocks.push(bdv.norm() / bdt);
+                (bdv, bdt) = (Vector3::zeros(), 0.0);
+            }
+        }
+        if blocks.is_empty() && bdt > 0.0 {
+            blocks.push(bdv.norm() / bdt);
         }
         let g = earth::gravity(lat.unwrap_or(std::f64::consts::FRAC_PI_4), 0.0);
         let omega = earth::OMEGA;
@@ -212,7 +225,11 @@ impl Seen {
             spread,
             is_static: rates.len() >= 10 && spread < 0.5,
             g,
-            gravity_ratio: f.norm() / g,
+            gravity_ratio: if blocks.is_empty() {
+                f.norm() / g
+            } else {
+                blocks.iter().sum::<f64>() / blocks.len() as f64 / g
+            },
             earth_rate_ratio: w.norm() / omega,
             roll: (-f.y).atan2(-f.z),
             pitch: f.x.atan2(f.y.hypot(f.z)),
@@ -238,17 +255,16 @@ impl Said {
     /// On a window that is not static: only a specific force far from gravity (0.5 to 2 g) says
     /// something.
     fn moving(&mut self, m: &Seen) {
-        let (w0, w1, f, g, gravity_ratio, spread) =
-            (m.w0, m.w1, m.f, m.g, m.gravity_ratio, m.spread);
+        let (w0, w1, g, gravity_ratio, spread) = (m.w0, m.w1, m.g, m.gravity_ratio, m.spread);
         // no vehicle averages 0.5 g or 2 g of specific force over seconds: a unit error shows
         // even while moving
         if !(0.5..2.0).contains(&gravity_ratio) {
             let p = format!(
-                "mean specific force |f| = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
+                "mean specific force |f| (of 1-s means) = {} m/s² over {w0:.1}–{w1:.1} s is {}× local gravity ({g:.4} m/s²), \
                  which no vehicle averages over seconds, at rest or moving: the accelerometer unit or scale (accel_unit, per-count scale) or the clock is wrong{}",
-                crate::io::units::sig3(f.norm()),
+                crate::io::units::sig3(gravity_ratio * g),
                 crate::io::units::sig3(gravity_ratio),
-                unit_hint(g / f.norm())
+                unit_hint(1.0 / gravity_ratio)
             );
             self.problems.push(p.clone());
             self.unit_problems.push(p);
@@ -723,52 +739,53 @@ pub fn least_gyro_bias_deg_h(check: &ImuCheck) -> Option<f64> {
         .then(|| (check.earth_rate_ratio - 1.0).max(0.0) * earth::OMEGA.to_degrees() * 3600.0)
 }
 
-/// A gyro bias at rest beyond what the sensor grade `grade` (None: navigation) has, or five σ
-/// of the largest gyro-bias prior given (`prior_deg_h`) when that is more, in words
-/// with its likely cause (deg/s read as rad/s), for the first seconds' check `check`; None
-/// within it, or with a MEMS grade (whose biases reach what a unit slip gives). The limits are
-/// far above the grades' priors: 10 s "at rest" by the specific force can still rock (the
-/// parked RLG log's first seconds turn at 55 deg/h).
+/// A gyro bias at rest beyond what the sensor grade `grade` (None: navigation) has, or on an
+/// axis five σ of the gyro-bias prior given for it (`prior_deg_h`, x y z) when that is more, in
+/// words with its likely cause (deg/s read as rad/s), for the first seconds' check `check`; None
+/// within it, or with a MEMS grade (whose biases reach what a unit slip gives). Each axis's
+/// least bias is its mean rate less Earth's whole rate. The limits are far above the grades'
+/// priors: 10 s "at rest" by the specific force can still rock (the parked RLG log's first
+/// seconds turn at 55 deg/h).
 pub fn gyro_bias_beyond_grade(
     check: &ImuCheck,
     grade: Option<&str>,
-    prior_deg_h: Option<f64>,
+    prior_deg_h: [Option<f64>; 3],
 ) -> Option<String> {
-    let (limit, words) = match grade {
+    let (grade_limit, grade_words) = match grade {
         None => (
             150.0,
-            "a navigation-grade gyro's (the default grade; prior 0.02 deg/h".to_string(),
+            "a navigation-grade gyro's (the default grade; prior 0.02 deg/h",
         ),
-        Some("tactical") => (300.0, "a tactical-grade gyro's (prior 1 deg/h".to_string()),
+        Some("tactical") => (300.0, "a tactical-grade gyro's (prior 1 deg/h"),
         _ => return None,
     };
-    // a gyro-bias prior given says what bias is plausible: five of its σ, not below the grade's
-    let (limit, words) = match prior_deg_h {
-        Some(p) if 5.0 * p > limit => (
-            5.0 * p,
-            format!(
-                "five σ of the gyro-bias prior given (--prior eps…: {} deg/h",
-                crate::io::units::sig3(p)
+    least_gyro_bias_deg_h(check)?;
+    let deg_h = 180.0 / std::f64::consts::PI * 3600.0;
+    let earth_deg_h = earth::OMEGA * deg_h;
+    (0..3).find_map(|i| {
+        let b = (check.w_mean_radps[i].abs() * deg_h - earth_deg_h).max(0.0);
+        // a gyro-bias prior given says what bias is plausible: five of its σ, not below the grade's
+        let (limit, words) = match prior_deg_h[i] {
+            Some(p) if 5.0 * p > grade_limit => (
+                5.0 * p,
+                format!(
+                    "five σ of the gyro-bias prior given for {} (--prior: {} deg/h",
+                    ["x", "y", "z"][i],
+                    crate::io::units::sig3(p)
+                ),
             ),
-        ),
-        Some(p) => (
-            limit,
+            _ => (grade_limit, grade_words.to_string()),
+        };
+        (b > limit).then(|| {
             format!(
-                "{words} and --prior eps… {} deg/h",
-                crate::io::units::sig3(p)
-            ),
-        ),
-        None => (limit, words),
-    };
-    let b = least_gyro_bias_deg_h(check)?;
-    (b > limit).then(|| {
-        format!(
-            "at rest the gyros read {} deg/h ({}× Earth rate): a bias of at least {} deg/h, beyond {words}, \
-             at most {limit} deg/h accepted); the gyro values may be deg/s read as rad/s (57.3× the true rate: check gyro_unit), or the \
-             sensor is of a lower grade (--grade tactical or mems, or --prior 'eps_*=…')",
-            crate::io::units::sig3(check.earth_rate_ratio * earth::OMEGA.to_degrees() * 3600.0),
-            crate::io::units::sig3(check.earth_rate_ratio),
-            crate::io::units::sig3(b)
-        )
+                "at rest the gyros read {} deg/h ({}× Earth rate): on {} a bias of at least {} deg/h, beyond {words}, \
+                 at most {limit} deg/h accepted); the gyro values may be deg/s read as rad/s (57.3× the true rate: check gyro_unit), or the \
+                 sensor is of a lower grade (--grade tactical or mems, or --prior 'eps_*=…')",
+                crate::io::units::sig3(check.earth_rate_ratio * earth_deg_h),
+                crate::io::units::sig3(check.earth_rate_ratio),
+                ["x", "y", "z"][i],
+                crate::io::units::sig3(b)
+            )
+        })
     })
 }

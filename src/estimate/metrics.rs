@@ -181,27 +181,17 @@ pub struct OutageDrift {
 /// For each outage, the pos_ne innovation (computed − fix, before the update) at the first
 /// fix after it: the drift of the filter's solution over the outage. `t_first`, `t_last`: the
 /// first and last IMU sample [s].
-pub fn outage_drifts<'a>(
+pub fn outage_drifts(
     outages: &[Outage],
-    run: &'a FilterRun,
+    run: &FilterRun,
     t_first: f64,
     t_last: f64,
 ) -> Result<Vec<OutageDrift>> {
     let mut out = Vec::new();
     for o in outages {
-        // the first fix after the outage, applied or rejected by the innovation gate (a drift
-        // beyond the gate is the drift all the same)
-        let after = |c: usize| {
-            let first = |v: &'a [super::filter::Innovation]| {
-                v.iter()
-                    .find(|i| i.t >= o.end_s && i.meas == "pos_ne" && i.component == c)
-            };
-            [first(&run.innovations), first(&run.gated)]
-                .into_iter()
-                .flatten()
-                .min_by(|a, b| a.t.total_cmp(&b.t))
-        };
-        let (Some(n), Some(e)) = (after(0), after(1)) else {
+        // the first position fix after the outage, its residual before any update (applied
+        // or rejected by the innovation gate, and the east one not after the north)
+        let Some(&(fix_t, [n, e])) = run.pos_ne_prior.iter().find(|p| p.0 >= o.end_s) else {
             bail!(
                 "--outage {}: no position fix after it inside the data (which end at {}): nothing to measure the drift against",
                 o.words(t_first),
@@ -213,10 +203,10 @@ pub fn outage_drifts<'a>(
             duration_s: o.end_s - o.start_s,
             start_s: o.start_s,
             end_s: o.end_s,
-            fix_t_s: n.t,
-            drift_n_m: n.nu,
-            drift_e_m: e.nu,
-            drift_horizontal_m: n.nu.hypot(e.nu),
+            fix_t_s: fix_t,
+            drift_n_m: n,
+            drift_e_m: e,
+            drift_horizontal_m: n.hypot(e),
         });
     }
     Ok(out)
