@@ -176,19 +176,9 @@ impl DataOptions {
         // the gyro-bias prior given for each axis [deg/h] (the most specific --prior, as where
         // they are applied; one that does not parse is left to that check)
         let eps_prior = ["eps_x", "eps_y", "eps_z"].map(|state| {
-            self.prior
-                .iter()
-                .filter_map(|p| p.split_once('='))
-                .filter_map(|(name, q)| {
-                    let name = name.trim();
-                    let rank = match name.strip_suffix('*') {
-                        Some(prefix) if state.starts_with(prefix) => prefix.len(),
-                        None if name == state => usize::MAX,
-                        _ => return None,
-                    };
-                    Some((rank, q))
-                })
-                .max_by_key(|x| x.0)
+            super::setup::prior_for(&self.prior, state)
+                .ok()
+                .flatten()
                 .and_then(|(_, q)| crate::io::units::parse_quantity_as(q, "deg/h").ok())
         });
         let beyond = crate::estimate::imu_check::gyro_bias_beyond_grade(

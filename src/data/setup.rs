@@ -575,7 +575,7 @@ fn check_prior_repeats(specs: &[String]) -> Result<()> {
 /// exact name over any prefix, a longer prefix over a shorter (`eps_x=1 deg/h` wins over
 /// `eps_*=10 deg/h` whatever their order). Names are unique ([`check_prior_repeats`]), so no
 /// two matches are equally specific.
-fn prior_for<'a>(specs: &'a [String], name: &str) -> Result<Option<(&'a str, &'a str)>> {
+pub(super) fn prior_for<'a>(specs: &'a [String], name: &str) -> Result<Option<(&'a str, &'a str)>> {
     let mut best: Option<(usize, &str, &str)> = None;
     for spec in specs {
         let (pattern, value) = prior_parts(spec)?;
