@@ -604,10 +604,10 @@ fn aiding_on_another_day_or_clock_is_named() {
     }
 }
 
-/// An aiding file whose clock is 30 s late against the IMU's: while the IMU turns at 12 deg/s
-/// the fixes stamped then still stand (they describe the rest 30 s before). Said as a likely
-/// clock offset (a warning: a vehicle can turn in place); the same data on one clock say
-/// nothing.
+/// An aiding file whose clock is 30 s late against the IMU's: the GNSS course turns match the
+/// gyros' 30 s before their stamps (refused, the offset named; with --force warned), and while
+/// the IMU turns at 12 deg/s the fixes stamped then still stand (they describe the rest 30 s
+/// before; a warning: a vehicle can turn in place); the same data on one clock say nothing.
 #[test]
 fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
     let dir = tempfile::tempdir().unwrap();
@@ -616,7 +616,7 @@ fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
     std::fs::write(
         &sc,
         "name = \"clk\"\nimu_rate_hz = 100.0\nseed = 3\n[start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\n\
-         [[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 2.0\naccel_mps2 = 1.0\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 2.0\naccel_mps2 = 3.0\n\
          [[segment]]\nkind = \"turn\"\nduration_s = 20.0\nyaw_rate_deg_s = 15.0\n[[segment]]\nkind = \"cruise\"\nduration_s = 20.0\n\
          [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
     )
@@ -635,29 +635,44 @@ fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
         })
         .collect();
     std::fs::write(d.join("late.txt"), late).unwrap();
-    let run = |aid: &Path, out: &str| {
-        let (ok, _, err) = sinsmodel(&[
+    let imu = sim.join("imu.txt");
+    let run = |aid: &Path, out: &str, force: bool| {
+        let out = d.join(out);
+        let mut args = vec![
             "filter",
             "--model",
             "P13",
             "--imu",
-            p(&sim.join("imu.txt")),
+            p(&imu),
             "--aid",
             p(aid),
             "--init",
             "40.0966,-105.1474,1601,0,0,0",
             "--out",
-            p(&d.join(out)),
-        ]);
-        assert!(ok, "{err}");
-        err
+            p(&out),
+        ];
+        if force {
+            args.push("--force");
+        }
+        let (ok, _, err) = sinsmodel(&args);
+        (ok, err)
     };
-    let err = run(&sim.join("gnss.txt"), "clean");
-    assert!(!err.contains("warning"), "{err}");
-    let err = run(&d.join("late.txt"), "late");
+    let (ok, err) = run(&sim.join("gnss.txt"), "clean", false);
+    assert!(ok && !err.contains("warning"), "{err}");
+    // the GNSS course turns 300° 30 s after the gyros: refused at the end of the IMU file
+    let (ok, err) = run(&d.join("late.txt"), "late", false);
     assert!(
-        err.contains("at 40.1–50.1 s: the IMU turns")
-            && err.contains("the aiding's clock is likely off against the IMU's"),
+        !ok && err.contains("--aid: the aiding's clock is likely 30.0 s off the IMU's")
+            && err.contains("add -30.0 s to the aiding file's times")
+            && !d.join("late").exists(),
+        "{err}"
+    );
+    let (ok, err) = run(&d.join("late.txt"), "late", true);
+    assert!(
+        ok && err.contains("at 40.1–50.1 s: the IMU turns")
+            && err.contains("the aiding's clock is likely off against the IMU's")
+            && err.contains("likely 30.0 s off the IMU's")
+            && err.contains("(--force given)"),
         "{err}"
     );
 }
@@ -842,4 +857,71 @@ fn the_outage_drift_does_not_depend_on_the_gate() {
         "the gate rejects the fix after the outage: {err}"
     );
     assert_eq!(off, gated);
+}
+
+/// The shared MEMS drive with its RTK file moved on the clock: 60 s late is refused (the GNSS
+/// course turns match the gyros' 60 s before their stamps), 2 s late is warned (its turns still
+/// match in part as stamped); as recorded, nothing is said of the clock.
+#[test]
+fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
+    let pos = std::fs::read_to_string(shared.join("gnss_1934_sf.pos")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // moves every epoch by `shift` seconds (within the day: the drive is at 19:34 GPST)
+    let moved = |shift: f64| -> PathBuf {
+        let text: String = pos
+            .lines()
+            .map(|l| {
+                if l.starts_with('%') {
+                    return format!("{l}\n");
+                }
+                let (date, rest) = l.split_once(' ').unwrap();
+                let (time, rest) = rest.trim_start().split_once(' ').unwrap();
+                let hms: Vec<f64> = time.split(':').map(|x| x.parse().unwrap()).collect();
+                let s = hms[0] * 3600.0 + hms[1] * 60.0 + hms[2] + shift;
+                let (h, m) = ((s / 3600.0).floor(), ((s % 3600.0) / 60.0).floor());
+                format!(
+                    "{date} {h:02}:{m:02}:{:06.3} {rest}\n",
+                    s - h * 3600.0 - m * 60.0
+                )
+            })
+            .collect();
+        let path = d.join(format!("moved{shift}.pos"));
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let run = |aid: &Path| {
+        let (ok, _, err) = sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            p(&shared.join("imu_1934.csv")),
+            "--aid",
+            p(aid),
+            "--init",
+            "auto",
+            "--grade",
+            "mems",
+            "--out",
+            p(&d.join("o")),
+        ]);
+        (ok, err)
+    };
+    let (ok, err) = run(&moved(0.0));
+    assert!(ok && !err.contains("clock is likely"), "{err}");
+    let (ok, err) = run(&moved(2.0));
+    assert!(
+        ok && err.contains("warning: --aid: the aiding's clock is likely 2.0 s off the IMU's")
+            && err.contains("add -2.0 s"),
+        "{err}"
+    );
+    let (ok, err) = run(&moved(60.0));
+    assert!(
+        !ok && err.contains("error: --aid: the aiding's clock is likely 60.0 s off the IMU's")
+            && err.contains("add -60.0 s")
+            && err.contains("(--force runs anyway)"),
+        "{err}"
+    );
 }

@@ -222,6 +222,12 @@ impl DataOptions {
         if let Some(w) = witness {
             judge.witness_rest(w);
         }
+        if let AidPlan::Fixes(list, _, _) = plan {
+            use crate::estimate::clock_check::{course_turns, ClockCheck};
+            if let Some(c) = ClockCheck::new(course_turns(list)) {
+                judge.watch_clock(c, imu.head());
+            }
+        }
         let claim = if self.static_aid.is_some() {
             Some("--static-aid")
         } else {

@@ -466,6 +466,8 @@ pub struct WindowJudge {
     /// What says the vehicle is at rest, beside the IMU (whose steady turn on a smooth curve
     /// looks like rest): None, nothing (the gyros of later windows are not judged).
     rest_witness: Option<RestWitness>,
+    /// The GNSS course turns against the gyros' (the aiding's clock), when there are fixes.
+    clock: Option<super::clock_check::ClockCheck>,
 }
 
 /// What says, beside the IMU, that the vehicle stands still in a stretch.
@@ -591,7 +593,30 @@ impl WindowJudge {
             rest_claim: None,
             t_first: head.window_s[0],
             rest_witness: None,
+            clock: None,
         }
+    }
+
+    /// Has the aiding's clock checked against the IMU's from the turns both see (`clock`, fed
+    /// the first seconds `head` here and every later window as it is judged).
+    pub fn watch_clock(
+        &mut self,
+        mut clock: super::clock_check::ClockCheck,
+        head: &[crate::io::imu::ImuSample],
+    ) {
+        clock.feed(head);
+        self.clock = Some(clock);
+    }
+
+    /// Feeds `window` (consecutive samples after the last) to the clock check; the offset it
+    /// finds (once).
+    pub fn judge_clock(
+        &mut self,
+        window: &[crate::io::imu::ImuSample],
+    ) -> Option<super::clock_check::ClockOffset> {
+        let clock = self.clock.as_mut()?;
+        clock.feed(window);
+        clock.judge(window.is_empty())
     }
 
     /// Lets the gyros of the first later window at rest be judged where `witness` confirms
@@ -708,6 +733,20 @@ pub fn window_check(
 ) -> crate::io::imu_stream::WindowCheck {
     let mut warned = false;
     Box::new(move |w| {
+        if let Some(off) = judge.judge_clock(w) {
+            let p = off.words();
+            if off.beyond_doubt() && !force {
+                anyhow::bail!("--aid: {p} (--force runs anyway)");
+            }
+            eprintln!(
+                "warning: --aid: {p} ({})",
+                if force {
+                    "--force given"
+                } else {
+                    "not refused: the fixes as stamped still match in part"
+                }
+            );
+        }
         let Some((p, warn_only)) = judge.judge(w) else {
             return Ok(());
         };

@@ -4,6 +4,7 @@
 
 pub mod align;
 pub mod allan;
+pub mod clock_check;
 pub mod filter;
 pub mod imu_check;
 pub mod init;

@@ -81,8 +81,11 @@ pub struct ImuStream {
     last_t: f64,
     /// A sample read by [`ImuStream::skip_through`] past its time, handed out next.
     pending: Option<ImuSample>,
-    /// Judges each window of [`HEAD_SECONDS`] after the head ([`ImuStream::judge_windows`]).
+    /// Judges each window of [`HEAD_SECONDS`] after the head ([`ImuStream::judge_windows`]), then an
+    /// empty one at the end of the file.
     judge: Option<WindowCheck>,
+    /// The window check has been told the file ended.
+    ended: bool,
     /// The samples after the head not yet judged.
     window: Vec<ImuSample>,
 }
@@ -171,6 +174,7 @@ impl ImuStream {
             last_t: f64::NAN,
             pending: None,
             judge: None,
+            ended: false,
             window: Vec::new(),
         };
         // validate the head in order, as every later sample will be (prev_t then stands at the
@@ -360,6 +364,7 @@ impl ImuStream {
         } else {
             let Some((s, line)) = self.src.next_sample()? else {
                 self.judge_window()?;
+                self.judge_end()?;
                 return Ok(None);
             };
             self.check(&s, line, self.delivered + 1)?;
@@ -391,6 +396,15 @@ impl ImuStream {
                 self.window.clear();
                 r?;
             }
+        }
+        Ok(())
+    }
+
+    /// Tells the window check the file has ended (an empty window, once).
+    fn judge_end(&mut self) -> Result<()> {
+        if let (Some(judge), false) = (self.judge.as_mut(), self.ended) {
+            self.ended = true;
+            judge(&[])?;
         }
         Ok(())
     }
