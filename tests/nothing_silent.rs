@@ -925,3 +925,63 @@ fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
         "{err}"
     );
 }
+
+/// The shared MEMS drive's RTK heights in feet (the velocities in m/s): with `--init auto` the
+/// start takes the first fix's height, so no start height disagrees; the heights change 3.28×
+/// as fast as the vertical velocities say and that is refused naming feet. An up velocity read
+/// as down is named too; the file as recorded passes (scale 0.98).
+#[test]
+fn the_real_drive_with_heights_in_feet_is_refused_under_init_auto() {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
+    let pos = std::fs::read_to_string(shared.join("gnss_1934_sf.pos")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // column `col` (0-based, after splitting on blanks) through `f`
+    let changed = |name: &str, col: usize, f: &dyn Fn(f64) -> f64| -> PathBuf {
+        let text: String = pos
+            .lines()
+            .map(|l| {
+                if l.starts_with('%') {
+                    return format!("{l}\n");
+                }
+                let mut v: Vec<String> = l.split_whitespace().map(String::from).collect();
+                v[col] = format!("{:.4}", f(v[col].parse().unwrap()));
+                format!("{}\n", v.join("  "))
+            })
+            .collect();
+        let path = d.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let run = |aid: &Path| {
+        let (ok, _, err) = sinsmodel(&[
+            "filter",
+            "--model",
+            "P13",
+            "--imu",
+            p(&shared.join("imu_1934.csv")),
+            "--aid",
+            p(aid),
+            "--init",
+            "auto",
+            "--grade",
+            "mems",
+            "--out",
+            p(&d.join("o")),
+        ]);
+        (ok, err)
+    };
+    let (ok, err) = run(&changed("same.pos", 4, &|h| h));
+    assert!(ok && !err.contains("vertical velocities"), "{err}");
+    let (ok, err) = run(&changed("feet.pos", 4, &|h| h / 0.3048));
+    assert!(
+        !ok && err.contains("--aid: the aiding file's heights change 3.")
+            && err.contains("heights in feet"),
+        "{err}"
+    );
+    let (ok, err) = run(&changed("up.pos", 17, &|vu| -vu));
+    assert!(
+        !ok && err.contains("a vertical velocity up read as down"),
+        "{err}"
+    );
+}

@@ -197,6 +197,8 @@ pub fn velocities_from_positions(fixes: &mut [Fix]) {
 /// wrong unit) is refused naming the first.
 pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
     let (mut checked, mut bad) = (0usize, Vec::new());
+    // the height rate from the positions against the receiver's down velocity: Σ u r, Σ u², Σ r²
+    let mut vertical = [0.0f64; 3];
     for k in 0..fixes.len() {
         let (true, Some(v)) = (receiver[k], fixes[k].v) else {
             continue;
@@ -205,6 +207,9 @@ pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
             continue;
         };
         let (vp, sp) = velocity_between(fixes, a, b);
+        vertical[0] += v.z * vp.z;
+        vertical[1] += v.z * v.z;
+        vertical[2] += vp.z * vp.z;
         checked += 1;
         let d = ((v - vp).x).hypot((v - vp).y);
         if d > 5.0 * fixes[k].sigma_v.hypot(sp) + 1.0 {
@@ -223,7 +228,37 @@ pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
             vp.y
         );
     }
-    Ok(())
+    check_vertical_scale(vertical, checked)
+}
+
+/// The heights against the receiver's vertical velocities over `n` fixes, from the sums `s`
+/// (Σ v_d·ṽ_d, Σ v_d², Σ ṽ_d² [m²/s²], ṽ_d from the height differences): the least-squares
+/// scale of the height rate on the velocity is 1 for one unit and sign; feet give 3.28, an up
+/// velocity read as down −1. Judged where the vertical velocities' RMS is 0.1 m/s or more over
+/// 20 fixes or more, and refused when the scale is off 1 by over 0.3 and 5 σ of its fit.
+fn check_vertical_scale(s: [f64; 3], n: usize) -> Result<()> {
+    if n < 20 || s[1] < n as f64 * 0.01 {
+        return Ok(());
+    }
+    let k = s[0] / s[1];
+    // residual Σ (ṽ − k v)² = Σṽ² − k Σ v ṽ
+    let sigma = ((s[2] - k * s[0]).max(0.0) / (n - 1) as f64 / s[1]).sqrt();
+    if (k - 1.0).abs() <= 0.3 || (k - 1.0).abs() <= 5.0 * sigma {
+        return Ok(());
+    }
+    const FEET_PER_METRE: f64 = 1.0 / 0.3048;
+    let cause = if (k / FEET_PER_METRE - 1.0).abs() < 0.1 {
+        "heights in feet (3.28 per metre)?"
+    } else if (k + 1.0).abs() < 0.3 {
+        "a vertical velocity up read as down (or heights as depths)?"
+    } else {
+        "heights or vertical velocities mis-scaled?"
+    };
+    bail!(
+        "--aid: the aiding file's heights change {k:.2} ± {sigma:.2} times as fast as its vertical velocities say (over {n} fixes, \
+         vertical speed {:.2} m/s RMS): {cause} (--aid-use pos leaves the velocities out)",
+        (s[1] / n as f64).sqrt()
+    )
 }
 
 /// Priors that decide how the heading can be found.
