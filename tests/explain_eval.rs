@@ -253,6 +253,26 @@ fn merged_cases_are_checked_like_any_input() {
     std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
     let (ok, err) = merge(&[edited.as_path()]);
     assert!(!ok && err.contains("wrong_term = true"), "{err}");
+    // a wrong term where only the hidden one was named
+    let mut v = stored.clone();
+    v["cases"][k]["named"] = serde_json::json!([stored["cases"][k]["term"].clone()]);
+    v["cases"][k]["wrong_term"] = serde_json::json!(true);
+    std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+    let (ok, err) = merge(&[edited.as_path()]);
+    assert!(
+        !ok && err.contains("named holds only the hidden term"),
+        "{err}"
+    );
+    // the truth with the other sign than the draw puts the term in with
+    let mut v = stored.clone();
+    let truth = stored["cases"][k]["truth"].as_f64().unwrap();
+    v["cases"][k]["truth"] = serde_json::json!(-truth);
+    std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+    let (ok, err) = merge(&[edited.as_path()]);
+    assert!(
+        !ok && err.contains("puts its term in with the sign of"),
+        "{err}"
+    );
     // the shards as written merge (with the missing ones run)
     let (c, _) = eval("chk_c", &["--cases", "2", "--first", "3"]);
     let (ok, err) = merge(&[a.as_path(), b.as_path(), c.as_path()]);

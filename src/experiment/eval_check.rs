@@ -57,6 +57,15 @@ fn check_draw(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
             shown(want)
         ));
     }
+    // the truth's size comes from the simulation (λ over the signature's information), its
+    // sign from the draw
+    if let (Some(v), Some((_, reference))) = (c.truth, d.case.hidden.first()) {
+        if v != 0.0 && v.signum() != reference.signum() {
+            return Err(format!(
+                "truth {v}: case {i} of seed {seed} puts its term in with the sign of {reference}"
+            ));
+        }
+    }
     let [lo, hi] = spec.lambda;
     match (c.lambda, d.lambda) {
         (None, None) => Ok(()),
@@ -144,6 +153,9 @@ fn check_flags(c: &CaseResult) -> Result<(), String> {
         Some(t) if !d && c.named.iter().any(|n| n == t) => {
             format!("detected = false, yet named holds the hidden term `{t}`")
         }
+        Some(t) if w && c.named.iter().all(|n| n == t) => format!(
+            "wrong_term = true, yet named holds only the hidden term `{t}`: a wrong term is another one"
+        ),
         Some(_) if !d && !w && !nothing => format!(
             "detected = false and wrong_term = false, yet named holds {named}: a named term is the hidden one (detected) or not (a wrong term)"
         ),
