@@ -127,6 +127,9 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         &outage_rows,
         with_truth.then_some(errors.as_slice()),
     );
+    if let Some(w) = rest_claim_line(&args.data, &run) {
+        eprintln!("{w}");
+    }
     eprintln!(
         "wrote {} in {} (nav.txt: {nav_rows} rows)",
         written(with_truth, !inputs.outages.is_empty()).join(", "),
@@ -208,6 +211,32 @@ fn print_summary(
     if let Some(errors) = errors {
         eprint!("{}", model_error_line(errors));
     }
+}
+
+/// Under `--static-aid` or `--zupt`, a line saying that velocity channels whose NIS is too
+/// large also fit a vehicle that moves (a gentle creep or a turn on a curve passes the IMU's
+/// rest checks); None otherwise.
+fn rest_claim_line(data: &sinsmodel::data::DataOptions, run: &FilterRun) -> Option<String> {
+    let claim = if data.static_aid.is_some() {
+        "--static-aid"
+    } else if data.zupt.is_some() {
+        "--zupt"
+    } else {
+        return None;
+    };
+    let large: Vec<String> = filter::nis_by_channel(run)
+        .iter()
+        .filter(|c| c.channel.starts_with("vel_") && c.verdict() == "too large")
+        .map(|c| format!("{} {}", c.channel, sinsmodel::explain::sig3(c.mean)))
+        .collect();
+    (!large.is_empty()).then(|| {
+        format!(
+            "note: {claim} says the vehicle stands still, and its zero-velocity updates' mean NIS ({}) is too large: \
+             the vehicle may move (a creep under 0.3 m/s² or a steady turn passes the IMU's rest checks; \
+             cut the files to the stretch at rest to tell)",
+            large.join(", ")
+        )
+    })
 }
 
 /// The summary's line on the fixes the innovation gate `gate` [σ] rejected (None without a
