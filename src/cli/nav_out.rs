@@ -42,9 +42,57 @@ impl Thinned {
     }
 }
 
+/// Rows handed to the writing thread at once.
+const BATCH_ROWS: usize = 1024;
+/// Batches in flight between the filter and the writing thread (memory stays bounded).
+const BATCHES_IN_FLIGHT: usize = 4;
+
+/// One nav.txt row before formatting: the corrected state and the 1-σ columns the model has.
+struct NavRow {
+    row: TruthRow,
+    sig: [f64; 9],
+    n_sig: u8,
+}
+
+/// The thread that formats and writes nav.txt rows behind the filter (the same bytes as
+/// writing them in line; the filter's thread only computes them): the batches' sender, and
+/// the thread, which hands the file back (or the first write error).
+struct RowWriter {
+    tx: std::sync::mpsc::SyncSender<Vec<NavRow>>,
+    thread: std::thread::JoinHandle<Result<AtomicFile, String>>,
+}
+
+impl RowWriter {
+    fn spawn(mut file: AtomicFile) -> anyhow::Result<RowWriter> {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<NavRow>>(BATCHES_IN_FLIGHT);
+        let thread = std::thread::Builder::new()
+            .name("nav.txt".into())
+            .spawn(move || {
+                let w = file.writer();
+                let mut line = Vec::with_capacity(200);
+                for batch in rx {
+                    for r in &batch {
+                        line.clear();
+                        // the truth layout (same digits), then the sigmas
+                        write_row(&mut line, &r.row).map_err(|e| e.to_string())?;
+                        line.pop(); // its newline
+                        for v in &r.sig[..r.n_sig as usize] {
+                            write!(line, " {v:.4e}").map_err(|e| e.to_string())?;
+                        }
+                        line.push(b'\n');
+                        w.write_all(&line).map_err(|e| e.to_string())?;
+                    }
+                }
+                Ok(file)
+            })?;
+        Ok(RowWriter { tx, thread })
+    }
+}
+
 /// Writes `nav.txt` rows from the filter's [`Observer::nav_sample`].
 pub struct NavWriter {
-    file: AtomicFile,
+    writer: Option<RowWriter>,
+    batch: Vec<NavRow>,
     clock: RowClock,
     idx: [Option<usize>; 9],
     n: usize,
@@ -112,7 +160,8 @@ impl NavWriter {
             "# attitude sigmas are the tilt errors about north, east, down (= roll, pitch, yaw near level)"
         )?;
         Ok(NavWriter {
-            file,
+            writer: Some(RowWriter::spawn(file)?),
+            batch: Vec::with_capacity(BATCH_ROWS),
             clock,
             idx,
             n: model.n(),
@@ -125,11 +174,13 @@ impl NavWriter {
     }
 
     /// Flushes and moves the file into place; draws `png`.
-    pub fn finish(self, png: &std::path::Path) -> anyhow::Result<()> {
+    pub fn finish(mut self, png: &std::path::Path) -> anyhow::Result<()> {
+        let file = self.close();
         if let Some(e) = self.error {
             anyhow::bail!("{e}");
         }
-        self.file.commit()?;
+        file.ok_or_else(|| anyhow::anyhow!("nav.txt: its writing thread ended early"))?
+            .commit()?;
         use sinsmodel::report::plot::{line_plot, Scale, Series};
         let dir = png.parent().unwrap_or(std::path::Path::new("."));
         let stem = png.file_stem().and_then(|s| s.to_str()).unwrap_or("nav");
@@ -181,6 +232,43 @@ impl NavWriter {
         )
     }
 
+    /// Hands the last rows to the writing thread and waits for it: the file, or None with the
+    /// thread's error in `self.error` (unless one was met first).
+    fn close(&mut self) -> Option<AtomicFile> {
+        self.send_batch();
+        let w = self.writer.take()?;
+        drop(w.tx);
+        match w.thread.join() {
+            Ok(Ok(f)) => Some(f),
+            Ok(Err(e)) => {
+                self.error.get_or_insert(e);
+                None
+            }
+            Err(_) => {
+                self.error
+                    .get_or_insert_with(|| "nav.txt: its writing thread panicked".into());
+                None
+            }
+        }
+    }
+
+    /// Hands the rows collected so far to the writing thread (a thread that stopped on an
+    /// error has its error read at [`NavWriter::finish`]).
+    fn send_batch(&mut self) {
+        if self.batch.is_empty() {
+            return;
+        }
+        let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH_ROWS));
+        if let Some(w) = &self.writer {
+            if w.tx.send(batch).is_err() {
+                // the thread stopped: its error comes with the join
+                let _ = self.close();
+                self.error
+                    .get_or_insert_with(|| "nav.txt: its writing thread stopped".into());
+            }
+        }
+    }
+
     fn row(&mut self, s: &NavState, x: &[f64], p: &[f64]) -> Result<(), String> {
         let get = |k: usize| self.idx[k].map(|i| x[i]).unwrap_or(0.0);
         let var = |k: usize| self.idx[k].map(|i| p[i * self.n + i]);
@@ -207,7 +295,7 @@ impl NavWriter {
             180.0 / std::f64::consts::PI,
             180.0 / std::f64::consts::PI,
         ];
-        let mut sig = Vec::with_capacity(9);
+        let (mut sig, mut n_sig) = ([0.0; 9], 0usize);
         for (k, sc) in scale.iter().enumerate() {
             if let Some(v) = var(k) {
                 let sd = v.max(0.0).sqrt() * sc;
@@ -217,7 +305,8 @@ impl NavWriter {
                         STATES[k], s.t
                     ));
                 }
-                sig.push(sd);
+                sig[n_sig] = sd;
+                n_sig += 1;
             }
         }
         let row = TruthRow {
@@ -246,16 +335,14 @@ impl NavWriter {
         if self.idx[2].is_some() {
             self.sigma[2].push((row.t, sig[2]));
         }
-        let w = self.file.writer();
-        // the truth layout (same digits), then the sigmas
-        let mut line = Vec::with_capacity(200);
-        write_row(&mut line, &row).map_err(|e| e.to_string())?;
-        line.pop(); // its newline
-        w.write_all(&line).map_err(|e| e.to_string())?;
-        for v in &sig {
-            write!(w, " {v:.4e}").map_err(|e| e.to_string())?;
+        self.batch.push(NavRow {
+            row,
+            sig,
+            n_sig: n_sig as u8,
+        });
+        if self.batch.len() >= BATCH_ROWS {
+            self.send_batch();
         }
-        writeln!(w).map_err(|e| e.to_string())?;
         self.rows += 1;
         Ok(())
     }
