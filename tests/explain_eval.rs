@@ -270,9 +270,32 @@ fn merged_cases_are_checked_like_any_input() {
     std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
     let (ok, err) = merge(&[edited.as_path()]);
     assert!(
-        !ok && err.contains("puts its term in with the sign of"),
+        !ok && err.contains("puts its term in with the")
+            && (err.contains("positive sign") || err.contains("negative sign")),
         "{err}"
     );
+    // the same term named twice; a term named while no candidate was tested; a field no
+    // release writes
+    let term = stored["cases"][k]["term"].clone();
+    for (field, value, says) in [
+        ("named", serde_json::json!([term, term]), "is there twice"),
+        (
+            "candidates_tested",
+            serde_json::json!(0),
+            "candidates_tested 0",
+        ),
+        (
+            "extra_field",
+            serde_json::json!(1),
+            "unknown field `extra_field`",
+        ),
+    ] {
+        let mut v = stored.clone();
+        v["cases"][k][field] = value;
+        std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+        let (ok, err) = merge(&[edited.as_path()]);
+        assert!(!ok && err.contains(says), "{field}: {err}");
+    }
     // the shards as written merge (with the missing ones run)
     let (c, _) = eval("chk_c", &["--cases", "2", "--first", "3"]);
     let (ok, err) = merge(&[a.as_path(), b.as_path(), c.as_path()]);

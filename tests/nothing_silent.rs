@@ -929,7 +929,8 @@ fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
 /// The shared MEMS drive's RTK heights in feet (the velocities in m/s): with `--init auto` the
 /// start takes the first fix's height, so no start height disagrees; the heights change 3.28×
 /// as fast as the vertical velocities say and that is refused naming feet. An up velocity read
-/// as down is named too; the file as recorded passes (scale 0.98).
+/// as down is named too; the file as recorded passes (scale 0.98), and so does one with 0.2 m/s
+/// of noise added to its vertical velocities (a scale shrunk towards 0).
 #[test]
 fn the_real_drive_with_heights_in_feet_is_refused_under_init_auto() {
     let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
@@ -979,6 +980,21 @@ fn the_real_drive_with_heights_in_feet_is_refused_under_init_auto() {
             && err.contains("heights in feet"),
         "{err}"
     );
+    // 0.2 m/s of noise on the vertical velocities (their stated σ kept): the scale shrinks
+    // towards 0 (noise adds to Σ v² only), which says nothing of the units
+    let state = std::cell::Cell::new(12345u64);
+    let uniform = || {
+        let x = state
+            .get()
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        state.set(x);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (ok, err) = run(&changed("noisy.pos", 17, &|vu| {
+        vu + 0.2 * 3f64.sqrt() * (2.0 * uniform() - 1.0)
+    }));
+    assert!(ok && !err.contains("vertical velocities say"), "{err}");
     let (ok, err) = run(&changed("up.pos", 17, &|vu| -vu));
     assert!(
         !ok && err.contains("a vertical velocity up read as down"),

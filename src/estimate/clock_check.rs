@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 
 /// Largest clock offset looked for [s] (offsets of an hour or more are refused by the time-span
 /// check of the aiding file).
-pub const MAX_LAG_S: f64 = 300.0;
+pub const MAX_LAG_S: f64 = 600.0;
 /// Step between the lags tried [s].
 const LAG_STEP_S: f64 = 0.5;
 /// Entry of lag zero.
@@ -32,6 +32,14 @@ const MIN_TURNED_RAD: f64 = std::f64::consts::PI;
 /// Least course change [rad] before an offset is said before the end of the IMU file: eight 90°
 /// turns.
 const EARLY_TURNED_RAD: f64 = 4.0 * std::f64::consts::PI;
+/// Peaks of the correlation closer than this [s] are one.
+const PEAK_APART_S: f64 = 3.0;
+/// Correlation within which of the best another lag's peak is as good (turns that repeat).
+const ALIKE: f64 = 0.05;
+/// Least correlation at the best lag for an offset to be refused …
+const BEYOND_DOUBT_BEST: f64 = 0.85;
+/// … with the stamps' correlation under this.
+const BEYOND_DOUBT_STAMPED: f64 = 0.5;
 /// Least correlation at the best lag for an offset to be said.
 const SAY_CORRELATION: f64 = 0.8;
 /// Least margin of the best lag's correlation over the stamped one's for an offset to be said.
@@ -126,7 +134,7 @@ struct LagSums {
 
 /// An offset found: the lag [s] at which the fixes match the IMU best (a fix stamped t
 /// describes the IMU's t + lag), the correlations there and at zero, and the course turned [rad].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct ClockOffset {
     /// Best lag [s].
     pub lag_s: f64,
@@ -136,18 +144,64 @@ pub struct ClockOffset {
     pub stamped: f64,
     /// GNSS course turned over the intervals judged at the best lag [rad].
     pub turned: f64,
+    /// Other lags [s] whose correlation peaks within [`ALIKE`] of the best (turns that repeat),
+    /// by distance from zero; `lag_s` is the one nearest zero.
+    pub alike: Vec<f64>,
 }
 
 impl ClockOffset {
     /// True when the offset is beyond doubt (a run on it would be nonsense): the best lag's
-    /// correlation at least 0.9 and the stamped one's under 0.5.
+    /// correlation at least [`BEYOND_DOUBT_BEST`] and the stamped one's under
+    /// [`BEYOND_DOUBT_STAMPED`].
     pub fn beyond_doubt(&self) -> bool {
-        self.best >= 0.9 && self.stamped < 0.5
+        self.best >= BEYOND_DOUBT_BEST && self.stamped < BEYOND_DOUBT_STAMPED
+    }
+
+    /// Why a found offset is only warned, in words.
+    pub fn why_warned(&self) -> String {
+        if self.stamped >= BEYOND_DOUBT_STAMPED {
+            format!(
+                "not refused: the fixes as stamped still match in part, correlation {:.2}",
+                self.stamped
+            )
+        } else {
+            format!(
+                "not refused: the best lag's correlation {:.2} is under {BEYOND_DOUBT_BEST}",
+                self.best
+            )
+        }
     }
 
     /// The finding in words, with its likely cause.
     pub fn words(&self) -> String {
         let l = self.lag_s;
+        if !self.alike.is_empty() {
+            let mut lags: Vec<String> = std::iter::once(l)
+                .chain(self.alike.iter().copied())
+                .take(4)
+                .map(|x| format!("{x:+.1}"))
+                .collect();
+            let more = if self.alike.len() > 3 {
+                format!(" (and {} more lags)", self.alike.len() - 3)
+            } else {
+                String::new()
+            };
+            let last = lags.pop().unwrap_or_default();
+            let lags = if lags.is_empty() {
+                last
+            } else {
+                format!("{} or {last}", lags.join(", "))
+            };
+            return format!(
+                "the aiding's clock is likely off the IMU's, by an amount these data cannot pin down: the GNSS course turns {:.0}° in all, \
+                 and its turns match the gyros' turns about the vertical about as well (correlation {:.2} at best, the others within \
+                 {ALIKE}) with each fix taken {lags} s{more} from its stamp, against {:.2} as stamped — the drive's turns repeat; check the aiding \
+                 file's time system and --clock-offset (add one of these to the aiding file's times)",
+                self.turned.to_degrees(),
+                self.best,
+                if self.stamped.abs() < 0.005 { 0.0 } else { self.stamped },
+            );
+        }
         let cause = if (15.0..=19.0).contains(&l.abs()) {
             format!(
                 "{:.0} s is about the GPS–UTC leap seconds (18 s since 2017): likely UTC times read as GPST",
@@ -340,13 +394,46 @@ impl ClockCheck {
     fn offset(&self) -> Option<ClockOffset> {
         let (stamped, k, best) = self.stamped_and_best()?;
         let lag_s = Self::lag(k);
-        (lag_s.abs() >= MIN_OFFSET_S && best >= SAY_CORRELATION && best - stamped >= SAY_MARGIN)
-            .then_some(ClockOffset {
-                lag_s,
-                best,
-                stamped,
-                turned: self.lags[k].turned,
+        if !(lag_s.abs() >= MIN_OFFSET_S && best >= SAY_CORRELATION && best - stamped >= SAY_MARGIN)
+        {
+            return None;
+        }
+        // the peaks about as high as the best (a drive whose turns repeat), nearest zero first
+        let c = |k: usize| {
+            self.correlation(k, MIN_TURNED_RAD)
+                .unwrap_or(f64::NEG_INFINITY)
+        };
+        let mut peaks: Vec<usize> = (0..self.lags.len())
+            .filter(|&j| {
+                let v = c(j);
+                v >= best - ALIKE
+                    && (j == 0 || v >= c(j - 1))
+                    && (j + 1 == self.lags.len() || v > c(j + 1))
             })
+            .collect();
+        peaks.sort_by(|a, b| Self::lag(*a).abs().total_cmp(&Self::lag(*b).abs()));
+        // ripples of one peak are one peak
+        let mut kept: Vec<usize> = Vec::new();
+        for j in peaks {
+            if kept
+                .iter()
+                .all(|&q| (Self::lag(q) - Self::lag(j)).abs() > PEAK_APART_S)
+            {
+                kept.push(j);
+            }
+        }
+        let peaks = kept;
+        let first = peaks.first().copied().unwrap_or(k);
+        Some(ClockOffset {
+            lag_s: Self::lag(first),
+            best,
+            stamped,
+            turned: self.lags[first].turned,
+            alike: peaks[1.min(peaks.len())..]
+                .iter()
+                .map(|&j| Self::lag(j))
+                .collect(),
+        })
     }
 
     /// The correlation as stamped and the best lag's [s], when both have seen enough turns (for
@@ -439,11 +526,48 @@ mod tests {
             let (found, _) = run(shift);
             let f = found.unwrap_or_else(|| panic!("{shift}: none"));
             assert!((f.lag_s + shift).abs() <= 0.5, "{shift}: {f:?}");
+            assert!(f.alike.is_empty(), "{shift}: {f:?}");
             // 3 s is a third of a 9-s turn: the stamped fixes still half match (warned only)
             assert_eq!(f.beyond_doubt(), shift.abs() > 9.0, "{shift}: {f:?}");
             let w = f.words();
             assert!(w.contains(&format!("add {:+.1} s", -shift)), "{w}");
             assert_eq!(w.contains("UTC times read as GPST"), shift == 18.0, "{w}");
+        }
+    }
+
+    /// A slalom moving from the first sample, a left-right turn every 20 s: the turns repeat, so
+    /// lags 20 s apart match about as well; the offset is said with the others that match,
+    /// the one nearest zero first (for 15 s, −5 s matches as well as the true −15 s).
+    #[test]
+    fn repeating_turns_leave_the_offset_ambiguous_and_say_so() {
+        let slalom = |t: f64| 15f64.to_radians() * (std::f64::consts::TAU * t / 20.0).sin();
+        for shift in [-5.0, 5.0, 15.0] {
+            let (samples, mut turns) = drive(400.0, slalom);
+            for t in &mut turns {
+                t.t0 += shift;
+                t.t1 += shift;
+            }
+            let mut c = ClockCheck::new(turns).unwrap();
+            c.feed(&samples);
+            let f = c.judge(true).unwrap_or_else(|| panic!("{shift}: none"));
+            // the true shift is among the lags said; the nearest zero first
+            let said: Vec<f64> = std::iter::once(f.lag_s).chain(f.alike.clone()).collect();
+            assert!(
+                said.iter().any(|l| (l + shift).abs() <= 0.5),
+                "{shift}: {f:?}"
+            );
+            assert!(
+                said.windows(2).all(|w| w[0].abs() <= w[1].abs()),
+                "{shift}: {f:?}"
+            );
+            let w = f.words();
+            assert!(
+                w.contains("cannot pin down") && w.contains("more lags)"),
+                "{w}"
+            );
+            if shift.abs() < 10.0 {
+                assert!(w.contains(&format!("{:+.1}, ", -shift)), "{w}");
+            }
         }
     }
 

@@ -741,9 +741,9 @@ pub fn window_check(
             eprintln!(
                 "warning: --aid: {p} ({})",
                 if force {
-                    "--force given"
+                    "--force given".to_string()
                 } else {
-                    "not refused: the fixes as stamped still match in part"
+                    off.why_warned()
                 }
             );
         }

@@ -234,8 +234,10 @@ pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
 /// The heights against the receiver's vertical velocities over `n` fixes, from the sums `s`
 /// (Σ v_d·ṽ_d, Σ v_d², Σ ṽ_d² [m²/s²], ṽ_d from the height differences): the least-squares
 /// scale of the height rate on the velocity is 1 for one unit and sign; feet give 3.28, an up
-/// velocity read as down −1. Judged where the vertical velocities' RMS is 0.1 m/s or more over
-/// 20 fixes or more, and refused when the scale is off 1 by over 0.3 and 5 σ of its fit.
+/// velocity read as down −1. Noise in the velocities only shrinks the scale towards 0 (it
+/// adds to Σ v_d² alone), so a scale between 0 and 1 says nothing; judged where the vertical
+/// velocities' RMS is 0.1 m/s or more over 20 fixes or more, and refused when the scale is
+/// over 1.3 or under −0.3, beyond 5 σ of its fit.
 fn check_vertical_scale(s: [f64; 3], n: usize) -> Result<()> {
     if n < 20 || s[1] < n as f64 * 0.01 {
         return Ok(());
@@ -243,7 +245,8 @@ fn check_vertical_scale(s: [f64; 3], n: usize) -> Result<()> {
     let k = s[0] / s[1];
     // residual Σ (ṽ − k v)² = Σṽ² − k Σ v ṽ
     let sigma = ((s[2] - k * s[0]).max(0.0) / (n - 1) as f64 / s[1]).sqrt();
-    if (k - 1.0).abs() <= 0.3 || (k - 1.0).abs() <= 5.0 * sigma {
+    let beyond = |bound: f64| (k - bound).abs() > 5.0 * sigma;
+    if !((k > 1.3 && beyond(1.3)) || (k < -0.3 && beyond(-0.3))) {
         return Ok(());
     }
     const FEET_PER_METRE: f64 = 1.0 / 0.3048;
@@ -956,7 +959,7 @@ impl<'a> Search<'a> {
         // the GNSS and the IMU must agree on how fast the vehicle goes there
         if !(speed_imu > 0.5 * speed_gnss && speed_imu < 2.0 * speed_gnss) {
             bail!(
-                "--init auto: from {ta:.3} to {tb:.3} s the IMU's integrated speed is {speed_imu:.2} m/s, the GNSS positions give {speed_gnss:.2} m/s: a clock offset between IMU and GNSS, or wrong IMU units? (give the heading with --init)"
+                "--init auto: from {ta:.3} to {tb:.3} s the IMU's integrated speed is {speed_imu:.2} m/s, the GNSS positions give {speed_gnss:.2} m/s: a clock offset between IMU and GNSS (UTC read as GPST is 18 s), or wrong IMU units? (give the start with --init: a run then measures the clock offset from the turns IMU and GNSS both see)"
             );
         }
         let course = v_chord.y.atan2(v_chord.x);

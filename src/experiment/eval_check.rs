@@ -62,7 +62,12 @@ fn check_draw(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
     if let (Some(v), Some((_, reference))) = (c.truth, d.case.hidden.first()) {
         if v != 0.0 && v.signum() != reference.signum() {
             return Err(format!(
-                "truth {v}: case {i} of seed {seed} puts its term in with the sign of {reference}"
+                "truth {v}: case {i} of seed {seed} puts its term in with the {} sign",
+                if *reference > 0.0 {
+                    "positive"
+                } else {
+                    "negative"
+                }
             ));
         }
     }
@@ -113,6 +118,24 @@ fn check_outcome(c: &CaseResult) -> Result<(), String> {
             }
         }
         _ => return Err("estimate and sigma: one is given without the other".into()),
+    }
+    if let Some((k, n)) = c
+        .named
+        .iter()
+        .enumerate()
+        .find(|(k, n)| c.named[..*k].contains(n))
+    {
+        return Err(format!(
+            "named: `{n}` is there twice (entries {} and {}): a run names a term once",
+            c.named[..k].iter().position(|x| x == n).unwrap_or(0) + 1,
+            k + 1
+        ));
+    }
+    if !c.named.is_empty() && c.candidates_tested == 0 {
+        return Err(format!(
+            "candidates_tested 0, yet named holds {}: a named term is a tested candidate",
+            c.named.join(", ")
+        ));
     }
     if let Some(n) = c.named.iter().find(|n| !is_term(n)) {
         return Err(format!(

@@ -46,6 +46,7 @@ impl Default for EvalSpec {
 
 /// One case's outcome.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct CaseResult {
     /// Index of the case in the campaign.
     pub index: usize,

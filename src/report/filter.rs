@@ -136,7 +136,8 @@ impl EpochFiles {
             format!(
                 "--truth: the truth's attitude differs from the filter's estimate in {} over the epochs with truth: \
                  is the truth's yaw in radians, counted the other way (PSINS: counter-clockwise), or of another body \
-                 frame, its roll and pitch in radians? model_error.txt measures against it",
+                 frame, its roll and pitch in radians? Or the estimate is off: an aiding clock off the IMU's or a model that misses \
+                 an error (see the warnings and the NIS above). model_error.txt measures against it",
                 said.join(", ")
             )
         })
