@@ -654,8 +654,9 @@ fn imu_unit_and_clock_slips_are_refused_with_their_cause() {
     assert!(ok && !err.contains("warning"), "{err}");
 }
 
-/// A slip the first 10 s cannot show (they are disturbed, not at rest) is found where the data
-/// first come to rest as the GNSS speeds confirm (filter, explain), and a specific force no
+/// A slip the first 10 s cannot show by the IMU alone (they are disturbed, not at rest) is
+/// found there where GNSS fixes stand through them, else where the data first come to rest as
+/// the GNSS speeds confirm (filter, explain), and a specific force no
 /// vehicle averages anywhere in the run: the run stops naming the stretch; navigate, without
 /// GNSS, judges only the specific force there; the disturbed data in the right units run.
 #[test]
@@ -704,14 +705,50 @@ fn imu_slips_after_the_first_seconds_are_found_where_the_data_show_them() {
     let (ok, err) = navigate(&shaken, &d.join("nav0.txt"));
     assert!(ok && !err.contains("warning"), "{err}");
 
+    // GNSS fixes that stand through the shaken first seconds say they are at rest: the mean
+    // rate is judged there (57.3× Earth rate)
     let (ok, err) = filter(&dps, "f1");
+    assert!(
+        !ok && err.contains("deg/s read as rad/s")
+            && err.contains("in the first 10 s")
+            && err.contains("dps.txt"),
+        "{err}"
+    );
+    assert!(!d.join("f1").exists(), "a refused run left its output");
+    // without fixes in the first 10 s nothing says they are at rest: the slip is found where
+    // the data come to rest as the fixes confirm
+    let late_fixes = d.join("gnss_from_10s.txt");
+    std::fs::write(
+        &late_fixes,
+        std::fs::read_to_string(&gnss)
+            .unwrap()
+            .lines()
+            .filter(|l| {
+                l.starts_with('#') || l.split(' ').next().unwrap().parse::<f64>().unwrap() > 10.5
+            })
+            .map(|l| format!("{l}\n"))
+            .collect::<String>(),
+    )
+    .unwrap();
+    let (ok, err) = run(&[
+        "filter",
+        "--model",
+        "P13",
+        "--imu",
+        dps.to_str().unwrap(),
+        "--aid",
+        late_fixes.to_str().unwrap(),
+        "--init",
+        "30,110,0,0,0,0",
+        "--out",
+        d.join("f1b").to_str().unwrap(),
+    ]);
     assert!(
         !ok && err.contains("deg/s read as rad/s")
             && err.contains("after the first 10 s")
             && err.contains("dps.txt"),
         "{err}"
     );
-    assert!(!d.join("f1").exists(), "a refused run left its output");
     // navigate has no GNSS to confirm that a later still stretch is at rest (a steady turn on
     // a smooth curve looks the same to the IMU): its gyros are not judged there
     let (ok, err) = navigate(&dps, &d.join("nav1.txt"));

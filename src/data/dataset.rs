@@ -152,18 +152,7 @@ impl DataOptions {
         let head = crate::io::imu::ImuData {
             samples: imu.head().to_vec(),
         };
-        let mut check = crate::estimate::imu_check::check(&head, Some(start.lat), 0.0, 10.0, true);
-        // a start that moves (its velocity, or a GNSS fix over 1 m/s in the first seconds) may
-        // turn steadily on a smooth curve, which looks like rest to the IMU: no gyro judgment
-        let (h0, h1) = (
-            imu.first_t(),
-            head.samples.last().map_or(imu.first_t(), |x| x.t),
-        );
-        let moving = start.v.norm() > 1.0 || witness.as_ref().is_some_and(|w| w.moving(h0, h1));
-        if moving {
-            check.gyro_unit_problems.clear();
-            check.is_static = false;
-        }
+        let (check, moving) = head_seen(&head, start, witness.as_ref());
         // a MEMS gyro's bias can reach what a unit slip gives: with --grade mems a warning
         let mems = self.grade.as_deref() == Some("mems");
         for p in check.gyro_unit_problems.iter().filter(|_| mems) {
@@ -570,6 +559,36 @@ fn check_fix_times(plan: &AidPlan, first_t: f64) -> Result<()> {
             "begin more than an hour after the IMU starts"
         }
     )
+}
+
+/// The check of the first seconds `head` and whether the start moves (its velocity, or a GNSS
+/// fix over 1 m/s there: it may turn steadily on a smooth curve, which looks like rest to the
+/// IMU, so its gyros are not judged). Where the specific force spreads (engine vibration) while
+/// three or more GNSS fixes stand, the means are judged as at rest (a gyro unit slip shows in
+/// |ω̄|).
+fn head_seen(
+    head: &crate::io::imu::ImuData,
+    start: &NavState,
+    witness: Option<&crate::estimate::imu_check::RestWitness>,
+) -> (crate::estimate::imu_check::ImuCheck, bool) {
+    use crate::estimate::imu_check::{check, check_at_witnessed_rest, RestWitness};
+    let mut seen = check(head, Some(start.lat), 0.0, 10.0, true);
+    let (h0, h1) = (
+        head.samples.first().map_or(0.0, |x| x.t),
+        head.samples.last().map_or(0.0, |x| x.t),
+    );
+    let moving = start.v.norm() > 1.0 || witness.is_some_and(|w| w.moving(h0, h1));
+    if moving {
+        seen.gyro_unit_problems.clear();
+        seen.is_static = false;
+    } else if !seen.is_static
+        && matches!(witness, Some(RestWitness::Speeds(v))
+            if v.iter().filter(|x| x.0 >= h0 && x.0 <= h1).count() >= 3)
+        && witness.is_some_and(|w| w.at_rest(h0, h1))
+    {
+        seen = check_at_witnessed_rest(head, Some(start.lat), 0.0, 10.0, true);
+    }
+    (seen, moving)
 }
 
 /// What says, beside the IMU, whether the vehicle stands still: a static vehicle, or the GNSS

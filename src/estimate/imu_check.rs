@@ -73,6 +73,30 @@ pub fn check(
     window_s: f64,
     tilted_ok: bool,
 ) -> ImuCheck {
+    check_with(imu, lat, skip_s, window_s, tilted_ok, false)
+}
+
+/// [`check`] of a window that something beside the IMU (GNSS fixes standing still) says is at
+/// rest although its specific force spreads (engine vibration): its means are judged as at
+/// rest — |ω̄| against Earth rate and the grade's biases, |f̄| against gravity.
+pub fn check_at_witnessed_rest(
+    imu: &ImuData,
+    lat: Option<f64>,
+    skip_s: f64,
+    window_s: f64,
+    tilted_ok: bool,
+) -> ImuCheck {
+    check_with(imu, lat, skip_s, window_s, tilted_ok, true)
+}
+
+fn check_with(
+    imu: &ImuData,
+    lat: Option<f64>,
+    skip_s: f64,
+    window_s: f64,
+    tilted_ok: bool,
+    witnessed_rest: bool,
+) -> ImuCheck {
     let s = &imu.samples;
     let mut intervals: Vec<f64> = s.windows(2).map(|w| w[1].t - w[0].t).collect();
     let median = imu.interval();
@@ -80,7 +104,8 @@ pub fn check(
     let gaps = intervals.iter().filter(|d| **d > 2.0 * median).count();
     intervals.sort_by(f64::total_cmp);
     let t_first = s.first().map(|x| x.t).unwrap_or(0.0);
-    let m = Seen::of(imu, lat, t_first + skip_s, window_s);
+    let mut m = Seen::of(imu, lat, t_first + skip_s, window_s);
+    m.is_static |= witnessed_rest;
     let (w0, w1, f, w) = (m.w0, m.w1, m.f, m.w);
     let mut out = Said::default();
     let deg = 180.0 / std::f64::consts::PI;
