@@ -861,7 +861,8 @@ fn the_outage_drift_does_not_depend_on_the_gate() {
 
 /// The shared MEMS drive with its RTK file moved on the clock: 60 s late is refused (the GNSS
 /// course turns match the gyros' 60 s before their stamps), 2 s late is warned (its turns still
-/// match in part as stamped); as recorded, nothing is said of the clock.
+/// match in part as stamped, and explain's report opens with it); as recorded, nothing is said
+/// of the clock.
 #[test]
 fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
     let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive");
@@ -916,6 +917,32 @@ fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
         ok && err.contains("warning: --aid: the aiding's clock is likely 2.0 s off the IMU's")
             && err.contains("add -2.0 s"),
         "{err}"
+    );
+    // explain's report (what people read, not stderr) opens with the warning
+    let out = d.join("explain2");
+    let (ok, _, err) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P13",
+        "--imu",
+        p(&shared.join("imu_1934.csv")),
+        "--aid",
+        p(&moved(2.0)),
+        "--init",
+        "auto",
+        "--grade",
+        "mems",
+        "--out",
+        p(&out),
+    ]);
+    assert!(ok, "{err}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let words = report.split("## In words").nth(1).unwrap();
+    assert!(
+        words
+            .trim_start()
+            .starts_with("- Warning about the data: --aid: the aiding's clock is likely 2.0 s off"),
+        "{report}"
     );
     let (ok, err) = run(&moved(60.0));
     assert!(

@@ -18,6 +18,9 @@ pub fn refuse_force_for_outputs(force: bool) -> Result<()> {
 /// Prints a note of the library (what is read, what `--init auto` found, warnings) on stderr.
 pub fn note(line: &str) {
     eprintln!("{line}");
+    if let Some(w) = line.strip_prefix("warning: ") {
+        sinsmodel::data::warnings::keep(w);
+    }
 }
 
 /// Prints the sensor noise and grade the run assumes and the known GNSS values (once per run).

@@ -265,6 +265,10 @@ fn finish(
 ) -> Result<()> {
     let mut e = e.clone();
     explain_notes::note_skipped(&mut e, skipped);
+    // what was said about the data goes first: a finding on data with a slip stands on it
+    for (k, w) in sinsmodel::data::warnings::take().into_iter().enumerate() {
+        e.summary.insert(k, format!("Warning about the data: {w}"));
+    }
     let text = explain_files::write(&out, &e, data)?;
     out.commit()?;
     if let Some(j) = &args.json {

@@ -763,14 +763,14 @@ pub fn window_check(
             if off.beyond_doubt() && !force {
                 anyhow::bail!("--aid: {p} (--force runs anyway)");
             }
-            eprintln!(
-                "warning: --aid: {p} ({})",
+            crate::data::warnings::warn(&format!(
+                "--aid: {p} ({})",
                 if force {
                     "--force given".to_string()
                 } else {
                     off.why_warned()
                 }
-            );
+            ));
         }
         let Some((p, warn_only)) = judge.judge(w) else {
             return Ok(());
@@ -789,7 +789,7 @@ pub fn window_check(
             } else {
                 why_warn
             };
-            eprintln!("warning: --imu {name}: {p} ({why})");
+            crate::data::warnings::warn(&format!("--imu {name}: {p} ({why})"));
         }
         Ok(())
     })

@@ -1,0 +1,45 @@
+//! The warnings a run says about its data, kept for its report: a warning on stderr scrolls away,
+//! while `explain`'s report is what people read (an aiding clock found off, a unit slip let
+//! through with --force). Process-wide; the command that reports takes them.
+
+use std::sync::Mutex;
+
+/// Most warnings kept (a run that repeats one does not grow memory).
+const KEPT_MAX: usize = 50;
+
+static KEPT: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// Keeps `text` (a warning without its "warning: ") for the run's report, once.
+pub fn keep(text: &str) {
+    if let Ok(mut v) = KEPT.lock() {
+        if v.len() < KEPT_MAX && !v.iter().any(|x| x == text) {
+            v.push(text.to_string());
+        }
+    }
+}
+
+/// Says `text` as a warning on stderr and keeps it for the run's report.
+pub fn warn(text: &str) {
+    eprintln!("warning: {text}");
+    keep(text);
+}
+
+/// The warnings kept so far, in the order said; forgets them.
+pub fn take() -> Vec<String> {
+    KEPT.lock()
+        .map(|mut v| std::mem::take(&mut *v))
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn kept_once_in_order_and_taken() {
+        super::take();
+        super::keep("a");
+        super::keep("b");
+        super::keep("a");
+        assert_eq!(super::take(), ["a", "b"]);
+        assert!(super::take().is_empty());
+    }
+}
