@@ -19,7 +19,7 @@ pub fn refuse_force_for_outputs(force: bool) -> Result<()> {
 pub fn note(line: &str) {
     eprintln!("{line}");
     if let Some(w) = line.strip_prefix("warning: ") {
-        sinsmodel::data::warnings::keep(w);
+        sinsmodel::io::warnings::keep(w);
     }
 }
 

@@ -266,7 +266,7 @@ fn finish(
     let mut e = e.clone();
     explain_notes::note_skipped(&mut e, skipped);
     // what was said about the data goes first: a finding on data with a slip stands on it
-    for (k, w) in sinsmodel::data::warnings::take().into_iter().enumerate() {
+    for (k, w) in sinsmodel::io::warnings::take().into_iter().enumerate() {
         e.summary.insert(k, format!("Warning about the data: {w}"));
     }
     let text = explain_files::write(&out, &e, data)?;

@@ -1,7 +1,6 @@
 //! The data a run reads, opened by the library: the options that name it ([`DataOptions`],
 //! [`ImuSource`]), the aiding plan and outages ([`aid`]), the initial state ([`start`]), the
-//! opened data set ([`Dataset`]), the filter set-up the options give ([`setup`]) and the
-//! warnings said about the data, kept for the report ([`warnings`]). What
+//! opened data set ([`Dataset`]) and the filter set-up the options give ([`setup`]). What
 //! `filter` and `explain` do with files, a library caller can do with the same calls.
 
 pub mod aid;
@@ -9,7 +8,6 @@ pub mod dataset;
 pub mod options;
 pub mod setup;
 mod start;
-pub mod warnings;
 pub use start::{init_numbers, init_value_problem};
 
 pub use aid::{AidPlan, Outage};

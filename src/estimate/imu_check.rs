@@ -763,7 +763,7 @@ pub fn window_check(
             if off.beyond_doubt() && !force {
                 anyhow::bail!("--aid: {p} (--force runs anyway)");
             }
-            crate::data::warnings::warn(&format!(
+            crate::io::warnings::warn(&format!(
                 "--aid: {p} ({})",
                 if force {
                     "--force given".to_string()
@@ -789,7 +789,7 @@ pub fn window_check(
             } else {
                 why_warn
             };
-            crate::data::warnings::warn(&format!("--imu {name}: {p} ({why})"));
+            crate::io::warnings::warn(&format!("--imu {name}: {p} ({why})"));
         }
         Ok(())
     })
