@@ -1,5 +1,6 @@
 //! Files in and out: IMU increments, aiding and truth files, readers of other formats (PSINS
-//! `.imu`, GNSS_IMU csv, RTKLIB `.pos`), quantities with units at the edges, atomic outputs, the warnings said about the data (kept for the report).
+//! `.imu`, GNSS_IMU csv, RTKLIB `.pos`), quantities with units at the edges, atomic outputs,
+//! the warnings said about the data (kept for the report).
 
 pub mod aiding;
 pub mod atomic_file;
