@@ -356,6 +356,7 @@ fn dataset_seeds_reach_the_input_checks() {
         "deg_as_rad_forced.bin",
         "mems.bin",
         "utc_18s.bin",
+        "turns.bin",
     ] {
         assert!(outcome(ok).is_ok(), "{ok}: {:?}", outcome(ok));
     }
@@ -366,6 +367,10 @@ fn dataset_seeds_reach_the_input_checks() {
             "--static-aid says the vehicle does not move",
         ),
         ("day_off.bin", "day"),
+        (
+            "clock_20s_late.bin",
+            "the aiding's clock is likely 20.0 s off the IMU's",
+        ),
     ] {
         let e = outcome(bad).expect_err(bad);
         assert!(e.contains(cause), "{bad}: expected `{cause}` in: {e}");

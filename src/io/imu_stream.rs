@@ -278,7 +278,8 @@ impl ImuStream {
     /// The project's text IMU format, streamed.
     pub fn text(path: &Path) -> Result<ImuStream> {
         let rows = TableRows::open(path, 7, "IMU file")?;
-        ImuStream::new(Box::new(TextSource { rows }), &path.display().to_string())
+        let src = crate::io::sample_source::ReadAhead::spawn(Box::new(TextSource { rows }))?;
+        ImuStream::new(Box::new(src), &path.display().to_string())
     }
 
     /// Samples already in memory, validated like a file's.
