@@ -892,24 +892,7 @@ fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
         std::fs::write(&path, text).unwrap();
         path
     };
-    let run = |aid: &Path| {
-        let (ok, _, err) = sinsmodel(&[
-            "filter",
-            "--model",
-            "P13",
-            "--imu",
-            p(&shared.join("imu_1934.csv")),
-            "--aid",
-            p(aid),
-            "--init",
-            "auto",
-            "--grade",
-            "mems",
-            "--out",
-            p(&d.join("o")),
-        ]);
-        (ok, err)
-    };
+    let run = |aid: &Path| mems_drive_filter(aid, &d.join("o"));
     let (ok, err) = run(&moved(0.0));
     assert!(ok && !err.contains("clock is likely"), "{err}");
     let (ok, err) = run(&moved(2.0));
@@ -981,24 +964,7 @@ fn the_real_drive_with_heights_in_feet_is_refused_under_init_auto() {
         std::fs::write(&path, text).unwrap();
         path
     };
-    let run = |aid: &Path| {
-        let (ok, _, err) = sinsmodel(&[
-            "filter",
-            "--model",
-            "P13",
-            "--imu",
-            p(&shared.join("imu_1934.csv")),
-            "--aid",
-            p(aid),
-            "--init",
-            "auto",
-            "--grade",
-            "mems",
-            "--out",
-            p(&d.join("o")),
-        ]);
-        (ok, err)
-    };
+    let run = |aid: &Path| mems_drive_filter(aid, &d.join("o"));
     let (ok, err) = run(&changed("same.pos", 4, &|h| h));
     assert!(ok && !err.contains("vertical velocities"), "{err}");
     let (ok, err) = run(&changed("feet.pos", 4, &|h| h / 0.3048));
@@ -1073,4 +1039,27 @@ fn static_aid_on_a_gentle_creep_says_the_vehicle_may_move() {
             "{accel}: {err}"
         );
     }
+}
+
+/// `filter` (P13, `--init auto`, `--grade mems`) on the shared MEMS drive's IMU with the aiding
+/// file `aid`, into `out`: whether it ran, and its stderr.
+fn mems_drive_filter(aid: &Path, out: &Path) -> (bool, String) {
+    let imu =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive/imu_1934.csv");
+    let (ok, _, err) = sinsmodel(&[
+        "filter",
+        "--model",
+        "P13",
+        "--imu",
+        p(&imu),
+        "--aid",
+        p(aid),
+        "--init",
+        "auto",
+        "--grade",
+        "mems",
+        "--out",
+        p(out),
+    ]);
+    (ok, err)
 }

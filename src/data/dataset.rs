@@ -586,7 +586,7 @@ fn head_seen(
             if v.iter().filter(|x| x.0 >= h0 && x.0 <= h1).count() >= 3)
         && witness.is_some_and(|w| w.at_rest(h0, h1))
     {
-        seen = check_at_witnessed_rest(head, Some(start.lat), 0.0, 10.0, true);
+        seen = check_at_witnessed_rest(head, Some(start.lat));
     }
     (seen, moving)
 }

@@ -76,17 +76,11 @@ pub fn check(
     check_with(imu, lat, skip_s, window_s, tilted_ok, false)
 }
 
-/// [`check`] of a window that something beside the IMU (GNSS fixes standing still) says is at
-/// rest although its specific force spreads (engine vibration): its means are judged as at
-/// rest — |ω̄| against Earth rate and the grade's biases, |f̄| against gravity.
-pub fn check_at_witnessed_rest(
-    imu: &ImuData,
-    lat: Option<f64>,
-    skip_s: f64,
-    window_s: f64,
-    tilted_ok: bool,
-) -> ImuCheck {
-    check_with(imu, lat, skip_s, window_s, tilted_ok, true)
+/// [`check`] of the first 10 s, which something beside the IMU (GNSS fixes standing still)
+/// says are at rest although their specific force spreads (engine vibration): the means are
+/// judged as at rest — |ω̄| against Earth rate and the grade's biases, |f̄| against gravity.
+pub fn check_at_witnessed_rest(imu: &ImuData, lat: Option<f64>) -> ImuCheck {
+    check_with(imu, lat, 0.0, 10.0, true, true)
 }
 
 fn check_with(
