@@ -296,6 +296,17 @@ fn merged_cases_are_checked_like_any_input() {
         let (ok, err) = merge(&[edited.as_path()]);
         assert!(!ok && err.contains(says), "{field}: {err}");
     }
+    // fields no release writes beside the cases: in the campaign settings, at the top
+    for at in ["spec", ""] {
+        let mut v = stored.clone();
+        match at {
+            "" => v["bogus_top"] = serde_json::json!(1),
+            _ => v[at]["bogus"] = serde_json::json!(1),
+        }
+        std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+        let (ok, err) = merge(&[edited.as_path()]);
+        assert!(!ok && err.contains("unknown field `bogus"), "{at}: {err}");
+    }
     // the shards as written merge (with the missing ones run)
     let (c, _) = eval("chk_c", &["--cases", "2", "--first", "3"]);
     let (ok, err) = merge(&[a.as_path(), b.as_path(), c.as_path()]);

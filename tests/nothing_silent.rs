@@ -927,6 +927,12 @@ fn the_real_drive_on_a_moved_clock_is_said_with_its_offset() {
             .starts_with("- Warning about the data: --aid: the aiding's clock is likely 2.0 s off"),
         "{report}"
     );
+    // 300 s late: the turns that match lie in the 360 s --init auto reads through to its start
+    let (ok, err) = run(&moved(300.0));
+    assert!(
+        !ok && err.contains("the aiding's clock is likely 300.0 s off the IMU's"),
+        "{err}"
+    );
     let (ok, err) = run(&moved(60.0));
     assert!(
         !ok && err.contains("error: --aid: the aiding's clock is likely 60.0 s off the IMU's")
@@ -988,6 +994,13 @@ fn the_real_drive_with_heights_in_feet_is_refused_under_init_auto() {
         vu + 0.2 * 3f64.sqrt() * (2.0 * uniform() - 1.0)
     }));
     assert!(ok && !err.contains("vertical velocities say"), "{err}");
+    // heights in km: they hardly move while the velocities (0.27 m/s RMS, stated σ 0.06) say
+    // they do
+    let (ok, err) = run(&changed("km.pos", 4, &|h| h / 1000.0));
+    assert!(
+        !ok && err.contains("heights that hardly move (in km, or held constant)"),
+        "{err}"
+    );
     let (ok, err) = run(&changed("up.pos", 17, &|vu| -vu));
     assert!(
         !ok && err.contains("a vertical velocity up read as down"),

@@ -54,6 +54,7 @@ pub struct EvalArgs {
 
 /// The stored run: its spec and its cases.
 #[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Stored {
     spec: EvalSpec,
     cases: Vec<CaseResult>,

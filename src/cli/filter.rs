@@ -237,7 +237,7 @@ fn rest_claim_line(data: &sinsmodel::data::DataOptions, run: &FilterRun) -> Opti
         format!(
             "note: {claim} says the vehicle stands still, and its zero-velocity updates' mean NIS ({}) is over {REST_NIS_NOTE}: \
              the vehicle may move (a creep under 0.3 m/s² or a steady turn passes the IMU's rest checks; \
-             cut the files to the stretch at rest to tell)",
+             cut the files to the stretch at rest to tell), or the initial attitude is off (a heading 180° wrong)",
             large.join(", ")
         )
     })

@@ -108,6 +108,17 @@ impl DataOptions {
             None => DEFAULT_STEP_S.max(imu.interval()),
         };
         let outages = self.outages(imu.first_t())?;
+        // the aiding clock is judged on every sample, those --init auto reads through included
+        let clock = match &plan {
+            AidPlan::Fixes(list, _, _) => {
+                crate::estimate::clock_check::watch_from_the_start(list, imu.head(), self.force)
+            }
+            AidPlan::Static { .. } => None,
+        }
+        .map(|(shared, check)| {
+            imu.judge_windows(check);
+            shared
+        });
         let start = self.start(&mut imu, &plan, &outages, truth_reader.as_mut(), note)?;
         let t0 = start.state.t;
         if let Some(o) = outages.iter().find(|o| o.end_s <= t0 + 1e-9) {
@@ -118,7 +129,7 @@ impl DataOptions {
                 if self.init_auto() { ", where --init auto found its start" } else { "" }
             );
         }
-        self.check_head(&mut imu, &start.state, &plan, note)?;
+        self.check_head(&mut imu, &start.state, &plan, clock, note)?;
         check_plan_at_start(&plan, &start.state, note)?;
         check_fixes(&mut plan, imu.first_t(), note)?;
         let aid = plan.after(t0);
@@ -143,6 +154,7 @@ impl DataOptions {
         imu: &mut ImuStream,
         start: &NavState,
         plan: &AidPlan,
+        clock: Option<crate::estimate::clock_check::SharedClock>,
         note: &mut dyn FnMut(&str),
     ) -> Result<()> {
         let imu_path = self.imu_path()?;
@@ -211,11 +223,8 @@ impl DataOptions {
         if let Some(w) = witness {
             judge.witness_rest(w);
         }
-        if let AidPlan::Fixes(list, _, _) = plan {
-            use crate::estimate::clock_check::{course_turns, ClockCheck};
-            if let Some(c) = ClockCheck::new(course_turns(list)) {
-                judge.watch_clock(c, imu.head());
-            }
+        if let Some(c) = clock {
+            judge.watch_clock(c);
         }
         let claim = if self.static_aid.is_some() {
             Some("--static-aid")

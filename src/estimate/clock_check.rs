@@ -157,6 +157,24 @@ impl ClockOffset {
         self.best >= BEYOND_DOUBT_BEST && self.stamped < BEYOND_DOUBT_STAMPED
     }
 
+    /// Says the offset: an error when it is beyond doubt (unless `force`), else a warning kept
+    /// for the report.
+    pub fn say(&self, force: bool) -> anyhow::Result<()> {
+        let p = self.words();
+        if self.beyond_doubt() && !force {
+            anyhow::bail!("--aid: {p} (--force runs anyway)");
+        }
+        crate::io::warnings::warn(&format!(
+            "--aid: {p} ({})",
+            if force {
+                "--force given".to_string()
+            } else {
+                self.why_warned()
+            }
+        ));
+        Ok(())
+    }
+
     /// Why a found offset is only warned, in words.
     pub fn why_warned(&self) -> String {
         if self.stamped >= BEYOND_DOUBT_STAMPED {
@@ -223,6 +241,36 @@ impl ClockOffset {
             if self.stamped.abs() < 0.005 { 0.0 } else { self.stamped },
         )
     }
+}
+
+/// A clock check shared by the window checks that feed it: the one installed when the stream
+/// opens (the samples `--init auto` reads through to find its start) and the one after.
+pub type SharedClock = std::rc::Rc<std::cell::RefCell<ClockCheck>>;
+
+/// The clock check of the fixes `fixes` fed the stream's first seconds `head`, and the window
+/// check that feeds it every later window until the data set's full checks take it over; None
+/// where the fixes show no turn.
+pub fn watch_from_the_start(
+    fixes: &[(PositionFix, Option<VelocityFix>)],
+    head: &[ImuSample],
+    force: bool,
+) -> Option<(SharedClock, crate::io::imu_stream::WindowCheck)> {
+    let mut c = ClockCheck::new(course_turns(fixes))?;
+    c.feed(head);
+    let shared = std::rc::Rc::new(std::cell::RefCell::new(c));
+    let fed = shared.clone();
+    let check: crate::io::imu_stream::WindowCheck = Box::new(move |w| {
+        let found = {
+            let mut c = fed.borrow_mut();
+            c.feed(w);
+            c.judge(w.is_empty())
+        };
+        match found {
+            Some(off) => off.say(force),
+            None => Ok(()),
+        }
+    });
+    Some((shared, check))
 }
 
 /// The streaming check: fed every IMU sample in order, it judges each GNSS interval at every

@@ -486,7 +486,7 @@ pub struct WindowJudge {
     /// looks like rest): None, nothing (the gyros of later windows are not judged).
     rest_witness: Option<RestWitness>,
     /// The GNSS course turns against the gyros' (the aiding's clock), when there are fixes.
-    clock: Option<super::clock_check::ClockCheck>,
+    clock: Option<super::clock_check::SharedClock>,
 }
 
 /// What says, beside the IMU, that the vehicle stands still in a stretch.
@@ -617,13 +617,8 @@ impl WindowJudge {
     }
 
     /// Has the aiding's clock checked against the IMU's from the turns both see (`clock`, fed
-    /// the first seconds `head` here and every later window as it is judged).
-    pub fn watch_clock(
-        &mut self,
-        mut clock: super::clock_check::ClockCheck,
-        head: &[crate::io::imu::ImuSample],
-    ) {
-        clock.feed(head);
+    /// every later window as it is judged).
+    pub fn watch_clock(&mut self, clock: super::clock_check::SharedClock) {
         self.clock = Some(clock);
     }
 
@@ -633,7 +628,7 @@ impl WindowJudge {
         &mut self,
         window: &[crate::io::imu::ImuSample],
     ) -> Option<super::clock_check::ClockOffset> {
-        let clock = self.clock.as_mut()?;
+        let mut clock = self.clock.as_ref()?.borrow_mut();
         clock.feed(window);
         clock.judge(window.is_empty())
     }
@@ -753,18 +748,7 @@ pub fn window_check(
     let mut warned = false;
     Box::new(move |w| {
         if let Some(off) = judge.judge_clock(w) {
-            let p = off.words();
-            if off.beyond_doubt() && !force {
-                anyhow::bail!("--aid: {p} (--force runs anyway)");
-            }
-            crate::io::warnings::warn(&format!(
-                "--aid: {p} ({})",
-                if force {
-                    "--force given".to_string()
-                } else {
-                    off.why_warned()
-                }
-            ));
+            off.say(force)?;
         }
         let Some((p, warn_only)) = judge.judge(w) else {
             return Ok(());

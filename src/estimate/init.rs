@@ -197,8 +197,9 @@ pub fn velocities_from_positions(fixes: &mut [Fix]) {
 /// wrong unit) is refused naming the first.
 pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
     let (mut checked, mut bad) = (0usize, Vec::new());
-    // the height rate from the positions against the receiver's down velocity: Σ u r, Σ u², Σ r²
-    let mut vertical = [0.0f64; 3];
+    // the height rate from the positions against the receiver's down velocity: Σ u r, Σ u², Σ r²,
+    // Σ σ_v²
+    let mut vertical = [0.0f64; 4];
     for k in 0..fixes.len() {
         let (true, Some(v)) = (receiver[k], fixes[k].v) else {
             continue;
@@ -210,6 +211,7 @@ pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
         vertical[0] += v.z * vp.z;
         vertical[1] += v.z * v.z;
         vertical[2] += vp.z * vp.z;
+        vertical[3] += fixes[k].sigma_v * fixes[k].sigma_v;
         checked += 1;
         let d = ((v - vp).x).hypot((v - vp).y);
         if d > 5.0 * fixes[k].sigma_v.hypot(sp) + 1.0 {
@@ -234,11 +236,13 @@ pub fn check_velocities(fixes: &[Fix], receiver: &[bool]) -> Result<()> {
 /// The heights against the receiver's vertical velocities over `n` fixes, from the sums `s`
 /// (Σ v_d·ṽ_d, Σ v_d², Σ ṽ_d² [m²/s²], ṽ_d from the height differences): the least-squares
 /// scale of the height rate on the velocity is 1 for one unit and sign; feet give 3.28, an up
-/// velocity read as down −1. Noise in the velocities only shrinks the scale towards 0 (it
-/// adds to Σ v_d² alone), so a scale between 0 and 1 says nothing; judged where the vertical
-/// velocities' RMS is 0.1 m/s or more over 20 fixes or more, and refused when the scale is
-/// over 1.3 or under −0.3, beyond 5 σ of its fit.
-fn check_vertical_scale(s: [f64; 3], n: usize) -> Result<()> {
+/// velocity read as down −1, heights that do not move (in km, or a constant) 0. Noise in the
+/// velocities shrinks the scale towards 0 (it adds to Σ v_d² alone), so a scale under 0.3 is
+/// judged only where the velocities' RMS is over 3 times their stated σ (`s[3]` = Σ σ_v²);
+/// judged where that RMS is 0.1 m/s or more over 20 fixes or more, and refused when the scale
+/// is over 1.3 or under 0.3 (−0.3 where the velocities' noise could explain it), beyond 5 σ of
+/// its fit.
+fn check_vertical_scale(s: [f64; 4], n: usize) -> Result<()> {
     if n < 20 || s[1] < n as f64 * 0.01 {
         return Ok(());
     }
@@ -246,7 +250,8 @@ fn check_vertical_scale(s: [f64; 3], n: usize) -> Result<()> {
     // residual Σ (ṽ − k v)² = Σṽ² − k Σ v ṽ
     let sigma = ((s[2] - k * s[0]).max(0.0) / (n - 1) as f64 / s[1]).sqrt();
     let beyond = |bound: f64| (k - bound).abs() > 5.0 * sigma;
-    if !((k > 1.3 && beyond(1.3)) || (k < -0.3 && beyond(-0.3))) {
+    let low = if s[1] > 9.0 * s[3] { 0.3 } else { -0.3 };
+    if !((k > 1.3 && beyond(1.3)) || (k < low && beyond(low))) {
         return Ok(());
     }
     const FEET_PER_METRE: f64 = 1.0 / 0.3048;
@@ -254,6 +259,8 @@ fn check_vertical_scale(s: [f64; 3], n: usize) -> Result<()> {
         "heights in feet (3.28 per metre)?"
     } else if (k + 1.0).abs() < 0.3 {
         "a vertical velocity up read as down (or heights as depths)?"
+    } else if k.abs() < 0.3 {
+        "heights that hardly move (in km, or held constant)?"
     } else {
         "heights or vertical velocities mis-scaled?"
     };

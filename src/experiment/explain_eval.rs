@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 
 /// What an evaluation draws.
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct EvalSpec {
     /// Seed of the campaign.
     pub seed: u64,
