@@ -513,22 +513,8 @@ fn a_truth_that_contradicts_the_filter_is_said() {
     let text = std::fs::read_to_string(sim.join("truth.txt")).unwrap();
     // t lat lon h v_n v_e v_d roll pitch yaw: yaw is the last column
     let yaw_col = 9;
-    let rewrite = |name: &str, f: &dyn Fn(f64) -> f64| {
-        let out: String = text
-            .lines()
-            .map(|l| {
-                if l.starts_with('#') {
-                    return format!("{l}\n");
-                }
-                let mut v: Vec<String> = l.split_whitespace().map(str::to_string).collect();
-                v[yaw_col] = format!("{:.6}", f(v[yaw_col].parse().unwrap()));
-                format!("{}\n", v.join(" "))
-            })
-            .collect();
-        let path = d.join(name);
-        std::fs::write(&path, out).unwrap();
-        path
-    };
+    let rewrite =
+        |name: &str, f: &dyn Fn(f64) -> f64| with_column(&text, '#', yaw_col, 6, f, &d.join(name));
     let run = |truth: &Path, out: &str| {
         let (ok, _, err) = sinsmodel(&[
             "filter",
@@ -694,22 +680,8 @@ fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
     let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(sim.join("gnss.txt")).unwrap();
-    let heights = |name: &str, f: &dyn Fn(f64) -> f64| {
-        let out: String = text
-            .lines()
-            .map(|l| {
-                if l.starts_with('#') {
-                    return format!("{l}\n");
-                }
-                let mut v: Vec<String> = l.split_whitespace().map(str::to_string).collect();
-                v[3] = format!("{:.4}", f(v[3].parse().unwrap()));
-                format!("{}\n", v.join(" "))
-            })
-            .collect();
-        let path = d.join(name);
-        std::fs::write(&path, out).unwrap();
-        path
-    };
+    let heights =
+        |name: &str, f: &dyn Fn(f64) -> f64| with_column(&text, '#', 3, 4, f, &d.join(name));
     let run_from = |aid: &Path, out: &str, init: &str| {
         sinsmodel(&[
             "filter",
@@ -954,21 +926,8 @@ fn the_real_drive_with_heights_in_feet_is_refused_under_init_auto() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // column `col` (0-based, after splitting on blanks) through `f`
-    let changed = |name: &str, col: usize, f: &dyn Fn(f64) -> f64| -> PathBuf {
-        let text: String = pos
-            .lines()
-            .map(|l| {
-                if l.starts_with('%') {
-                    return format!("{l}\n");
-                }
-                let mut v: Vec<String> = l.split_whitespace().map(String::from).collect();
-                v[col] = format!("{:.4}", f(v[col].parse().unwrap()));
-                format!("{}\n", v.join("  "))
-            })
-            .collect();
-        let path = d.join(name);
-        std::fs::write(&path, text).unwrap();
-        path
+    let changed = |name: &str, col: usize, f: &dyn Fn(f64) -> f64| {
+        with_column(&pos, '%', col, 4, f, &d.join(name))
     };
     let run = |aid: &Path| mems_drive_filter(aid, &d.join("o"));
     let (ok, err) = run(&changed("same.pos", 4, &|h| h));
@@ -1075,4 +1034,29 @@ fn mems_drive_filter(aid: &Path, out: &Path) -> (bool, String) {
         p(out),
     ]);
     (ok, err)
+}
+
+/// Writes `text` to `path` with column `col` (0-based, blank-separated) of every data row put
+/// through `f` and written with `decimals` digits; rows starting with `comment` kept as they are.
+fn with_column(
+    text: &str,
+    comment: char,
+    col: usize,
+    decimals: usize,
+    f: &dyn Fn(f64) -> f64,
+    path: &Path,
+) -> PathBuf {
+    let out: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with(comment) {
+                return format!("{l}\n");
+            }
+            let mut v: Vec<String> = l.split_whitespace().map(str::to_string).collect();
+            v[col] = format!("{:.*}", decimals, f(v[col].parse().unwrap()));
+            format!("{}\n", v.join(" "))
+        })
+        .collect();
+    std::fs::write(path, out).unwrap();
+    path.to_path_buf()
 }
