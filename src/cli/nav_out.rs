@@ -252,20 +252,15 @@ impl NavWriter {
         }
     }
 
-    /// Hands the rows collected so far to the writing thread (a thread that stopped on an
-    /// error has its error read at [`NavWriter::finish`]).
+    /// Hands the rows collected so far to the writing thread (one that stopped on an error
+    /// takes no more; its error comes with the join in [`NavWriter::finish`]).
     fn send_batch(&mut self) {
         if self.batch.is_empty() {
             return;
         }
         let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH_ROWS));
         if let Some(w) = &self.writer {
-            if w.tx.send(batch).is_err() {
-                // the thread stopped: its error comes with the join
-                let _ = self.close();
-                self.error
-                    .get_or_insert_with(|| "nav.txt: its writing thread stopped".into());
-            }
+            let _ = w.tx.send(batch);
         }
     }
 

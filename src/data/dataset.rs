@@ -109,16 +109,13 @@ impl DataOptions {
         };
         let outages = self.outages(imu.first_t())?;
         // the aiding clock is judged on every sample, those --init auto reads through included
-        let clock = match &plan {
-            AidPlan::Fixes(list, _, _) => {
-                crate::estimate::clock_check::watch_from_the_start(list, imu.head(), self.force)
+        if let AidPlan::Fixes(list, _, _) = &plan {
+            if let Some(c) =
+                crate::estimate::clock_check::window_check(list, imu.head(), self.force)
+            {
+                imu.judge_windows(c);
             }
-            AidPlan::Static { .. } => None,
         }
-        .map(|(shared, check)| {
-            imu.judge_windows(check);
-            shared
-        });
         let start = self.start(&mut imu, &plan, &outages, truth_reader.as_mut(), note)?;
         let t0 = start.state.t;
         if let Some(o) = outages.iter().find(|o| o.end_s <= t0 + 1e-9) {
@@ -129,7 +126,7 @@ impl DataOptions {
                 if self.init_auto() { ", where --init auto found its start" } else { "" }
             );
         }
-        self.check_head(&mut imu, &start.state, &plan, clock, note)?;
+        self.check_head(&mut imu, &start.state, &plan, note)?;
         check_plan_at_start(&plan, &start.state, note)?;
         check_fixes(&mut plan, imu.first_t(), note)?;
         let aid = plan.after(t0);
@@ -154,7 +151,6 @@ impl DataOptions {
         imu: &mut ImuStream,
         start: &NavState,
         plan: &AidPlan,
-        clock: Option<crate::estimate::clock_check::SharedClock>,
         note: &mut dyn FnMut(&str),
     ) -> Result<()> {
         let imu_path = self.imu_path()?;
@@ -219,13 +215,6 @@ impl DataOptions {
         // the rest of the run, a window at a time as it is read
         use crate::estimate::imu_check::{window_check, WindowJudge};
         let mut judge = WindowJudge::new(start.lat, &check, mems);
-        let witness_for_claim = witness.clone();
-        if let Some(w) = witness {
-            judge.witness_rest(w);
-        }
-        if let Some(c) = clock {
-            judge.watch_clock(c);
-        }
         let claim = if self.static_aid.is_some() {
             Some("--static-aid")
         } else {
@@ -244,7 +233,7 @@ impl DataOptions {
         }
         // the GNSS fixes beside --zupt say whether the vehicle stands (speed less 3σ)
         if let (Some("--zupt"), Some(crate::estimate::imu_check::RestWitness::Speeds(v))) =
-            (claim, witness_for_claim.as_ref())
+            (claim, witness.as_ref())
         {
             if let Some((t, sp)) = v.iter().find(|x| x.0 > start.t && x.1 > 1.0) {
                 bail!(
@@ -254,6 +243,9 @@ impl DataOptions {
                     crate::io::aiding::time_from_first_sample(*t, imu.first_t())
                 );
             }
+        }
+        if let Some(w) = witness {
+            judge.witness_rest(w);
         }
         if let Some(p) = claim.and_then(|o| judge.claim_rest(o, imu.head())) {
             if self.force {

@@ -243,34 +243,24 @@ impl ClockOffset {
     }
 }
 
-/// A clock check shared by the window checks that feed it: the one installed when the stream
-/// opens (the samples `--init auto` reads through to find its start) and the one after.
-pub type SharedClock = std::rc::Rc<std::cell::RefCell<ClockCheck>>;
-
-/// The clock check of the fixes `fixes` fed the stream's first seconds `head`, and the window
-/// check that feeds it every later window until the data set's full checks take it over; None
-/// where the fixes show no turn.
-pub fn watch_from_the_start(
+/// The window check of the aiding clock against the fixes `fixes`, fed the stream's first
+/// seconds `head` here and every later window by the stream (those `--init auto` reads through
+/// to its start included); it says an offset found ([`ClockOffset::say`]). None where the
+/// fixes show no turn.
+pub fn window_check(
     fixes: &[(PositionFix, Option<VelocityFix>)],
     head: &[ImuSample],
     force: bool,
-) -> Option<(SharedClock, crate::io::imu_stream::WindowCheck)> {
+) -> Option<crate::io::imu_stream::WindowCheck> {
     let mut c = ClockCheck::new(course_turns(fixes))?;
     c.feed(head);
-    let shared = std::rc::Rc::new(std::cell::RefCell::new(c));
-    let fed = shared.clone();
-    let check: crate::io::imu_stream::WindowCheck = Box::new(move |w| {
-        let found = {
-            let mut c = fed.borrow_mut();
-            c.feed(w);
-            c.judge(w.is_empty())
-        };
-        match found {
+    Some(Box::new(move |w| {
+        c.feed(w);
+        match c.judge(w.is_empty()) {
             Some(off) => off.say(force),
             None => Ok(()),
         }
-    });
-    Some((shared, check))
+    }))
 }
 
 /// The streaming check: fed every IMU sample in order, it judges each GNSS interval at every
@@ -484,9 +474,9 @@ impl ClockCheck {
         })
     }
 
-    /// The correlation as stamped and the best lag's [s], when both have seen enough turns (for
-    /// tests and reports).
-    pub fn summary(&self) -> Option<(f64, f64, f64)> {
+    /// The correlation as stamped and the best lag's [s], when both have seen enough turns.
+    #[cfg(test)]
+    fn summary(&self) -> Option<(f64, f64, f64)> {
         let (stamped, k, best) = self.stamped_and_best()?;
         Some((stamped, Self::lag(k), best))
     }

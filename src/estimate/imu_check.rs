@@ -485,8 +485,6 @@ pub struct WindowJudge {
     /// What says the vehicle is at rest, beside the IMU (whose steady turn on a smooth curve
     /// looks like rest): None, nothing (the gyros of later windows are not judged).
     rest_witness: Option<RestWitness>,
-    /// The GNSS course turns against the gyros' (the aiding's clock), when there are fixes.
-    clock: Option<super::clock_check::SharedClock>,
 }
 
 /// What says, beside the IMU, that the vehicle stands still in a stretch.
@@ -612,25 +610,7 @@ impl WindowJudge {
             rest_claim: None,
             t_first: head.window_s[0],
             rest_witness: None,
-            clock: None,
         }
-    }
-
-    /// Has the aiding's clock checked against the IMU's from the turns both see (`clock`, fed
-    /// every later window as it is judged).
-    pub fn watch_clock(&mut self, clock: super::clock_check::SharedClock) {
-        self.clock = Some(clock);
-    }
-
-    /// Feeds `window` (consecutive samples after the last) to the clock check; the offset it
-    /// finds (once).
-    pub fn judge_clock(
-        &mut self,
-        window: &[crate::io::imu::ImuSample],
-    ) -> Option<super::clock_check::ClockOffset> {
-        let mut clock = self.clock.as_ref()?.borrow_mut();
-        clock.feed(window);
-        clock.judge(window.is_empty())
     }
 
     /// Lets the gyros of the first later window at rest be judged where `witness` confirms
@@ -747,9 +727,6 @@ pub fn window_check(
 ) -> crate::io::imu_stream::WindowCheck {
     let mut warned = false;
     Box::new(move |w| {
-        if let Some(off) = judge.judge_clock(w) {
-            off.say(force)?;
-        }
         let Some((p, warn_only)) = judge.judge(w) else {
             return Ok(());
         };

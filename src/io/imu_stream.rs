@@ -81,9 +81,9 @@ pub struct ImuStream {
     last_t: f64,
     /// A sample read by [`ImuStream::skip_through`] past its time, handed out next.
     pending: Option<ImuSample>,
-    /// Judges each window of [`HEAD_SECONDS`] after the head ([`ImuStream::judge_windows`]), then an
-    /// empty one at the end of the file.
-    judge: Option<WindowCheck>,
+    /// Judge each window of [`HEAD_SECONDS`] after the head, in the order added
+    /// ([`ImuStream::judge_windows`]), then an empty one at the end of the file.
+    judges: Vec<WindowCheck>,
     /// The window check has been told the file ended.
     ended: bool,
     /// The samples after the head not yet judged.
@@ -173,7 +173,7 @@ impl ImuStream {
             delivered: 0,
             last_t: f64::NAN,
             pending: None,
-            judge: None,
+            judges: Vec::new(),
             ended: false,
             window: Vec::new(),
         };
@@ -369,7 +369,7 @@ impl ImuStream {
                 return Ok(None);
             };
             self.check(&s, line, self.delivered + 1)?;
-            if self.judge.is_some() {
+            if !self.judges.is_empty() {
                 self.window.push(s);
                 let span = s.t - self.window[0].t;
                 if span >= HEAD_SECONDS && self.window.len() >= HEAD_MIN_SAMPLES {
@@ -383,31 +383,30 @@ impl ImuStream {
         Ok(Some(s))
     }
 
-    /// Has `check` judge every window of [`HEAD_SECONDS`] read after the head (the head is judged
-    /// where the stream is opened), and the last, shorter one at the end of the file.
+    /// Has `check` judge, after the checks added before it, every window of [`HEAD_SECONDS`]
+    /// read from now on (the head is judged where the stream is opened), the last, shorter one
+    /// at the end of the file, then an empty one.
     pub fn judge_windows(&mut self, check: WindowCheck) {
-        self.judge = Some(check);
+        self.judges.push(check);
     }
 
     /// Judges the samples collected since the last window and forgets them.
     fn judge_window(&mut self) -> Result<()> {
-        if let Some(judge) = self.judge.as_mut() {
-            if !self.window.is_empty() {
-                let r = judge(&self.window);
-                self.window.clear();
-                r?;
-            }
+        if self.window.is_empty() {
+            return Ok(());
         }
-        Ok(())
+        let r = self.judges.iter_mut().try_for_each(|j| j(&self.window));
+        self.window.clear();
+        r
     }
 
     /// Tells the window check the file has ended (an empty window, once).
     fn judge_end(&mut self) -> Result<()> {
-        if let (Some(judge), false) = (self.judge.as_mut(), self.ended) {
-            self.ended = true;
-            judge(&[])?;
+        if self.ended {
+            return Ok(());
         }
-        Ok(())
+        self.ended = true;
+        self.judges.iter_mut().try_for_each(|j| j(&[]))
     }
 
     /// Reads and drops the samples whose time is at or before `t` [s] (a run that starts at
