@@ -378,21 +378,7 @@ fn the_aiding_file_is_checked_against_itself_on_every_run() {
     let imu = sim.join("imu.txt");
     let run_with = |aid: &Path, out: &str, extra: &[&str]| {
         let out = d.join(out);
-        let mut a = vec![
-            "filter",
-            "--model",
-            "P13",
-            "--imu",
-            p(&imu),
-            "--aid",
-            p(aid),
-            "--init",
-            "40.0966,-105.1474,1601,0,0,30",
-            "--out",
-            p(&out),
-        ];
-        a.extend_from_slice(extra);
-        let (ok, _, err) = sinsmodel(&a);
+        let (ok, err) = filter_p13(&imu, aid, "40.0966,-105.1474,1601,0,0,30", &out, extra);
         (ok, err, out)
     };
     let run = |aid: &Path, out: &str| run_with(aid, out, &[]);
@@ -623,25 +609,14 @@ fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
     std::fs::write(d.join("late.txt"), late).unwrap();
     let imu = sim.join("imu.txt");
     let run = |aid: &Path, out: &str, force: bool| {
-        let out = d.join(out);
-        let mut args = vec![
-            "filter",
-            "--model",
-            "P13",
-            "--imu",
-            p(&imu),
-            "--aid",
-            p(aid),
-            "--init",
+        let extra: &[&str] = if force { &["--force"] } else { &[] };
+        filter_p13(
+            &imu,
+            aid,
             "40.0966,-105.1474,1601,0,0,0",
-            "--out",
-            p(&out),
-        ];
-        if force {
-            args.push("--force");
-        }
-        let (ok, _, err) = sinsmodel(&args);
-        (ok, err)
+            &d.join(out),
+            extra,
+        )
     };
     let (ok, err) = run(&sim.join("gnss.txt"), "clean", false);
     assert!(ok && !err.contains("warning"), "{err}");
@@ -683,34 +658,22 @@ fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
     let heights =
         |name: &str, f: &dyn Fn(f64) -> f64| with_column(&text, '#', 3, 4, f, &d.join(name));
     let run_from = |aid: &Path, out: &str, init: &str| {
-        sinsmodel(&[
-            "filter",
-            "--model",
-            "P13",
-            "--imu",
-            p(&sim.join("imu.txt")),
-            "--aid",
-            p(aid),
-            "--init",
-            init,
-            "--out",
-            p(&d.join(out)),
-        ])
+        filter_p13(&sim.join("imu.txt"), aid, init, &d.join(out), &[])
     };
     let run = |aid: &Path, out: &str| run_from(aid, out, "30,110,100,0,0,0");
-    let (ok, _, err) = run(&sim.join("gnss.txt"), "clean");
+    let (ok, err) = run(&sim.join("gnss.txt"), "clean");
     assert!(ok && !err.contains("warning"), "{err}");
-    let (ok, _, err) = run(&heights("feet.txt", &|h| h * 3.2808), "feet");
+    let (ok, err) = run(&heights("feet.txt", &|h| h * 3.2808), "feet");
     assert!(!ok && err.contains("one of them in feet?"), "{err}");
-    let (ok, _, err) = run(&heights("datum.txt", &|h| h + 80.0), "datum");
+    let (ok, err) = run(&heights("datum.txt", &|h| h + 80.0), "datum");
     assert!(ok && err.contains("heights on two datums?"), "{err}");
     // a sea-level start of 20 m under ellipsoidal fixes at 66.5 m (northern Germany's geoid) is
     // no feet, though 3.3× apart: it runs (it had been refused)
     let geoid = heights("geoid.txt", &|h| h - 33.5);
-    let (ok, _, err) = run_from(&geoid, "geoid", "30,110,20,0,0,0");
+    let (ok, err) = run_from(&geoid, "geoid", "30,110,20,0,0,0");
     assert!(ok && !err.contains("feet"), "{err}");
     // 600 m off is beyond any datum: warned as such, not as two datums
-    let (ok, _, err) = run(&heights("far.txt", &|h| h + 600.0), "far");
+    let (ok, err) = run(&heights("far.txt", &|h| h + 600.0), "far");
     assert!(
         ok && err.contains("more than two height datums differ by"),
         "{err}"
@@ -1018,21 +981,27 @@ fn static_aid_on_a_gentle_creep_says_the_vehicle_may_move() {
 fn mems_drive_filter(aid: &Path, out: &Path) -> (bool, String) {
     let imu =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/gnss-imu-drive/imu_1934.csv");
-    let (ok, _, err) = sinsmodel(&[
+    filter_p13(&imu, aid, "auto", out, &["--grade", "mems"])
+}
+
+/// `filter --model P13 --imu IMU --aid AID --init INIT --out OUT EXTRA…`: whether it ran, and
+/// its stderr.
+fn filter_p13(imu: &Path, aid: &Path, init: &str, out: &Path, extra: &[&str]) -> (bool, String) {
+    let mut a = vec![
         "filter",
         "--model",
         "P13",
         "--imu",
-        p(&imu),
+        p(imu),
         "--aid",
         p(aid),
         "--init",
-        "auto",
-        "--grade",
-        "mems",
+        init,
         "--out",
         p(out),
-    ]);
+    ];
+    a.extend_from_slice(extra);
+    let (ok, _, err) = sinsmodel(&a);
     (ok, err)
 }
 
