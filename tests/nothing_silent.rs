@@ -337,18 +337,13 @@ fn ecef_and_dms_pos_files_are_named() {
 /// A 50-s drive (rest, 1.5 m/s² acceleration, a 90° turn) at 100 Hz with 1 Hz fixes and
 /// velocities, simulated into `d/sim`.
 fn drive(d: &Path) -> PathBuf {
-    let sc = d.join("drive.toml");
-    std::fs::write(
-        &sc,
+    let sim = simulated_from(
+        d,
         "name = \"drive\"\nimu_rate_hz = 100.0\nseed = 7\n[start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\n\
          euler_deg = [0.0, 0.0, 30.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 10.0\n[[segment]]\nkind = \"accelerate\"\n\
          duration_s = 10.0\naccel_mps2 = 1.5\n[[segment]]\nkind = \"turn\"\nduration_s = 30.0\nyaw_rate_deg_s = 3.0\n\
          [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
-    )
-    .unwrap();
-    let sim = d.join("sim");
-    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
-    assert!(ok, "{err}");
+    );
     sim
 }
 
@@ -584,18 +579,13 @@ fn aiding_on_another_day_or_clock_is_named() {
 fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("clk.toml");
-    std::fs::write(
-        &sc,
+    let sim = simulated_from(
+        d,
         "name = \"clk\"\nimu_rate_hz = 100.0\nseed = 3\n[start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\n\
          [[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[[segment]]\nkind = \"accelerate\"\nduration_s = 2.0\naccel_mps2 = 3.0\n\
          [[segment]]\nkind = \"turn\"\nduration_s = 20.0\nyaw_rate_deg_s = 15.0\n[[segment]]\nkind = \"cruise\"\nduration_s = 20.0\n\
          [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
-    )
-    .unwrap();
-    let sim = d.join("sim");
-    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
-    assert!(ok, "{err}");
+    );
     let late: String = std::fs::read_to_string(sim.join("gnss.txt"))
         .unwrap()
         .lines()
@@ -645,15 +635,10 @@ fn a_late_aiding_clock_is_said_where_the_imu_turns_and_the_fixes_stand() {
 fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("low.toml");
-    std::fs::write(
-        &sc,
+    let sim = simulated_from(
+        d,
         "name = \"low\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 30.0\nlon_deg = 110.0\nh_m = 100.0\n[[segment]]\nkind = \"rest\"\nduration_s = 40.0\n[gnss]\nrate_hz = 1.0\n",
-    )
-    .unwrap();
-    let sim = d.join("sim");
-    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
-    assert!(ok, "{err}");
+    );
     let text = std::fs::read_to_string(sim.join("gnss.txt")).unwrap();
     let heights =
         |name: &str, f: &dyn Fn(f64) -> f64| with_column(&text, '#', 3, 4, f, &d.join(name));
@@ -687,17 +672,12 @@ fn heights_in_feet_or_on_another_datum_are_named_at_a_low_site() {
 fn a_tumble_about_a_level_axis_is_no_unit_slip() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sc = d.join("tt.toml");
-    std::fs::write(
-        &sc,
+    let sim = simulated_from(
+        d,
         "name = \"tt\"\nimu_rate_hz = 100.0\n[start]\nlat_deg = 40.0\nlon_deg = -105.0\nh_m = 1600.0\n\
          [[segment]]\nkind = \"rest\"\nduration_s = 30.0\n[[segment]]\nkind = \"rotate\"\naxis = \"x\"\nangle_deg = 360.0\nduration_s = 10.0\n\
          [[segment]]\nkind = \"rest\"\nduration_s = 20.0\n",
-    )
-    .unwrap();
-    let sim = d.join("sim");
-    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
-    assert!(ok, "{err}");
+    );
     let (ok, _, err) = sinsmodel(&[
         "filter",
         "--model",
@@ -1028,4 +1008,13 @@ fn with_column(
         .collect();
     std::fs::write(path, out).unwrap();
     path.to_path_buf()
+}
+
+/// `simulate` of the scenario `toml` (written to `d/scenario.toml`) into `d/sim`; that directory.
+fn simulated_from(d: &Path, toml: &str) -> PathBuf {
+    let (sc, sim) = (d.join("scenario.toml"), d.join("sim"));
+    std::fs::write(&sc, toml).unwrap();
+    let (ok, _, err) = sinsmodel(&["simulate", p(&sc), "--out", p(&sim)]);
+    assert!(ok, "{err}");
+    sim
 }
