@@ -337,14 +337,13 @@ fn ecef_and_dms_pos_files_are_named() {
 /// A 50-s drive (rest, 1.5 m/s² acceleration, a 90° turn) at 100 Hz with 1 Hz fixes and
 /// velocities, simulated into `d/sim`.
 fn drive(d: &Path) -> PathBuf {
-    let sim = simulated_from(
+    simulated_from(
         d,
         "name = \"drive\"\nimu_rate_hz = 100.0\nseed = 7\n[start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\n\
          euler_deg = [0.0, 0.0, 30.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 10.0\n[[segment]]\nkind = \"accelerate\"\n\
          duration_s = 10.0\naccel_mps2 = 1.5\n[[segment]]\nkind = \"turn\"\nduration_s = 30.0\nyaw_rate_deg_s = 3.0\n\
          [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.05 m\"\nsigma_d = \"0.1 m\"\nsigma_v = \"0.02 m/s\"\n",
-    );
-    sim
+    )
 }
 
 #[test]
