@@ -145,7 +145,8 @@ impl Finding {
 #[derive(Debug, Clone, Serialize)]
 pub struct Consistency {
     /// The split: `time` (halves of the aiding epochs), `speed` (below and from the median
-    /// aided speed), `motion` (by the body axis of the most recent rotation).
+    /// aided speed), `motion` (by the body axis of the most recent rotation); for noise levels
+    /// `rotation` (rotating or turning, or not), `time` and `vibration` (vibrating or quiet).
     pub split: String,
     /// The groups with information, each with its estimate and σ (display unit); a group
     /// whose σ is infinite, NaN or more than 100× the best group's carries none and is left out.

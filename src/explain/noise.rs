@@ -369,26 +369,65 @@ pub(super) fn stage(
             ));
             nf.stand_in = Some(why);
         }
+        if let Some(why) = implausible_scale(f) {
+            nf.words.push_str(&format!(". {why}"));
+            nf.stand_in.get_or_insert(why);
+        }
         findings.push(nf);
     }
     Ok((findings, Some(pass)))
 }
 
-/// Each innovation's group in the two splits of the noise levels: (0 at rest or moving
-/// straight, 1 while the body rotates or turns, to 2 s after), and (0 first half, 1 second
-/// half of the updates).
-fn innovation_groups(data: &ExplainData, pass: &Pass) -> anyhow::Result<Vec<[usize; 2]>> {
-    // rotating spans from the rate averaged over 0.1 s
+/// Most a sensor's noise level can be mis-stated by and still be read as that level: grades
+/// differ by one or two orders of magnitude, and within a grade the data sheets' values differ
+/// by a few times.
+pub(super) const PLAUSIBLE_SCALE: f64 = 30.0;
+
+/// Why sensor noise level `f`'s scale is no reading of the sensor's noise (more than
+/// [`PLAUSIBLE_SCALE`] times the stated or less than its inverse), in words; None for a
+/// plausible scale and for the aiding's σ (a receiver's σ may be stated for fixes with none).
+fn implausible_scale(f: &LevelFit) -> Option<String> {
+    if matches!(f.level, Level::Sigma(_))
+        || (1.0 / PLAUSIBLE_SCALE..=PLAUSIBLE_SCALE).contains(&f.scale)
+    {
+        return None;
+    }
+    let way = if f.scale > 1.0 { "larger" } else { "smaller" };
+    Some(format!(
+        "A level {}× the stated is {way} than a noise level mis-stated within a grade ({}× at most): either the stated noise is not this sensor's (give --grade or --noise for it and run again) or the scale compensates for an effect the candidates do not describe",
+        sig3(f.scale),
+        PLAUSIBLE_SCALE
+    ))
+}
+
+/// Each innovation's group in the three splits of the noise levels: (0 at rest or moving
+/// straight, 1 while the body rotates or turns, to 2 s after), (0 first half, 1 second half of
+/// the updates) and (0 quiet, 1 while the body vibrates, to 2 s after; all 0 when the vibration
+/// level does not change across the data, see [`vibrating_spans`]).
+fn innovation_groups(data: &ExplainData, pass: &Pass) -> anyhow::Result<Vec<[usize; 3]>> {
+    // rotating spans from the rate averaged over 0.1 s; vibration from the scatter of the
+    // specific force about its mean over the same 0.1 s
     let mut spans: Vec<(f64, f64)> = Vec::new();
+    let mut windows: Vec<(f64, f64, f64)> = Vec::new();
     let mut samples = data.imu.samples()?;
-    let (mut t0, mut acc) = (f64::NAN, nalgebra::Vector3::zeros());
+    let (mut t0, mut t_prev, mut acc) = (f64::NAN, f64::NAN, nalgebra::Vector3::zeros());
+    let (mut f_sum, mut f_sq, mut count) = (nalgebra::Vector3::zeros(), 0.0, 0usize);
     let mut on = false;
     while let Some(smp) = samples.next_sample()? {
         if t0.is_nan() {
             t0 = smp.t;
+            t_prev = smp.t;
             continue;
         }
         acc += smp.dtheta;
+        let dt = smp.t - t_prev;
+        t_prev = smp.t;
+        if dt > 0.0 {
+            let f = smp.dv / dt;
+            f_sum += f;
+            f_sq += f.norm_squared();
+            count += 1;
+        }
         if smp.t - t0 >= 0.1 {
             let rate = acc.norm() / (smp.t - t0);
             if rate > super::signatures::ROTATING {
@@ -402,20 +441,57 @@ fn innovation_groups(data: &ExplainData, pass: &Pass) -> anyhow::Result<Vec<[usi
             } else if rate < 0.5 * super::signatures::ROTATING {
                 on = false;
             }
+            if count >= 2 {
+                let n = count as f64;
+                let scatter = (f_sq / n - (f_sum / n).norm_squared()).max(0.0).sqrt();
+                windows.push((t0, smp.t, scatter));
+            }
             t0 = smp.t;
             acc = nalgebra::Vector3::zeros();
+            (f_sum, f_sq, count) = (nalgebra::Vector3::zeros(), 0.0, 0);
         }
     }
+    let shaking = vibrating_spans(&windows);
     let inn = &pass.run.innovations;
     let half = inn.len() / 2;
+    let within = |sp: &[(f64, f64)], t: f64| sp.iter().any(|&(a, b)| t >= a && t <= b + 2.0);
     Ok(inn
         .iter()
         .enumerate()
         .map(|(k, i)| {
-            let moving = spans.iter().any(|&(a, b)| i.t >= a && i.t <= b + 2.0);
-            [usize::from(moving), usize::from(k >= half)]
+            [
+                usize::from(within(&spans, i.t)),
+                usize::from(k >= half),
+                usize::from(within(&shaking, i.t)),
+            ]
         })
         .collect())
+}
+
+/// The spans [s] where the body vibrates, from 0.1-s windows (start, end, RMS scatter of the
+/// specific force about its window mean [m/s²]): windows above the geometric mean of the
+/// scatter's 10th and 90th percentiles, merged. None when those percentiles are within 3× of
+/// each other or the 90th is under 0.1 m/s² (sensor noise alone): the vibration level does
+/// not change enough across the data to tell a noise level from an effect of vibration.
+fn vibrating_spans(windows: &[(f64, f64, f64)]) -> Vec<(f64, f64)> {
+    if windows.len() < 10 {
+        return Vec::new();
+    }
+    let mut v: Vec<f64> = windows.iter().map(|w| w.2).collect();
+    v.sort_by(f64::total_cmp);
+    let (p10, p90) = (v[v.len() / 10], v[v.len() * 9 / 10]);
+    if p90 < 0.1 || p90 < 3.0 * p10 {
+        return Vec::new();
+    }
+    let cut = (p10.max(1e-9) * p90).sqrt();
+    let mut spans: Vec<(f64, f64)> = Vec::new();
+    for &(a, b, _) in windows.iter().filter(|w| w.2 > cut) {
+        match spans.last_mut() {
+            Some(last) if a <= last.1 + 1e-9 => last.1 = b,
+            _ => spans.push((a, b)),
+        }
+    }
+    spans
 }
 
 /// Level `f`'s scale fitted on each group of each split apart: passes at half and twice the
@@ -427,10 +503,10 @@ fn split_scales(
     cfg: &FilterConfig,
     f: &LevelFit,
     pass: &Pass,
-    groups: &[[usize; 2]],
+    groups: &[[usize; 3]],
 ) -> anyhow::Result<Vec<super::Consistency>> {
-    let loglik_by_group = |p: &Pass| -> [[f64; 2]; 2] {
-        let mut l = [[0.0; 2]; 2];
+    let loglik_by_group = |p: &Pass| -> [[f64; 2]; 3] {
+        let mut l = [[0.0; 2]; 3];
         for (i, g) in p.run.innovations.iter().zip(groups) {
             let li = super::diagnostics::loglik_of(i);
             for (split, &k) in g.iter().enumerate() {
@@ -458,6 +534,7 @@ fn split_scales(
             ["at rest or moving straight", "while rotating or turning"],
         ),
         (1, "time", ["first half", "second half"]),
+        (2, "vibration", ["quiet", "while vibrating"]),
     ] {
         let est: Vec<(f64, f64)> = (0..2)
             .map(|k| {
@@ -676,6 +753,53 @@ mod tests {
         assert!((a + 3.0).abs() < 1e-9, "{a}");
         assert!(calls <= MAX_EVALS, "{calls}");
         assert_eq!(edge, 0);
+    }
+
+    #[test]
+    fn vibration_spans_only_where_the_level_changes() {
+        // 0.1-s windows: quiet (0.02 m/s²) but for 2–3 s and 5–5.5 s (3 m/s²)
+        let w: Vec<(f64, f64, f64)> = (0..100)
+            .map(|k| {
+                let t = k as f64 * 0.1;
+                let on = (2.0..3.0).contains(&t) || (5.0..5.5).contains(&t);
+                (t, t + 0.1, if on { 3.0 } else { 0.02 })
+            })
+            .collect();
+        let sp = vibrating_spans(&w);
+        assert_eq!(sp.len(), 2, "{sp:?}");
+        assert!(
+            (sp[0].0 - 2.0).abs() < 1e-9 && (sp[0].1 - 3.0).abs() < 1e-9,
+            "{sp:?}"
+        );
+        // the same level throughout (or only sensor noise): no split
+        let flat: Vec<(f64, f64, f64)> = w.iter().map(|x| (x.0, x.1, 3.0)).collect();
+        assert!(vibrating_spans(&flat).is_empty());
+        let noise: Vec<(f64, f64, f64)> =
+            w.iter().map(|x| (x.0, x.1, x.2.min(0.05) * 0.5)).collect();
+        assert!(vibrating_spans(&noise).is_empty());
+    }
+
+    #[test]
+    fn a_sensor_noise_scale_beyond_a_grade_is_no_reading_of_the_noise() {
+        let fit = |level, scale| LevelFit {
+            level,
+            scale,
+            interval: [scale / 1.2, scale * 1.2],
+            at_bound: 0,
+            two_delta_loglik: 100.0,
+            p_holm: 0.0,
+            significant: true,
+        };
+        assert!(implausible_scale(&fit(Level::AccelVrw, 10.0)).is_none());
+        assert!(implausible_scale(&fit(Level::GyroArw, 0.1)).is_none());
+        let why = implausible_scale(&fit(Level::AccelVrw, 335.0)).unwrap();
+        assert!(
+            why.contains("335× the stated") && why.contains("--grade"),
+            "{why}"
+        );
+        assert!(implausible_scale(&fit(Level::GyroBiasRw, 0.01)).is_some());
+        // an aiding σ may be stated for fixes that carry none
+        assert!(implausible_scale(&fit(Level::Sigma("pos_h"), 0.001)).is_none());
     }
 
     #[test]

@@ -491,7 +491,7 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
             .map(|p| {
                 format!(
                     "; they are also correlated in time (Ljung–Box p {} after Bonferroni)",
-                    sig3(p)
+                    p_text(p)
                 )
             })
             .unwrap_or_default();
@@ -516,6 +516,17 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
                 sig3(ch.nis_mean.sqrt()),
                 sig3(ch.nis_mean)
             )),
+            // correlated and far too small: a filter given more noise than the data carry
+            // corrects slowly, which alone correlates its innovations
+            (false, _) if ch.nis_mean < 0.5 * ch.nis_band[0] => out.push(format!(
+                "{} innovations are {}× smaller than the model predicts (mean NIS {}, 95 % band {}–{}) and correlated in time (Ljung–Box p {} after Bonferroni over the channels): its measurement or process noise is set too high for these data. A filter given more noise than the data carry corrects slowly, which alone correlates its innovations, so whether a slow effect is there too cannot be told until the noise is right (--noise, --grade, or the aiding's σ).",
+                channel_word(&ch.channel),
+                sig3((1.0 / ch.nis_mean.max(1e-12)).sqrt()),
+                sig3(ch.nis_mean),
+                sig3(ch.nis_band[0]),
+                sig3(ch.nis_band[1]),
+                correlated.map(p_text).unwrap_or_default(),
+            )),
             // the whiteness test failed and the size is not too large: say where the size lies
             (false, _) => {
                 let size = if ch.nis_mean < ch.nis_band[0] {
@@ -537,7 +548,11 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
         }
     }
     for ch in &e.baseline.channels {
-        if ch.nis_mean < 0.5 * ch.nis_band[0] {
+        // (a correlated one was said above, with why it is correlated)
+        let said = ch
+            .whiteness_p
+            .is_some_and(|p| p * e.baseline.channels.len() as f64 <= 0.01);
+        if ch.nis_mean < 0.5 * ch.nis_band[0] && !said {
             consistent = false;
             out.push(format!(
                 "{} innovations are {}× smaller than the model predicts (mean NIS {}): its measurement or process noise is set too high for these data.",
@@ -639,6 +654,24 @@ fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
                 ""
             }
         ));
+        // a stand-in takes up misfit without being its cause: said apart
+        let taken: f64 = e
+            .findings
+            .iter()
+            .filter(|f| f.stand_in.is_some())
+            .filter_map(|f| f.misfit_share)
+            .map(|x| x.max(0.0))
+            .sum();
+        if taken >= 0.05 {
+            if let Some(last) = out.last_mut() {
+                last.pop();
+                last.push_str(&format!(
+                    "; {} % of the excess is taken up only by fits that are not causes (\"Fitted, but not a cause\" above): the causes found leave {} % of it unexplained.",
+                    sig3(100.0 * taken),
+                    sig3(100.0 * (left.max(0.0) + taken).min(1.0))
+                ));
+            }
+        }
     }
     // what the extended model leaves in the innovations (the baseline's was said above)
     let left = e.extended.structure();
