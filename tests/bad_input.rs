@@ -149,6 +149,25 @@ fn scenario_errors_name_file_line_and_problem() {
             ":10:",
             "unknown unit `furlong`",
         ),
+        // a scale factor of 10 written for 10 ppm, a bias in rad/s for deg/h, in m/s² for µg
+        (
+            "scale.toml",
+            format!("{base}[errors]\nkg_11 = \"10\"\n"),
+            ":10:",
+            "1.00e7 ppm is beyond the 2.00e5 ppm the term can physically have",
+        ),
+        (
+            "bias.toml",
+            format!("{base}[errors]\neps_x = \"10 rad/s\"\n"),
+            ":10:",
+            "is beyond the 72000 deg/h",
+        ),
+        (
+            "accel.toml",
+            format!("{base}[errors]\nnabla_x = \"50 m/s^2\"\n"),
+            ":10:",
+            "is beyond the 1.00e6 ug",
+        ),
         ("syntax.toml", format!("{base}[errors\n"), ":9", "invalid"),
         (
             "kind.toml",

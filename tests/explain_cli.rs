@@ -302,6 +302,24 @@ fn explain_refuses_bad_input_with_the_reason() {
             vec![
                 "explain",
                 "--model",
+                "P31",
+                "--imu",
+                rlg,
+                "--static-aid",
+                "34.246048,108.909664,380",
+                "--init",
+                init,
+                "--prior",
+                "d_x=1e300 ug/g^2",
+                "--out",
+                o,
+            ],
+            "the filter diverged",
+        ),
+        (
+            vec![
+                "explain",
+                "--model",
                 "P28",
                 "--imu",
                 rlg,
@@ -314,7 +332,7 @@ fn explain_refuses_bad_input_with_the_reason() {
                 "--out",
                 o,
             ],
-            "the filter diverged",
+            "beyond the 72000 deg/h the term can physically have",
         ),
     ];
     for (args, expect) in cases {
@@ -673,13 +691,141 @@ fn demo_with_its_cause_withheld_names_no_noise_level() {
         .find(|l| l.starts_with("Left unexplained"))
         .unwrap_or_else(|| panic!("{stderr}"));
     let pct: f64 = left
-        .split("the causes found leave ")
+        .split("Left unexplained by the causes found: ")
         .nth(1)
         .and_then(|t| t.split(' ').next())
         .and_then(|t| t.parse().ok())
         .unwrap_or_else(|| panic!("{left}"));
     assert!(pct > 50.0, "{left}");
+    let by_causes = v["gain"]["misfit_unexplained_by_causes"].as_f64().unwrap();
+    assert!((by_causes * 100.0 - pct).abs() < 0.1, "{by_causes} {left}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("Left unexplained by the causes found:")
+            && report.contains("(a bound, no estimate)"),
+        "the report's glance table"
+    );
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// A common accelerometer delay (2 ms on x, y and z) on a nine-rotation turntable: the rounds
+/// fit tau_z at twice its size beside a cross-quadratic stand-in, and once the stand-in is
+/// dropped tau_y is significant beside it. No delay may then be presented as a cause with a
+/// value off the truth; tau_z says why it is not named and how to fit them together.
+#[test]
+fn a_common_accelerometer_delay_is_not_named_at_twice_its_size() {
+    let dir = tmp("common-delay");
+    let sim = nine_rotation_turntable(&dir);
+    let out = dir.join("explain");
+    let (ok, _, stderr) = turntable_explain(&sim, &out, &[]);
+    assert!(ok, "{stderr}");
+    let v = json(&out.join("explain.json"));
+    let findings = v["findings"].as_array().unwrap();
+    for f in findings {
+        let cause = f["stand_in"].is_null() && f["not_attributed"].is_null();
+        let term = f["term"].as_str().unwrap();
+        if cause && term.starts_with("tau_") {
+            let est = f["estimate"].as_f64().unwrap();
+            assert!(
+                (est - 2.0).abs() < 0.5,
+                "{term} = {est} ms named as a cause: {stderr}"
+            );
+        }
+    }
+    let tau_z = findings
+        .iter()
+        .find(|f| f["term"] == "tau_z")
+        .unwrap_or_else(|| panic!("tau_z not fitted: {stderr}"));
+    if (tau_z["estimate"].as_f64().unwrap() - 2.0).abs() >= 0.5 {
+        let why = tau_z["not_attributed"].as_str().unwrap_or("");
+        assert!(
+            why.contains("stand-ins") && why.contains("--candidates '!"),
+            "{tau_z}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// explain on a truth whose heading contradicts the run's (--init at yaw 90°, the truth at 0°):
+/// a warning on stderr and in the report, as `filter` says it (the model-error figures measure
+/// against that truth).
+#[test]
+fn explain_says_when_the_truth_contradicts_the_run() {
+    let dir = tmp("truth-heading");
+    let sim = nine_rotation_turntable(&dir);
+    let out = dir.join("explain");
+    let (ok, _, stderr) = turntable_explain(&sim, &out, &["--init", "30,114,20,0,0,90"]);
+    assert!(ok, "{stderr}");
+    let warned = |text: &str| {
+        text.matches("the truth's attitude differs from the filter's estimate in heading")
+            .count()
+    };
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: --truth"))
+        .collect();
+    assert_eq!(said.len(), 1, "{stderr}");
+    assert!(warned(said[0]) == 1, "{stderr}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(warned(&report) >= 1, "not in the report");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// explain (P28, static aid at the start, the truth given) on the turntable simulated in `sim`,
+/// with `extra` options, into `out`: (success, stdout, stderr).
+fn turntable_explain(
+    sim: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> (bool, String, String) {
+    let (imu, truth) = (sim.join("imu.txt"), sim.join("truth.txt"));
+    let mut args = vec!["explain", "--model", "P28", "--imu", imu.to_str().unwrap()];
+    args.extend([
+        "--static-aid",
+        "30,114,20",
+        "--truth",
+        truth.to_str().unwrap(),
+    ]);
+    args.extend(extra);
+    args.extend(["--out", out.to_str().unwrap()]);
+    sinsmodel(&args)
+}
+
+/// Simulates, into `dir`/sim, a nine-rotation turntable (90° in 5 s about x, x, y, y, z, z, −x,
+/// −y, −z, 20 s at rest after each, 60 s before) at 200 Hz with a common accelerometer delay of
+/// 2 ms; returns the simulation's directory.
+fn nine_rotation_turntable(dir: &std::path::Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut scen = String::from(
+        "name = \"tt\"\nimu_rate_hz = 200.0\ntruth_rate_hz = 10.0\nseed = 3\n[start]\nlat_deg = 30.0\nlon_deg = 114.0\nh_m = 20.0\neuler_deg = [0.0, 0.0, 0.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n",
+    );
+    for (axis, angle) in [
+        ("x", 90),
+        ("x", 90),
+        ("y", 90),
+        ("y", 90),
+        ("z", 90),
+        ("z", 90),
+        ("x", -90),
+        ("y", -90),
+        ("z", -90),
+    ] {
+        scen.push_str(&format!(
+            "[[segment]]\nkind = \"rotate\"\naxis = \"{axis}\"\nangle_deg = {angle}.0\nduration_s = 5.0\n[[segment]]\nkind = \"rest\"\nduration_s = 20.0\n"
+        ));
+    }
+    scen.push_str("[errors]\ntau_x = \"2 ms\"\ntau_y = \"2 ms\"\ntau_z = \"2 ms\"\n[noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n");
+    let scen_path = dir.join("tt.toml");
+    std::fs::write(&scen_path, scen).unwrap();
+    let sim = dir.join("sim");
+    let (ok, _, stderr) = sinsmodel(&[
+        "simulate",
+        scen_path.to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    sim
 }
 
 /// explain keeps about what `filter` keeps per aiding epoch (it had held ~2.9 KB, then ~0.8 KB,

@@ -182,6 +182,11 @@ fn negative_and_huge_numbers_get_the_options_own_words() {
     for (opt, val, words) in [
         ("--nav-rate", "-5", "--nav-rate -5: must be positive (Hz)"),
         ("--step", "-1", "--step -1: expected a filter step"),
+        (
+            "--step",
+            "10",
+            "milliseconds written as seconds? (10 ms is --step 0.01)",
+        ),
         ("--zupt", "-0.1", "--zupt -0.1: expected a velocity σ"),
         ("--init-speed", "-3", "--init-speed"),
     ] {

@@ -253,12 +253,23 @@ impl DataOptions {
         Ok(())
     }
 
-    /// `--step` when given, checked: in (0, 10] s.
+    /// `--step` when given, checked: in (0, 1] s (a longer step integrates the error model over
+    /// whole manoeuvres with a second-order Φ: milliseconds written as seconds).
     pub(crate) fn step_given(&self) -> Result<Option<f64>> {
         match self.step {
-            Some(s) if !(s.is_finite() && s > 0.0 && s <= 10.0) => {
+            Some(s) if !(s.is_finite() && s > 0.0 && s <= 1.0) => {
+                let hint = if s.is_finite() && s > 1.0 {
+                    format!(
+                        "; a step of {} s spans whole manoeuvres: milliseconds written as seconds? ({} ms is --step {})",
+                        crate::io::units::shown_number(s),
+                        crate::io::units::shown_number(s),
+                        crate::io::units::shown_number(s / 1000.0)
+                    )
+                } else {
+                    String::new()
+                };
                 bail!(
-                    "--step {}: expected a filter step in (0, 10] s",
+                    "--step {}: expected a filter step in (0, 1] s{hint}",
                     crate::io::units::shown_number(s)
                 )
             }

@@ -31,6 +31,58 @@ pub fn model_error_rms_arcsec(run: &FilterRun, t0: f64, t1: f64) -> Option<[f64;
     ])
 }
 
+/// Where the truth contradicts the filter itself, in words (None when it does not), from each
+/// axis's (north tilt, east tilt, heading) |e| [rad] and |e| / σ over the epochs with truth: on
+/// an axis where the median |e| exceeds 5° and the median |e| / σ 10, the truth is not of this
+/// run's attitude (yaw in radians or with the opposite sign, another body frame) or not of its
+/// time; `measured` names what measures against it (e.g. `model_error.txt measures`).
+pub fn truth_disagreement(disagreement: &[Vec<(f64, f64)>; 3], measured: &str) -> Option<String> {
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(0.0)
+    };
+    let mut said = Vec::new();
+    for (k, axis) in ["north tilt", "east tilt", "heading"].iter().enumerate() {
+        let d = &disagreement[k];
+        if d.len() < 10 {
+            continue;
+        }
+        let e = median(d.iter().map(|x| x.0).collect());
+        let z = median(d.iter().map(|x| x.1).collect());
+        if e > 5f64.to_radians() && z > 10.0 {
+            said.push(format!(
+                "{axis} by a median {:.1}° ({z:.0} σ)",
+                e.to_degrees()
+            ));
+        }
+    }
+    (!said.is_empty()).then(|| {
+        format!(
+            "--truth: the truth's attitude differs from the filter's estimate in {} over the epochs with truth: \
+             is the truth's yaw in radians, counted the other way (PSINS: counter-clockwise), or of another body \
+             frame, its roll and pitch in radians? Or the estimate is off: an aiding clock off the IMU's or a model that misses \
+             an error (see the warnings and the NIS above). {measured} against it",
+            said.join(", ")
+        )
+    })
+}
+
+/// The per-axis (north tilt, east tilt, heading) |e| [rad] and |e| / σ of `run`'s records with
+/// truth, for [`truth_disagreement`]; `phi` the model's indices of phi_n, phi_e, phi_d.
+pub fn attitude_disagreement(run: &FilterRun, phi: [Option<usize>; 3]) -> [Vec<(f64, f64)>; 3] {
+    let mut out: [Vec<(f64, f64)>; 3] = Default::default();
+    for r in &run.records {
+        let Some(p) = r.phi_true else { continue };
+        let e = r.phi_est - p;
+        for (k, i) in phi.iter().enumerate() {
+            if let Some(i) = *i {
+                out[k].push((e[k].abs(), e[k].abs() / r.sigma[i]));
+            }
+        }
+    }
+    out
+}
+
 /// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.
 pub fn channel_name(meas: &str, component: usize) -> String {
     match meas.strip_suffix("_ne") {

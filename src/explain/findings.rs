@@ -299,6 +299,26 @@ pub struct Explanation {
     pub model_error_after: Vec<(f64, f64, f64)>,
 }
 
+impl Explanation {
+    /// Fraction of the baseline's excess misfit taken up only by fits that are not causes
+    /// (stand-ins): the sum of their shares, 0 without any.
+    pub fn misfit_taken_by_stand_ins(&self) -> f64 {
+        self.findings
+            .iter()
+            .filter(|f| f.stand_in.is_some())
+            .filter_map(|f| f.misfit_share)
+            .map(|x| x.max(0.0))
+            .sum()
+    }
+
+    /// Fraction of the baseline's excess misfit the causes found leave: what the extended model
+    /// leaves plus what only stand-ins take up (at most 1); absent like `misfit_unexplained`.
+    pub fn misfit_unexplained_by_causes(&self) -> Option<f64> {
+        self.misfit_unexplained
+            .map(|u| (u.max(0.0) + self.misfit_taken_by_stand_ins()).min(1.0))
+    }
+}
+
 /// A significant candidate explain does not name: its value would be implausibly large.
 #[derive(Debug, Clone, Serialize)]
 pub struct Implausible {
@@ -483,6 +503,7 @@ impl Consistency {
                     })
                     .collect::<Vec<_>>()
                     .join(", ");
+                list.push_str(&format!(" {unit}"));
                 if shown.len() < informative.len() {
                     list.push_str(&format!(
                         " (the {} farthest from their weighted mean {} of {} groups)",
@@ -500,7 +521,7 @@ impl Consistency {
                     ));
                 }
                 format!(
-                    "grouped by {}, the updates give {list} {unit} (χ² {} on {} degrees of freedom): it does not hold across the data",
+                    "grouped by {}, the updates give {list} (χ² {} on {} degrees of freedom): it does not hold across the data",
                     match self.split.as_str() {
                         "motion" => "the last rotation's axis",
                         other => other,

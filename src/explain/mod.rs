@@ -47,6 +47,7 @@ use crate::estimate::filter::{self, channel_str, AidingEpoch, FilterConfig, Filt
 use crate::estimate::stats;
 use crate::io::imu::ImuData;
 use crate::io::truth::TruthRow;
+use crate::io::warnings::warn;
 use crate::model::catalog::{Sensor, StateRef};
 use crate::model::generated::common;
 use crate::model::{did_you_mean, Model};
@@ -425,6 +426,7 @@ pub fn explain(
     }
     let widened_kept = std::ptr::eq(ctx, &widened);
     let Stage {
+        truth_warning,
         base_stats,
         innovations_before,
         model_error_before,
@@ -433,6 +435,7 @@ pub fn explain(
         not_separable,
         r,
     } = stage;
+    truth_warning.iter().for_each(|w| warn(w));
     let excess = baseline_excess(&base_stats);
     // which findings are causes, judged on the rounds' extended pass; the causes' values then
     // come from the model they recommend, without the stand-ins (a stand-in beside a cause
@@ -446,6 +449,8 @@ pub fn explain(
         }
     }
     let r = without_stand_ins(ctx, r, &judged, progress)?;
+    let passed_over = passed_over(ctx, &r, &judged, &cands, progress)?;
+    let stand_ins = judged_stand_ins(&r, &judged);
     let (noise_findings, noise_pass) = noise::stage(ctx, &r, &base_stats, progress)?;
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let last_pass = noise_pass.as_ref().unwrap_or(&r.pass);
@@ -472,19 +477,12 @@ pub fn explain(
                 finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
         }
     }
+    mark_passed_over(&mut findings, &stand_ins, &passed_over);
     findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
     let extended_stats = last_pass.stats.clone();
-    let gain = Gain {
-        loglik: extended_stats.loglik - base_stats.loglik,
-        nis_mean_before: base_stats.nis_mean,
-        nis_mean_after: extended_stats.nis_mean,
-        model_error_rms_before: base_stats.model_error_rms_arcsec.map(|e| e[0].hypot(e[1])),
-        model_error_rms_after: extended_stats
-            .model_error_rms_arcsec
-            .map(|e| e[0].hypot(e[1])),
-    };
+    let gain = Gain::between(&base_stats, &extended_stats);
     let mut ranked = tests;
     ranked.sort_by(|a, b| b.llr.total_cmp(&a.llr));
     let mut expl = Explanation {
@@ -514,6 +512,114 @@ pub fn explain(
     };
     expl.summary = summary(&expl);
     Ok(expl)
+}
+
+/// Candidates the rounds passed over that are significant beside the causes once the
+/// stand-ins are dropped (a stand-in took their part of the misfit while they were judged):
+/// (term index, GLR estimate, σ in the display unit), from one pass with the candidates not
+/// named on `r`'s model; none when every finding in `judged` is a cause.
+fn passed_over(
+    ctx: &Context,
+    r: &Rounds,
+    judged: &[Finding],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Vec<(usize, f64, f64)>> {
+    if judged.iter().all(Finding::is_cause) {
+        return Ok(Vec::new());
+    }
+    let named = |t: usize| {
+        let name = common::TERMS[t].name;
+        r.named.iter().any(|n| n.term == t)
+            || judged
+                .iter()
+                .any(|f| f.equivalent.iter().any(|e| e == name))
+            || r.model.states.contains(&StateRef::Term(t))
+    };
+    let pool: Vec<usize> = cands.iter().copied().filter(|&t| !named(t)).collect();
+    if pool.is_empty() {
+        return Ok(Vec::new());
+    }
+    let cfg = ctx.extended_config(&r.model, &r.widened)?;
+    let round = r.rounds + 1;
+    let pass = run_pass(&r.model, &pool, ctx.data, &cfg, &mut |f| progress(round, f))?;
+    let (_, eligible) = candidate_tests(&pass.sig, ctx.opts);
+    let (sel, _) = forward_select(&pass.sig, &eligible, pass.run.innovations.len(), ctx.opts);
+    Ok(sel
+        .iter()
+        .map(|s| (pass.sig.cands[s.idx], s.glr, s.glr_sigma))
+        .collect())
+}
+
+/// The names of the stand-ins among `judged` (one finding per named term of `r`) and of the
+/// members of their classes (which would take their place were they withheld alone).
+fn judged_stand_ins(r: &Rounds, judged: &[Finding]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for (n, f) in r.named.iter().zip(judged).filter(|(_, f)| !f.is_cause()) {
+        for name in std::iter::once(common::TERMS[n.term].name.to_string())
+            .chain(f.equivalent.iter().cloned())
+        {
+            if !out.contains(&name) {
+                out.push(name);
+            }
+        }
+    }
+    out
+}
+
+/// Every cause of the sensor of a candidate in `passed_over` is no longer named: its value was
+/// fitted while the stand-ins (`stand_ins`, with their classes) took part of the misfit that
+/// candidate explains beside it; its words say so and how to fit them together.
+fn mark_passed_over(
+    findings: &mut [Finding],
+    stand_ins: &[String],
+    passed_over: &[(usize, f64, f64)],
+) {
+    for f in findings.iter_mut().filter(|f| f.is_cause()) {
+        let Some(t) = common::TERMS.iter().position(|x| x.name == f.term) else {
+            continue;
+        };
+        let sensor = common::TERMS[t].sensor;
+        let beside: Vec<String> = passed_over
+            .iter()
+            .filter(|p| common::TERMS[p.0].sensor == sensor)
+            .map(|&(c, glr, sd)| {
+                let info = &common::TERMS[c];
+                format!(
+                    "{} ({} ± {} {})",
+                    info.name,
+                    sig3(glr),
+                    sig3(sd),
+                    info.display
+                )
+            })
+            .collect();
+        if beside.is_empty() {
+            continue;
+        }
+        let withheld: Vec<String> = stand_ins.iter().map(|n| format!("!{n}")).collect();
+        let why = format!(
+            "once the stand-ins ({}) are dropped, {} become significant beside it: its value was fitted while a stand-in took part of their misfit and is not final; run again with --candidates '{}' to fit them together",
+            stand_ins.join(", "),
+            beside.join(", "),
+            withheld.join(",")
+        );
+        f.words.push_str(&format!(". Not named as a cause: {why}"));
+        f.not_attributed = Some(why);
+    }
+}
+
+impl Gain {
+    /// What the extended pass (`after`) gains over the baseline's (`before`).
+    fn between(before: &PassStats, after: &PassStats) -> Gain {
+        Gain {
+            loglik: after.loglik - before.loglik,
+            nis_mean_before: before.nis_mean,
+            nis_mean_after: after.nis_mean,
+            model_error_rms_before: before.model_error_rms_arcsec.map(|e| e[0].hypot(e[1])),
+            model_error_rms_after: after.model_error_rms_arcsec.map(|e| e[0].hypot(e[1])),
+        }
+    }
 }
 
 /// Two optional reasons as one (joined by "; ").
@@ -640,6 +746,8 @@ const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
 
 /// The baseline pass and the selection rounds on it.
 struct Stage {
+    /// What `--truth` contradicts in the baseline's estimate, in words.
+    truth_warning: Option<String>,
     base_stats: PassStats,
     innovations_before: Vec<(f64, &'static str, f64)>,
     model_error_before: Vec<(f64, f64, f64)>,
@@ -660,6 +768,13 @@ fn baseline_and_select(
     let base = run_pass(ctx.baseline, cands, ctx.data, &cfg, &mut |f| progress(1, f))?;
     let base_stats = base.stats.clone();
     let innovations_before = normalised(&base.run);
+    // a truth not of this run's attitude (or time) makes every model-error figure meaningless
+    let phi = ["phi_n", "phi_e", "phi_d"].map(|n| ctx.baseline.index_of(n));
+    let off = crate::estimate::metrics::attitude_disagreement(&base.run, phi);
+    let truth_warning = crate::estimate::metrics::truth_disagreement(
+        &off,
+        "the model error (truth) figures measure",
+    );
     let model_error_before = model_error_series(&base.run);
     let (tests, eligible) = candidate_tests(&base.sig, ctx.opts);
     let not_testable: Vec<String> = tests
@@ -674,6 +789,7 @@ fn baseline_and_select(
         .collect();
     let r = select_and_retest(ctx, cands.to_vec(), base, &eligible, progress)?;
     Ok(Stage {
+        truth_warning,
         base_stats,
         innovations_before,
         model_error_before,

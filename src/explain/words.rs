@@ -383,7 +383,7 @@ fn tight_priors_words(e: &Explanation, out: &mut Vec<String>) {
         };
         out.push(if e.baseline_priors_widened {
             format!(
-                "The baseline's priors are too tight for this sensor: {with}, {values}. A baseline held to priors the data reject is biased and its bias would be explained, so explain ran again with {options}: the baseline's log-likelihood rises by 2Δℓ {gain}, and what follows is that run. Give them, or the --grade of your sensor, yourself."
+                "The baseline's priors are too tight for these data: {with}, {values}. Either this sensor's errors are larger than its grade's priors (then give these priors, or the --grade of your sensor, yourself), or an effect the candidates do not describe acts through these terms (at rest a constant error of the specific force or rate looks like a bias); the data alone cannot tell which. A baseline held to priors the data reject is biased and its bias would be explained, so explain ran again with {options}: the baseline's log-likelihood rises by 2Δℓ {gain}, and what follows is that run; a term it finds beside these widened ones may be what they took up."
             )
         } else {
             format!(
@@ -654,23 +654,20 @@ fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
                 ""
             }
         ));
-        // a stand-in takes up misfit without being its cause: said apart
-        let taken: f64 = e
-            .findings
-            .iter()
-            .filter(|f| f.stand_in.is_some())
-            .filter_map(|f| f.misfit_share)
-            .map(|x| x.max(0.0))
-            .sum();
-        if taken >= 0.05 {
-            if let Some(last) = out.last_mut() {
-                last.pop();
-                last.push_str(&format!(
-                    "; {} % of the excess is taken up only by fits that are not causes (\"Fitted, but not a cause\" above): the causes found leave {} % of it unexplained.",
-                    sig3(100.0 * taken),
-                    sig3(100.0 * (left.max(0.0) + taken).min(1.0))
-                ));
-            }
+        // a stand-in takes up misfit without being its cause: said first
+        let taken = e.misfit_taken_by_stand_ins();
+        if let (true, Some(by_causes), Some(last)) = (
+            taken >= 0.05,
+            e.misfit_unexplained_by_causes(),
+            out.last_mut(),
+        ) {
+            *last = format!(
+                "Left unexplained by the causes found: {} % of the baseline's excess misfit. Fits that are not causes (\"Fitted, but not a cause\" above) take up {} % of it; with them the extended model leaves {} % (mean NIS {} against 1 for a consistent filter), which is no explanation.",
+                sig3(100.0 * by_causes),
+                sig3(100.0 * taken),
+                sig3(100.0 * left.max(0.0)),
+                nis_text(e.extended.nis_mean),
+            );
         }
     }
     // what the extended model leaves in the innovations (the baseline's was said above)

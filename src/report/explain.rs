@@ -36,6 +36,9 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
     if let Some(u) = e.misfit_unexplained {
         gain["misfit_unexplained"] = json!(u);
     }
+    if let Some(u) = e.misfit_unexplained_by_causes() {
+        gain["misfit_unexplained_by_causes"] = json!(u);
+    }
     json!({
         "written_by": "sinsmodel explain",
         "data": data,
@@ -266,18 +269,32 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
         } else {
             "**found: a cause**"
         };
-        let value = match f.scale {
-            Some(_) if f.unit == "x stated" => {
+        let bound = match f.scale_bound {
+            Some("at most") => Some("≤"),
+            Some(_) => Some("≥"),
+            None => None,
+        };
+        let value = match (f.scale, bound) {
+            (Some(k), Some(cmp)) if f.unit == "x stated" => {
+                format!("{cmp} {}× the stated σ (a bound, no estimate)", sig3(k))
+            }
+            (Some(k), Some(cmp)) => format!(
+                "{cmp} {} {} ({cmp} {}× the stated; a bound, no estimate)",
+                num(f.estimate),
+                notation(&f.unit),
+                sig3(k)
+            ),
+            (Some(_), None) if f.unit == "x stated" => {
                 format!("{} ± {} × the stated σ", num(f.estimate), num(f.sigma))
             }
-            Some(k) => format!(
+            (Some(k), None) => format!(
                 "{} ± {} {} ({}× the stated)",
                 num(f.estimate),
                 num(f.sigma),
                 notation(&f.unit),
                 sig3(k)
             ),
-            None => format!(
+            (None, _) => format!(
                 "{} ± {} {}",
                 num(f.estimate),
                 num(f.sigma),
@@ -299,11 +316,20 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
             f.term, f.kind
         ));
     }
-    if let Some(u) = e.misfit_unexplained {
-        s.push_str(&format!(
-            "\nLeft unexplained by the model explain recommends: {} % of the baseline's excess misfit.\n",
-            sig3(100.0 * u)
-        ));
+    if let (Some(u), Some(c)) = (e.misfit_unexplained, e.misfit_unexplained_by_causes()) {
+        if c > u + 0.005 {
+            s.push_str(&format!(
+                "\nLeft unexplained by the causes found: {} % of the baseline's excess misfit (fits that are not causes take up {} %; with them the extended model leaves {} %).\n",
+                sig3(100.0 * c),
+                sig3(100.0 * e.misfit_taken_by_stand_ins()),
+                sig3(100.0 * u)
+            ));
+        } else {
+            s.push_str(&format!(
+                "\nLeft unexplained by the model explain recommends: {} % of the baseline's excess misfit.\n",
+                sig3(100.0 * u)
+            ));
+        }
     }
 }
 
@@ -604,6 +630,16 @@ fn notes_section(s: &mut String) {
          correlated at |ρ| > 0.9 and likelihoods within the α-level margin); explain names the \
          member the spec's priors find most plausible and says which excitation would separate \
          them.\n",
+    );
+    s.push_str(
+        "\n**Found** is a finding named as a cause: significant, plausible in its prior σ, \
+         holding across the data in every split tested (its consistency table) and not in a class \
+         the data cannot separate. **Fitted, but not a cause** is significant but fails one of \
+         those: implausible in its prior σ (or, for a noise level, more than 30× from the stated), \
+         not one value across the data, or removing little of the misfit; its words say which, \
+         and it is no property of the sensor: it probably stands in for something the candidates \
+         lack. **Fitted, not attributed** is significant, but its class holds members whose \
+         values differ by an order of magnitude or more: none is named.\n",
     );
 }
 

@@ -59,9 +59,12 @@ pub fn demo_against_truth(e: &Explanation) -> String {
             )
         })
         .collect();
+    if against.is_empty() {
+        return "(hidden truth: d = 490 ug/g^2 on every axis; no d_ term was found, so there is no estimate to hold against it)".to_string();
+    }
     format!(
         "(hidden truth: d = 490 ug/g^2 on every axis; the estimates read {} against it; 0.7 % of that is expected: the regressor f^2 is formed from 2 kHz increments, which average the 90 Hz sine, sinc^2 = 0.993)",
-        if against.is_empty() { "nothing (no d_ term found)".to_string() } else { against.join(", ") }
+        against.join(", ")
     )
 }
 

@@ -113,34 +113,7 @@ impl EpochFiles {
     /// its σ, the truth is not of this run's attitude (yaw in radians or with the opposite
     /// sign, another body frame).
     pub fn truth_disagreement(&self) -> Option<String> {
-        let median = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(0.0)
-        };
-        let mut said = Vec::new();
-        for (k, axis) in ["north tilt", "east tilt", "heading"].iter().enumerate() {
-            let d = &self.disagreement[k];
-            if d.len() < 10 {
-                continue;
-            }
-            let e = median(&mut d.iter().map(|x| x.0).collect());
-            let z = median(&mut d.iter().map(|x| x.1).collect());
-            if e > 5f64.to_radians() && z > 10.0 {
-                said.push(format!(
-                    "{axis} by a median {:.1}° ({z:.0} σ)",
-                    e.to_degrees()
-                ));
-            }
-        }
-        (!said.is_empty()).then(|| {
-            format!(
-                "--truth: the truth's attitude differs from the filter's estimate in {} over the epochs with truth: \
-                 is the truth's yaw in radians, counted the other way (PSINS: counter-clockwise), or of another body \
-                 frame, its roll and pitch in radians? Or the estimate is off: an aiding clock off the IMU's or a model that misses \
-                 an error (see the warnings and the NIS above). model_error.txt measures against it",
-                said.join(", ")
-            )
-        })
+        crate::estimate::metrics::truth_disagreement(&self.disagreement, "model_error.txt measures")
     }
 
     /// Commits states.txt, innovations.txt (written now from `run`) and model_error.txt;
