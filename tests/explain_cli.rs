@@ -714,11 +714,7 @@ fn demo_with_its_cause_withheld_names_no_noise_level() {
 /// value off the truth; tau_z says why it is not named and how to fit them together.
 #[test]
 fn a_common_accelerometer_delay_is_not_named_at_twice_its_size() {
-    let dir = tmp("common-delay");
-    let sim = nine_rotation_turntable(&dir);
-    let out = dir.join("explain");
-    let (ok, _, stderr) = turntable_explain(&sim, &out, &[]);
-    assert!(ok, "{stderr}");
+    let (dir, out, stderr) = explained_turntable("common-delay", &[]);
     let v = json(&out.join("explain.json"));
     let findings = v["findings"].as_array().unwrap();
     for f in findings {
@@ -751,11 +747,7 @@ fn a_common_accelerometer_delay_is_not_named_at_twice_its_size() {
 /// against that truth).
 #[test]
 fn explain_says_when_the_truth_contradicts_the_run() {
-    let dir = tmp("truth-heading");
-    let sim = nine_rotation_turntable(&dir);
-    let out = dir.join("explain");
-    let (ok, _, stderr) = turntable_explain(&sim, &out, &["--init", "30,114,20,0,0,90"]);
-    assert!(ok, "{stderr}");
+    let (dir, out, stderr) = explained_turntable("truth-heading", &["--init", "30,114,20,0,0,90"]);
     let warned = |text: &str| {
         text.matches("the truth's attitude differs from the filter's estimate in heading")
             .count()
@@ -771,13 +763,13 @@ fn explain_says_when_the_truth_contradicts_the_run() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// explain (P28, static aid at the start, the truth given) on the turntable simulated in `sim`,
-/// with `extra` options, into `out`: (success, stdout, stderr).
-fn turntable_explain(
-    sim: &std::path::Path,
-    out: &std::path::Path,
-    extra: &[&str],
-) -> (bool, String, String) {
+/// The nine-rotation turntable simulated into a fresh directory `name`, and explain (P28,
+/// static aid at the start, the truth given, `extra` options) run on it into its `explain`:
+/// (the directory, the explain output, explain's stderr); explain must succeed.
+fn explained_turntable(name: &str, extra: &[&str]) -> (PathBuf, PathBuf, String) {
+    let dir = tmp(name);
+    let sim = nine_rotation_turntable(&dir);
+    let out = dir.join("explain");
     let (imu, truth) = (sim.join("imu.txt"), sim.join("truth.txt"));
     let mut args = vec!["explain", "--model", "P28", "--imu", imu.to_str().unwrap()];
     args.extend([
@@ -788,7 +780,9 @@ fn turntable_explain(
     ]);
     args.extend(extra);
     args.extend(["--out", out.to_str().unwrap()]);
-    sinsmodel(&args)
+    let (ok, _, stderr) = sinsmodel(&args);
+    assert!(ok, "{stderr}");
+    (dir, out, stderr)
 }
 
 /// Simulates, into `dir`/sim, a nine-rotation turntable (90° in 5 s about x, x, y, y, z, z, −x,
