@@ -714,7 +714,50 @@ fn demo_with_its_cause_withheld_names_no_noise_level() {
 /// value off the truth; tau_z says why it is not named and how to fit them together.
 #[test]
 fn a_common_accelerometer_delay_is_not_named_at_twice_its_size() {
-    let (dir, out, stderr) = explained_turntable("common-delay", &[]);
+    let (dir, out, stderr) = explained_turntable("common-delay", &NINE_MIXED, &[]);
+    no_delay_named_off_its_value(&out, &stderr);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The nine rotations of the turntable the common-delay tests use (axis, degrees).
+const NINE_MIXED: [(&str, i32); 9] = [
+    ("x", 90),
+    ("x", 90),
+    ("y", 90),
+    ("y", 90),
+    ("z", 90),
+    ("z", 90),
+    ("x", -90),
+    ("y", -90),
+    ("z", -90),
+];
+
+/// A common accelerometer delay (2 ms on x, y and z) on nine rotations about x four times, y
+/// four times, then z (the first nine of `scenarios/turntable.toml`): no single delay can be
+/// told from the common one there, and tau_z alone fits about twice its value with no stand-in
+/// beside it (3.80 ± 0.31 ms "Found" on three seeds in a review). Fitted beside the delays it
+/// takes up, it moves by more than 3 of its σ: not named.
+#[test]
+fn a_common_delay_the_rotations_cannot_separate_is_not_named() {
+    let seq = [
+        ("x", 90),
+        ("x", 90),
+        ("x", 90),
+        ("x", 90),
+        ("y", 90),
+        ("y", 90),
+        ("y", 90),
+        ("y", 90),
+        ("z", 90),
+    ];
+    let (dir, out, stderr) = explained_turntable("delay-unseparated", &seq, &[]);
+    no_delay_named_off_its_value(&out, &stderr);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// No accelerometer delay in `out`'s explain.json is a cause with a value more than 0.5 ms off
+/// the simulated 2 ms; tau_z, fitted off it, says why it is not named.
+fn no_delay_named_off_its_value(out: &std::path::Path, stderr: &str) {
     let v = json(&out.join("explain.json"));
     let findings = v["findings"].as_array().unwrap();
     for f in findings {
@@ -735,11 +778,11 @@ fn a_common_accelerometer_delay_is_not_named_at_twice_its_size() {
     if (tau_z["estimate"].as_f64().unwrap() - 2.0).abs() >= 0.5 {
         let why = tau_z["not_attributed"].as_str().unwrap_or("");
         assert!(
-            why.contains("stand-ins") && why.contains("--candidates '!"),
+            (why.contains("stand-ins") && why.contains("--candidates '!"))
+                || why.contains("the data do not fix its value"),
             "{tau_z}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// explain on a truth whose heading contradicts the run's (--init at yaw 90°, the truth at 0°):
@@ -747,7 +790,11 @@ fn a_common_accelerometer_delay_is_not_named_at_twice_its_size() {
 /// against that truth).
 #[test]
 fn explain_says_when_the_truth_contradicts_the_run() {
-    let (dir, out, stderr) = explained_turntable("truth-heading", &["--init", "30,114,20,0,0,90"]);
+    let (dir, out, stderr) = explained_turntable(
+        "truth-heading",
+        &NINE_MIXED,
+        &["--init", "30,114,20,0,0,90"],
+    );
     let warned = |text: &str| {
         text.matches("the truth's attitude differs from the filter's estimate in heading")
             .count()
@@ -766,9 +813,13 @@ fn explain_says_when_the_truth_contradicts_the_run() {
 /// The nine-rotation turntable simulated into a fresh directory `name`, and explain (P28,
 /// static aid at the start, the truth given, `extra` options) run on it into its `explain`:
 /// (the directory, the explain output, explain's stderr); explain must succeed.
-fn explained_turntable(name: &str, extra: &[&str]) -> (PathBuf, PathBuf, String) {
+fn explained_turntable(
+    name: &str,
+    seq: &[(&str, i32)],
+    extra: &[&str],
+) -> (PathBuf, PathBuf, String) {
     let dir = tmp(name);
-    let sim = nine_rotation_turntable(&dir);
+    let sim = nine_rotation_turntable(&dir, seq);
     let out = dir.join("explain");
     let (imu, truth) = (sim.join("imu.txt"), sim.join("truth.txt"));
     let mut args = vec!["explain", "--model", "P28", "--imu", imu.to_str().unwrap()];
@@ -788,22 +839,12 @@ fn explained_turntable(name: &str, extra: &[&str]) -> (PathBuf, PathBuf, String)
 /// Simulates, into `dir`/sim, a nine-rotation turntable (90° in 5 s about x, x, y, y, z, z, −x,
 /// −y, −z, 20 s at rest after each, 60 s before) at 200 Hz with a common accelerometer delay of
 /// 2 ms; returns the simulation's directory.
-fn nine_rotation_turntable(dir: &std::path::Path) -> PathBuf {
+fn nine_rotation_turntable(dir: &std::path::Path, seq: &[(&str, i32)]) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
     let mut scen = String::from(
         "name = \"tt\"\nimu_rate_hz = 200.0\ntruth_rate_hz = 10.0\nseed = 3\n[start]\nlat_deg = 30.0\nlon_deg = 114.0\nh_m = 20.0\neuler_deg = [0.0, 0.0, 0.0]\n[[segment]]\nkind = \"rest\"\nduration_s = 60.0\n",
     );
-    for (axis, angle) in [
-        ("x", 90),
-        ("x", 90),
-        ("y", 90),
-        ("y", 90),
-        ("z", 90),
-        ("z", 90),
-        ("x", -90),
-        ("y", -90),
-        ("z", -90),
-    ] {
+    for (axis, angle) in seq {
         scen.push_str(&format!(
             "[[segment]]\nkind = \"rotate\"\naxis = \"{axis}\"\nangle_deg = {angle}.0\nduration_s = 5.0\n[[segment]]\nkind = \"rest\"\nduration_s = 20.0\n"
         ));

@@ -478,6 +478,7 @@ pub fn explain(
         }
     }
     mark_passed_over(&mut findings, &stand_ins, &passed_over);
+    companions_move(ctx, &r, &tests, &mut findings, progress)?;
     findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
@@ -549,6 +550,119 @@ fn passed_over(
         .iter()
         .map(|s| (pass.sig.cands[s.idx], s.glr, s.glr_sigma))
         .collect())
+}
+
+/// Most candidates fitted beside the causes in [`companions_move`] (one pass).
+const MAX_COMPANIONS: usize = 6;
+
+/// Candidates significant alone that the causes take up (not named, not in a class, not
+/// implausible, not unconfirmed) are fitted beside them in one more pass: a cause of the same
+/// sensor whose value then moves by more than 3 of its σ is "not attributed": the data do not fix
+/// its value on this excitation (a delay on z fits what a common delay on x, y and z does on a
+/// turntable that never separates them), and its words say so with both values.
+fn companions_move(
+    ctx: &Context,
+    r: &Rounds,
+    tests: &[CandidateTest],
+    findings: &mut [Finding],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<()> {
+    let causes: Vec<usize> = (0..findings.len())
+        .filter(|&k| findings[k].is_cause())
+        .collect();
+    let known = |name: &str| {
+        findings
+            .iter()
+            .any(|f| f.term == name || f.equivalent.iter().any(|e| e == name))
+            || r.implausible.iter().any(|i| i.term == name)
+            || r.unconfirmed.iter().any(|u| u.0 == name)
+    };
+    let mut taken: Vec<usize> = tests
+        .iter()
+        .filter(|c| c.testable && c.confounded_with.is_none() && c.p_holm <= ctx.opts.alpha)
+        .filter(|c| !known(&c.term))
+        .filter_map(|c| common::TERMS.iter().position(|t| t.name == c.term))
+        .filter(|&t| !r.model.states.contains(&StateRef::Term(t)))
+        .filter(|&t| {
+            causes
+                .iter()
+                .any(|&k| term_sensor(&findings[k].term) == Some(common::TERMS[t].sensor))
+        })
+        .collect();
+    taken.truncate(MAX_COMPANIONS);
+    if causes.is_empty() || taken.is_empty() {
+        return Ok(());
+    }
+    let terms = r
+        .model
+        .states
+        .iter()
+        .filter_map(|s| match *s {
+            StateRef::Term(t) if !ctx.baseline.states.contains(s) => Some(t),
+            _ => None,
+        })
+        .chain(taken.iter().copied());
+    let model = model_with(&ctx.baseline.name, terms)?;
+    let cfg = ctx.extended_config(&model, &r.widened)?;
+    let round = r.rounds + 1;
+    let pass = run_pass(&model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
+    let Some(last) = pass.run.records.last() else {
+        return Ok(());
+    };
+    let gain = 2.0 * (pass.stats.loglik - r.pass.stats.loglik);
+    let value = |name: &str| {
+        let t = common::TERMS.iter().position(|x| x.name == name)?;
+        let i = model.index_of(name)?;
+        let k = 1.0 / common::TERMS[t].display_to_si;
+        Some((last.x[i] * k, last.sigma[i] * k))
+    };
+    let beside: Vec<String> = taken
+        .iter()
+        .filter_map(|&t| {
+            let info = &common::TERMS[t];
+            let (x, sd) = value(info.name)?;
+            Some(format!(
+                "{} {} ± {} {}",
+                info.name,
+                sig3(x),
+                sig3(sd),
+                info.display
+            ))
+        })
+        .collect();
+    for k in causes {
+        let f = &mut findings[k];
+        let Some((x, sd)) = value(&f.term) else {
+            continue;
+        };
+        let moved = (x - f.estimate).abs() / f.sigma;
+        if !(f.sigma > 0.0 && moved > 3.0) {
+            continue;
+        }
+        let why = format!(
+            "the candidates significant alone that it takes up, fitted beside it ({}), move it to {} ± {} {}, {} of its σ from this value (the fit changes by 2Δℓ {}): the data do not fix its value on this excitation; one that excites these terms apart decides",
+            beside.join(", "),
+            sig3(x),
+            sig3(sd),
+            f.unit,
+            sig3(moved),
+            sig3(gain)
+        );
+        f.words.push_str(&format!(". Not named as a cause: {why}"));
+        f.not_attributed = Some(match f.not_attributed.take() {
+            Some(w) => format!("{w}; {why}"),
+            None => why,
+        });
+    }
+    Ok(())
+}
+
+/// The sensor of the library term `name`, if it is one.
+fn term_sensor(name: &str) -> Option<Sensor> {
+    common::TERMS
+        .iter()
+        .find(|t| t.name == name)
+        .map(|t| t.sensor)
 }
 
 /// The names of the stand-ins among `judged` (one finding per named term of `r`) and of the
