@@ -72,15 +72,25 @@ pub fn truth_disagreement(disagreement: &[Vec<(f64, f64)>; 3], measured: &str) -
 pub fn attitude_disagreement(run: &FilterRun, phi: [Option<usize>; 3]) -> [Vec<(f64, f64)>; 3] {
     let mut out: [Vec<(f64, f64)>; 3] = Default::default();
     for r in &run.records {
-        let Some(p) = r.phi_true else { continue };
-        let e = r.phi_est - p;
-        for (k, i) in phi.iter().enumerate() {
-            if let Some(i) = *i {
-                out[k].push((e[k].abs(), e[k].abs() / r.sigma[i]));
-            }
-        }
+        add_attitude_disagreement(&mut out, r, phi);
     }
     out
+}
+
+/// Adds record `r`'s |e| [rad] and |e| / σ per axis to `acc` when it has truth (a streamed run
+/// collects them record by record); `phi` the model's indices of phi_n, phi_e, phi_d.
+pub fn add_attitude_disagreement(
+    acc: &mut [Vec<(f64, f64)>; 3],
+    r: &super::filter::Record,
+    phi: [Option<usize>; 3],
+) {
+    let Some(p) = r.phi_true else { return };
+    let e = r.phi_est - p;
+    for (k, i) in phi.iter().enumerate() {
+        if let Some(i) = *i {
+            acc[k].push((e[k].abs(), e[k].abs() / r.sigma[i]));
+        }
+    }
 }
 
 /// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.

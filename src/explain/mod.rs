@@ -581,7 +581,7 @@ fn companions_move(
         .iter()
         .filter(|c| c.testable && c.confounded_with.is_none() && c.p_holm <= ctx.opts.alpha)
         .filter(|c| !known(&c.term))
-        .filter_map(|c| common::TERMS.iter().position(|t| t.name == c.term))
+        .filter_map(|c| term_index(&c.term))
         .filter(|&t| !r.model.states.contains(&StateRef::Term(t)))
         .filter(|&t| {
             causes
@@ -611,7 +611,7 @@ fn companions_move(
     };
     let gain = 2.0 * (pass.stats.loglik - r.pass.stats.loglik);
     let value = |name: &str| {
-        let t = common::TERMS.iter().position(|x| x.name == name)?;
+        let t = term_index(name)?;
         let i = model.index_of(name)?;
         let k = 1.0 / common::TERMS[t].display_to_si;
         Some((last.x[i] * k, last.sigma[i] * k))
@@ -648,21 +648,25 @@ fn companions_move(
             sig3(moved),
             sig3(gain)
         );
-        f.words.push_str(&format!(". Not named as a cause: {why}"));
-        f.not_attributed = Some(match f.not_attributed.take() {
-            Some(w) => format!("{w}; {why}"),
-            None => why,
-        });
+        not_named(f, why);
     }
     Ok(())
 }
 
+/// The index in `common::TERMS` of the term `name`, if it is one.
+fn term_index(name: &str) -> Option<usize> {
+    common::TERMS.iter().position(|t| t.name == name)
+}
+
 /// The sensor of the library term `name`, if it is one.
 fn term_sensor(name: &str) -> Option<Sensor> {
-    common::TERMS
-        .iter()
-        .find(|t| t.name == name)
-        .map(|t| t.sensor)
+    term_index(name).map(|t| common::TERMS[t].sensor)
+}
+
+/// Cause `f` is no longer named: `why` joins its reasons and ends its words.
+fn not_named(f: &mut Finding, why: String) {
+    f.words.push_str(&format!(". Not named as a cause: {why}"));
+    f.not_attributed = joined(f.not_attributed.take(), Some(why));
 }
 
 /// The names of the stand-ins among `judged` (one finding per named term of `r`) and of the
@@ -690,10 +694,9 @@ fn mark_passed_over(
     passed_over: &[(usize, f64, f64)],
 ) {
     for f in findings.iter_mut().filter(|f| f.is_cause()) {
-        let Some(t) = common::TERMS.iter().position(|x| x.name == f.term) else {
+        let Some(sensor) = term_sensor(&f.term) else {
             continue;
         };
-        let sensor = common::TERMS[t].sensor;
         let beside: Vec<String> = passed_over
             .iter()
             .filter(|p| common::TERMS[p.0].sensor == sensor)
@@ -718,8 +721,7 @@ fn mark_passed_over(
             beside.join(", "),
             withheld.join(",")
         );
-        f.words.push_str(&format!(". Not named as a cause: {why}"));
-        f.not_attributed = Some(why);
+        not_named(f, why);
     }
 }
 

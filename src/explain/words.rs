@@ -468,17 +468,20 @@ fn time_reference(e: &Explanation) -> f64 {
     }
 }
 
+/// Channel `ch`'s Ljung–Box p after Bonferroni over `channels` channels, when it fails at 0.01.
+fn correlated_p(ch: &super::diagnostics::ChannelStats, channels: usize) -> Option<f64> {
+    ch.whiteness_p
+        .map(|p| (p * channels as f64).min(1.0))
+        .filter(|p| *p <= 0.01)
+}
+
 /// The summary's lines on where the baseline misfits the data (innovations too large, correlated
 /// or too small), or that it is consistent; times from `t_ref` [s].
 fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
     let mut consistent = true;
     for ch in &e.baseline.channels {
         let too_large = ch.nis_mean > ch.nis_band[1] * 1.5;
-        // Ljung–Box p after Bonferroni over the channels, when it fails at 0.01
-        let correlated = ch
-            .whiteness_p
-            .map(|p| (p * e.baseline.channels.len() as f64).min(1.0))
-            .filter(|p| *p <= 0.01);
+        let correlated = correlated_p(ch, e.baseline.channels.len());
         if !too_large && correlated.is_none() {
             continue;
         }
@@ -549,9 +552,7 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
     }
     for ch in &e.baseline.channels {
         // (a correlated one was said above, with why it is correlated)
-        let said = ch
-            .whiteness_p
-            .is_some_and(|p| p * e.baseline.channels.len() as f64 <= 0.01);
+        let said = correlated_p(ch, e.baseline.channels.len()).is_some();
         if ch.nis_mean < 0.5 * ch.nis_band[0] && !said {
             consistent = false;
             out.push(format!(

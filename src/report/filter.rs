@@ -85,11 +85,11 @@ impl EpochFiles {
         if let (Some(f), Some(p)) = (self.model_error.as_mut(), r.phi_true) {
             let e = r.phi_est - p;
             e_ne = Some([e.x, e.y]);
-            for (k, i) in self.phi.iter().enumerate() {
-                if let Some(i) = *i {
-                    self.disagreement[k].push((e[k].abs(), e[k].abs() / r.sigma[i]));
-                }
-            }
+            crate::estimate::metrics::add_attitude_disagreement(
+                &mut self.disagreement,
+                r,
+                self.phi,
+            );
             writeln!(
                 f.writer(),
                 "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} {:.4}",
