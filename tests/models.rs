@@ -168,8 +168,11 @@ fn measurement_support_follows_the_states() {
         .fill_h("pos_h", &random_point(&mut Rng(3)).0, &mut h)
         .unwrap_err();
     assert!(e.to_string().contains("needs state `dh`"), "{e}");
+    // with the vertical channel: the height, and a body-frame velocity reference (its rows
+    // reference dv_d)
     let v = Model::parse("P31+vertical").unwrap();
-    assert_eq!(v.measurements().len(), 3);
+    let names: Vec<_> = v.measurements().iter().map(|x| x.name).collect();
+    assert_eq!(names, ["vel_ne", "pos_ne", "pos_h", "vel_body"]);
 }
 
 /// Generated sparse kernel, run-time sparse propagation and dense Φ P Φᵀ + Q agree.

@@ -85,6 +85,7 @@ fn mems_drive_mounting_and_noise_identification() {
                     p.sigma_neu[2].max(0.05),
                 ],
             )),
+            body_vel: None,
         })
         .collect();
     let base = || {

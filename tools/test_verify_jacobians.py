@@ -81,6 +81,14 @@ class MisprintsAreCaught(unittest.TestCase):
         self.assertEqual(code, 1, f"reversed delay not caught:\n{out}")
         self.assertIn("][tau_y]:", out, f"wrong entry named:\n{out}")
 
+    def test_reversed_reference_mounting_is_named_in_h(self):
+        self.check_fails(12, "P13+vertical+mount_z", "H[vel_body][1][mount_z]")
+
+    def test_body_velocity_attitude_convention_is_checked(self):
+        code, out = run("--corrupt", "13", "--models", "P13+vertical")
+        self.assertEqual(code, 1, f"reversed attitude convention not caught:\n{out}")
+        self.assertIn("H[vel_body]", out, f"wrong entry named:\n{out}")
+
     def test_every_spec_term_is_checked_by_default(self):
         models = vj.default_models()
         named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}

@@ -179,6 +179,13 @@ GNSS_PHYSICS = {
 }
 
 
+# Velocity-reference terms, written independently of the spec: the reference (odometer, DVL)
+# measures the velocity in its own frame r, whose attitude against the IMU body frame is the
+# rotation of roll, pitch, yaw (mount_x, mount_y, mount_z): C_r^b = dcm_from_euler(mount), and
+# it reads v^r = (C_r^b)^T v^b.
+REFERENCE_PHYSICS = {"mount_x": 0, "mount_y": 1, "mount_z": 2}
+
+
 def load_spec_terms(spec_dir=SPEC_DIR):
     """Every term of the spec as name -> (sensor, axis index, regressor function), the library
     names, and the presets (name -> state list, `base` + `terms` resolved)."""
@@ -194,6 +201,16 @@ def load_spec_terms(spec_dir=SPEC_DIR):
                     f"GNSS term `{name}` is unknown to the checker's independent measurement model "
                     f"(it knows {' '.join(sorted(GNSS_PHYSICS))}): write its physics in GNSS_PHYSICS")
             terms[name] = ("gnss", None, None)
+            if t.get("library", False):
+                library.append(name)
+            continue
+        if t["sensor"] == "reference":
+            # a velocity reference's term: its physics is REFERENCE_PHYSICS, never the spec's H
+            if name not in REFERENCE_PHYSICS:
+                raise SpecTranslationError(
+                    f"reference term `{name}` is unknown to the checker's independent measurement model "
+                    f"(it knows {' '.join(sorted(REFERENCE_PHYSICS))}): write its physics in REFERENCE_PHYSICS")
+            terms[name] = ("reference", None, None)
             if t.get("library", False):
                 library.append(name)
             continue
@@ -228,9 +245,10 @@ except (SpecTranslationError, OSError, KeyError, tomllib.TOMLDecodeError) as _e:
 NAV = ["phi_n", "phi_e", "phi_d", "dv_n", "dv_e", "dv_d", "dlat", "dlon", "dh"]
 TERM_NAMES = list(TERMS)
 ALL_STATES = NAV + TERM_NAMES
-# the measurements, written independently: z = [dv_n, dv_e, dp_n, dp_e, dp_u]
-MEAS_ROWS = {"vel_ne": [0, 1], "pos_ne": [2, 3], "pos_h": [4]}
-MEAS_STATES = {"vel_ne": ["dv_n", "dv_e"], "pos_ne": ["dlat", "dlon"], "pos_h": ["dh"]}
+# the measurements, written independently: z = [dv_n, dv_e, dp_n, dp_e, dp_u, dvb_x, dvb_y, dvb_z]
+MEAS_ROWS = {"vel_ne": [0, 1], "pos_ne": [2, 3], "pos_h": [4], "vel_body": [5, 6, 7]}
+MEAS_STATES = {"vel_ne": ["dv_n", "dv_e"], "pos_ne": ["dlat", "dlon"], "pos_h": ["dh"],
+               "vel_body": ["phi_n", "dv_n", "dv_d"]}
 
 # ---------------------------------------------------------------- the nonlinear error dynamics
 def build_jacobian_function():
@@ -268,7 +286,7 @@ def build_jacobian_function():
     df = [0, 0, 0]
     for k, name in enumerate(TERM_NAMES):
         sensor, axis, reg = TERMS[name]
-        if sensor == "gnss":
+        if sensor in ("gnss", "reference"):
             continue
         if isinstance(reg, tuple) and reg[0] == "delay":
             # the accelerometer reads the signal of theta earlier
@@ -314,11 +332,20 @@ def build_jacobian_function():
     arm = ca.vertcat(*lever)
     c_arm = c @ arm
     v_arm = c @ ca.cross(w_b, arm)
+    # the velocity reference: computed body velocity (C~^T (v + dv)) minus its reading
+    mount = [0, 0, 0]
+    for k, name in enumerate(TERM_NAMES):
+        if TERMS[name][0] == "reference":
+            mount[REFERENCE_PHYSICS[name]] = mount[REFERENCE_PHYSICS[name]] + theta[k]
+    c_rb = dcm_from_euler(mount[0], mount[1], mount[2])
+    v_b = c.T @ v
+    z_body = c_tilde.T @ (v + dv) - c_rb.T @ v_b
     z = ca.vertcat(dv[0] - dt * vd_t[0] - v_arm[0],
                    dv[1] - dt * vd_t[1] - v_arm[1],
                    (rm0 + h) * (dlat - dt * latd_t) - c_arm[0],
                    (rn0 + h) * ca.cos(lat) * (dlon - dt * lond_t) - c_arm[1],
-                   dh - dt * hd_t + c_arm[2])
+                   dh - dt * hd_t + c_arm[2],
+                   z_body)
     jac_h = ca.jacobian(z, x)
     x0 = ca.DM.zeros(len(ALL_STATES))
     fun = ca.Function("sins_error_jacobian", [p, x], [jac, jac_h])
@@ -366,6 +393,15 @@ def corrupt(kind, out, pt):
         # a lever arm's velocity rows with the cross product reversed (l x w for w x l)
         col = idx["lever_y"]
         out["h"]["vel_ne"][0][col] = -out["h"]["vel_ne"][0][col]
+    elif kind == 12 and "vel_body" in out["h"] and "mount_z" in idx:
+        # a mounting's H with the sign reversed (the reference's yaw taken the other way)
+        col = idx["mount_z"]
+        out["h"]["vel_body"][1][col] = -out["h"]["vel_body"][1][col]
+    elif kind == 13 and "vel_body" in out["h"]:
+        # the attitude error entered with C~ = (I + [phi x]) C, the opposite convention
+        for r in range(3):
+            for s in ("phi_n", "phi_e", "phi_d"):
+                out["h"]["vel_body"][r][idx[s]] = -out["h"]["vel_body"][r][idx[s]]
     elif kind == 11 and "tau_y" in idx:
         # an accelerometer delay with its sign reversed (a lead taken for a lag)
         for k, row in enumerate(["dv_n", "dv_e", "dv_d"]):
@@ -534,7 +570,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed; the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed, 12: a reference mounting's yaw reversed in H[vel_body], 13: the attitude error's sign reversed in H[vel_body]; the check must fail")
     args = ap.parse_args()
 
     models = args.models or default_models()

@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 64;
+pub const TERM_COUNT: usize = 67;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -1099,6 +1099,51 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         doc: "GNSS antenna lever arm along body z (down)",
         library: true,
     },
+    TermInfo {
+        name: "mount_x",
+        sensor: Sensor::Reference,
+        axis: 0,
+        regressor: 0,
+        unit: "rad",
+        display: "deg",
+        display_to_si: 0.017453292519943295,
+        sigma: 0.017453292519943295,
+        noise: 0.0,
+        limit: 0.17453292519943295,
+        group: "reference mounting",
+        doc: "velocity reference mounting roll against the IMU body frame (small angle)",
+        library: true,
+    },
+    TermInfo {
+        name: "mount_y",
+        sensor: Sensor::Reference,
+        axis: 0,
+        regressor: 0,
+        unit: "rad",
+        display: "deg",
+        display_to_si: 0.017453292519943295,
+        sigma: 0.017453292519943295,
+        noise: 0.0,
+        limit: 0.17453292519943295,
+        group: "reference mounting",
+        doc: "velocity reference mounting pitch against the IMU body frame (small angle)",
+        library: true,
+    },
+    TermInfo {
+        name: "mount_z",
+        sensor: Sensor::Reference,
+        axis: 0,
+        regressor: 0,
+        unit: "rad",
+        display: "deg",
+        display_to_si: 0.017453292519943295,
+        sigma: 0.017453292519943295,
+        noise: 0.0,
+        limit: 0.17453292519943295,
+        group: "reference mounting",
+        doc: "velocity reference mounting yaw against the IMU body frame (small angle)",
+        library: true,
+    },
 ];
 
 /// Structural non-zeros of the full navigation block.
@@ -1207,6 +1252,9 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[],
+    &[],
+    &[],
     &[],
     &[],
     &[],
@@ -1387,6 +1435,9 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             1.0,
             1.0,
             1.0,
+            0.017453292519943295,
+            0.017453292519943295,
+            0.017453292519943295,
         ],
     },
     GradeInfo {
@@ -1472,12 +1523,15 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             1.0,
             1.0,
             1.0,
+            0.017453292519943295,
+            0.017453292519943295,
+            0.017453292519943295,
         ],
     },
 ];
 
 /// Number of measurement types.
-pub const MEASUREMENT_COUNT: usize = 3;
+pub const MEASUREMENT_COUNT: usize = 4;
 
 /// Measurement types.
 pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
@@ -1527,6 +1581,27 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
             },
         ],
         states: &["dh"],
+    },
+    MeasurementInfo {
+        name: "vel_body",
+        doc: "body-frame (FRD) velocity error against a velocity reference (odometer, DVL), m/s",
+        sigma: 0.1,
+        aiding: Aiding::BodyVelocity,
+        rows: &[
+            MeasRowInfo {
+                name: "dvb_x",
+                unit: "m/s",
+            },
+            MeasRowInfo {
+                name: "dvb_y",
+                unit: "m/s",
+            },
+            MeasRowInfo {
+                name: "dvb_z",
+                unit: "m/s",
+            },
+        ],
+        states: &["dv_d", "dv_e", "dv_n", "phi_d", "phi_e", "phi_n"],
     },
 ];
 
@@ -2343,6 +2418,15 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
         63 => {
             // lever_z: Gnss x axis, regressor 1
         }
+        64 => {
+            // mount_x: Reference x axis, regressor 1
+        }
+        65 => {
+            // mount_y: Reference x axis, regressor 1
+        }
+        66 => {
+            // mount_z: Reference x axis, regressor 1
+        }
         _ => panic!("term index {term} out of range"),
     }
 }
@@ -2385,6 +2469,29 @@ pub fn residual(
             // dp_u: h - aid.h [m], 1-σ aid.sigma_d
             z[0] = h - aid.h;
             sigma[0] = aid.sigma_d;
+        }
+        3 => {
+            let vn = s.vn;
+            let ve = s.ve;
+            let vd = s.vd;
+            let c11 = s.c11;
+            let c12 = s.c12;
+            let c13 = s.c13;
+            let c21 = s.c21;
+            let c22 = s.c22;
+            let c23 = s.c23;
+            let c31 = s.c31;
+            let c32 = s.c32;
+            let c33 = s.c33;
+            // dvb_x: c11 * vn + c21 * ve + c31 * vd - aid.vx [m/s], 1-σ aid.sigma_b
+            z[0] = c11 * vn + c21 * ve + c31 * vd - aid.vx;
+            sigma[0] = aid.sigma_b;
+            // dvb_y: c12 * vn + c22 * ve + c32 * vd - aid.vy [m/s], 1-σ aid.sigma_b
+            z[1] = c12 * vn + c22 * ve + c32 * vd - aid.vy;
+            sigma[1] = aid.sigma_b;
+            // dvb_z: c13 * vn + c23 * ve + c33 * vd - aid.vz [m/s], 1-σ aid.sigma_b
+            z[2] = c13 * vn + c23 * ve + c33 * vd - aid.vz;
+            sigma[2] = aid.sigma_b;
         }
         _ => panic!("measurement index {m} out of range"),
     }
@@ -2453,6 +2560,44 @@ pub fn measurement_entries(
             emit(0, "lever_x", c31);
             emit(0, "lever_y", c32);
             emit(0, "lever_z", c33);
+        }
+        3 => {
+            let vn = nav.v_ned[0];
+            let ve = nav.v_ned[1];
+            let vd = nav.v_ned[2];
+            let c11 = nav.c[0][0];
+            let c12 = nav.c[0][1];
+            let c13 = nav.c[0][2];
+            let c21 = nav.c[1][0];
+            let c22 = nav.c[1][1];
+            let c23 = nav.c[1][2];
+            let c31 = nav.c[2][0];
+            let c32 = nav.c[2][1];
+            let c33 = nav.c[2][2];
+            emit(0, "phi_n", c31 * ve - c21 * vd);
+            emit(0, "phi_e", c11 * vd - c31 * vn);
+            emit(0, "phi_d", c21 * vn - c11 * ve);
+            emit(0, "dv_n", c11);
+            emit(0, "dv_e", c21);
+            emit(0, "dv_d", c31);
+            emit(0, "mount_y", c13 * vn + c23 * ve + c33 * vd);
+            emit(0, "mount_z", -(c12 * vn + c22 * ve + c32 * vd));
+            emit(1, "phi_n", c32 * ve - c22 * vd);
+            emit(1, "phi_e", c12 * vd - c32 * vn);
+            emit(1, "phi_d", c22 * vn - c12 * ve);
+            emit(1, "dv_n", c12);
+            emit(1, "dv_e", c22);
+            emit(1, "dv_d", c32);
+            emit(1, "mount_x", -(c13 * vn + c23 * ve + c33 * vd));
+            emit(1, "mount_z", c11 * vn + c21 * ve + c31 * vd);
+            emit(2, "phi_n", c33 * ve - c23 * vd);
+            emit(2, "phi_e", c13 * vd - c33 * vn);
+            emit(2, "phi_d", c23 * vn - c13 * ve);
+            emit(2, "dv_n", c13);
+            emit(2, "dv_e", c23);
+            emit(2, "dv_d", c33);
+            emit(2, "mount_x", c12 * vn + c22 * ve + c32 * vd);
+            emit(2, "mount_y", -(c11 * vn + c21 * ve + c31 * vd));
         }
         _ => panic!("measurement index {m} out of range"),
     }

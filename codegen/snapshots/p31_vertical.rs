@@ -310,7 +310,7 @@ pub const A_PATTERN: [(usize, usize); A_NNZ] = [
 ];
 
 /// Measurements this model supports.
-pub const MEASUREMENTS: [&str; 3] = ["vel_ne", "pos_ne", "pos_h"];
+pub const MEASUREMENTS: [&str; 4] = ["vel_ne", "pos_ne", "pos_h", "vel_body"];
 
 /// Number of accumulated regressors.
 pub const NR: usize = 9;
@@ -598,6 +598,40 @@ pub fn fill_h_pos_h(_nav: &NavPoint, h: &mut [[f64; N]; 1]) {
     h[0][DH] = 1.0;
 }
 
+/// Writes the non-zeros of H for `vel_body`: body-frame (FRD) velocity error against a velocity reference (odometer, DVL), m/s.
+pub fn fill_h_vel_body(nav: &NavPoint, h: &mut [[f64; N]; 3]) {
+    let vn = nav.v_ned[0];
+    let ve = nav.v_ned[1];
+    let vd = nav.v_ned[2];
+    let c11 = nav.c[0][0];
+    let c12 = nav.c[0][1];
+    let c13 = nav.c[0][2];
+    let c21 = nav.c[1][0];
+    let c22 = nav.c[1][1];
+    let c23 = nav.c[1][2];
+    let c31 = nav.c[2][0];
+    let c32 = nav.c[2][1];
+    let c33 = nav.c[2][2];
+    h[0][PHI_N] = c31 * ve - c21 * vd;
+    h[0][PHI_E] = c11 * vd - c31 * vn;
+    h[0][PHI_D] = c21 * vn - c11 * ve;
+    h[0][DV_N] = c11;
+    h[0][DV_E] = c21;
+    h[0][DV_D] = c31;
+    h[1][PHI_N] = c32 * ve - c22 * vd;
+    h[1][PHI_E] = c12 * vd - c32 * vn;
+    h[1][PHI_D] = c22 * vn - c12 * ve;
+    h[1][DV_N] = c12;
+    h[1][DV_E] = c22;
+    h[1][DV_D] = c32;
+    h[2][PHI_N] = c33 * ve - c23 * vd;
+    h[2][PHI_E] = c13 * vd - c33 * vn;
+    h[2][PHI_D] = c23 * vn - c13 * ve;
+    h[2][DV_N] = c13;
+    h[2][DV_E] = c23;
+    h[2][DV_D] = c33;
+}
+
 /// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
 pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
     if name == "vel_ne" {
@@ -619,6 +653,14 @@ pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
     if name == "pos_h" {
         let mut m = [[0.0; N]; 1];
         fill_h_pos_h(nav, &mut m);
+        for (i, row) in m.iter().enumerate() {
+            h[i * N..(i + 1) * N].copy_from_slice(row);
+        }
+        return true;
+    }
+    if name == "vel_body" {
+        let mut m = [[0.0; N]; 3];
+        fill_h_vel_body(nav, &mut m);
         for (i, row) in m.iter().enumerate() {
             h[i * N..(i + 1) * N].copy_from_slice(row);
         }

@@ -234,6 +234,7 @@ fn common_terms(spec: &Spec) -> TokenStream {
             Sensor::Gyro => quote!(Sensor::Gyro),
             Sensor::Accel => quote!(Sensor::Accel),
             Sensor::Gnss => quote!(Sensor::Gnss),
+            Sensor::Reference => quote!(Sensor::Reference),
         };
         let axis = t.axis;
         let reg = t.regressor;
@@ -269,7 +270,7 @@ fn common_patterns(spec: &Spec, nav_entries: &[SymEntry]) -> TokenStream {
         let rows: &[usize] = match t.sensor {
             Sensor::Gyro => &spec.compose.gyro_rows,
             Sensor::Accel => &spec.compose.accel_rows,
-            Sensor::Gnss => &[],
+            Sensor::Gnss | Sensor::Reference => &[],
         };
         let rows = rows.iter().map(|r| const_name(&spec.nav_states[*r].name));
         quote!(&[#(#rows),*])
@@ -355,6 +356,7 @@ fn common_measurements(spec: &Spec) -> TokenStream {
         let aiding = match m.aiding {
             crate::spec::Aiding::Position => quote!(Aiding::Position),
             crate::spec::Aiding::Velocity => quote!(Aiding::Velocity),
+            crate::spec::Aiding::BodyVelocity => quote!(Aiding::BodyVelocity),
         };
         quote!(MeasurementInfo { name: #name, doc: #doc, sigma: #sigma, aiding: #aiding, rows: &[#(#rows),*], states: &[#(#states),*] })
     });

@@ -77,7 +77,7 @@ fn nav_symbol_dim(name: &str) -> Option<crate::units::Dim> {
 
 /// Navigation-state quantities a measurement residual may use: the filter's state at the fix
 /// time (SI units), with the WGS-84 radii at that state.
-pub const RESIDUAL_STATE_SYMBOLS: [(&str, &str); 8] = [
+pub const RESIDUAL_STATE_SYMBOLS: [(&str, &str); 17] = [
     ("lat", "geodetic latitude [rad]"),
     ("lon", "longitude [rad]"),
     ("h", "height above the ellipsoid, up [m]"),
@@ -86,6 +86,15 @@ pub const RESIDUAL_STATE_SYMBOLS: [(&str, &str); 8] = [
     ("vd", "down velocity [m/s]"),
     ("rm", "R_M + h at the state [m]"),
     ("rn", "R_N + h at the state [m]"),
+    ("c11", "C_b^n element (1, 1) at the state"),
+    ("c12", "C_b^n element (1, 2)"),
+    ("c13", "C_b^n element (1, 3)"),
+    ("c21", "C_b^n element (2, 1)"),
+    ("c22", "C_b^n element (2, 2)"),
+    ("c23", "C_b^n element (2, 3)"),
+    ("c31", "C_b^n element (3, 1)"),
+    ("c32", "C_b^n element (3, 2)"),
+    ("c33", "C_b^n element (3, 3)"),
 ];
 
 /// Fields of the aiding record a residual may use (`aid.lat`, …): what a position fix gives and
@@ -93,6 +102,9 @@ pub const RESIDUAL_STATE_SYMBOLS: [(&str, &str); 8] = [
 pub const AID_POSITION_FIELDS: [&str; 6] = ["lat", "lon", "h", "sigma_n", "sigma_e", "sigma_d"];
 /// Fields of a velocity fix (`aid.vn`, …; one 1-σ for every component).
 pub const AID_VELOCITY_FIELDS: [&str; 4] = ["vn", "ve", "vd", "sigma_v"];
+/// Fields of a body-frame velocity fix from a reference (odometer, DVL; `aid.vx`, …; one 1-σ
+/// for every component).
+pub const AID_BODY_VELOCITY_FIELDS: [&str; 4] = ["vx", "vy", "vz", "sigma_b"];
 
 /// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s],
 /// `dw.x dw.y dw.z` [rad/s²] (angular acceleration) and `df.x df.y df.z` [m/s³] (the specific
@@ -418,14 +430,16 @@ fn check_field(f: &syn::ExprField, kind: ExprKind) -> Result<(), String> {
     };
     let ok_member = matches!(member.as_str(), "x" | "y" | "z");
     let aid_field = AID_POSITION_FIELDS.contains(&member.as_str())
-        || AID_VELOCITY_FIELDS.contains(&member.as_str());
+        || AID_VELOCITY_FIELDS.contains(&member.as_str())
+        || AID_BODY_VELOCITY_FIELDS.contains(&member.as_str());
     match (kind, base.as_deref()) {
         (ExprKind::Residual, Some("aid")) if aid_field => Ok(()),
         (ExprKind::Residual, _) => Err(format!(
-            "unknown field `{}` (the aiding record has aid.{} and aid.{})",
+            "unknown field `{}` (the aiding record has aid.{}, aid.{} and aid.{})",
             f.to_token_stream().to_string().replace(' ', ""),
             AID_POSITION_FIELDS.join(" aid."),
-            AID_VELOCITY_FIELDS.join(" aid.")
+            AID_VELOCITY_FIELDS.join(" aid."),
+            AID_BODY_VELOCITY_FIELDS.join(" aid.")
         )),
         (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
         (ExprKind::Regressor, _) => Err(format!(

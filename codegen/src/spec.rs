@@ -60,6 +60,16 @@ pub enum Sensor {
     /// GNSS aiding: the term enters the measurements (its H entries), not A — a time offset,
     /// an antenna lever arm.
     Gnss,
+    /// A body-frame velocity reference (odometer, DVL): the term enters its measurement (its H
+    /// entries), not A — a mounting misalignment.
+    Reference,
+}
+
+impl Sensor {
+    /// The term enters the measurements (its `h` entries), not A.
+    pub fn enters_h(self) -> bool {
+        matches!(self, Sensor::Gnss | Sensor::Reference)
+    }
 }
 
 /// A navigation error state (attitude, velocity, position).
@@ -181,6 +191,9 @@ pub enum Aiding {
     Position,
     /// A velocity fix (`aid.vn`, `aid.ve`, `aid.vd`, `aid.sigma_v`).
     Velocity,
+    /// A body-frame (FRD) velocity from a reference: odometer, DVL (`aid.vx`, `aid.vy`,
+    /// `aid.vz`, `aid.sigma_b`).
+    BodyVelocity,
 }
 
 /// A measurement type (`vel_ne`, `pos_ne`, `pos_h`).
@@ -758,7 +771,7 @@ fn load_term(
         .map_err(|e| src.error(t.unit.span(), &item, format!("unit: {e}")))?;
     let axis = term_axis(src, t, &item, sensor)?;
     let (rexpr, h) = match sensor {
-        Sensor::Gnss => gnss_term_h(src, t, &item)?,
+        Sensor::Gnss | Sensor::Reference => gnss_term_h(src, t, &item)?,
         _ => (
             sensor_term_regressor(src, t, &item, sensor, unit.dim)?,
             Vec::new(),
@@ -795,10 +808,11 @@ fn term_sensor(src: &Source, t: &RawTerm, item: &str) -> Result<Sensor, SpecErro
         "gyro" => Ok(Sensor::Gyro),
         "accel" => Ok(Sensor::Accel),
         "gnss" => Ok(Sensor::Gnss),
+        "reference" => Ok(Sensor::Reference),
         other => Err(src.error(
             t.sensor.span(),
             item,
-            format!("unknown sensor `{other}` (expected `gyro`, `accel` or `gnss`)"),
+            format!("unknown sensor `{other}` (expected `gyro`, `accel`, `gnss` or `reference`)"),
         )),
     }
 }
@@ -806,7 +820,7 @@ fn term_sensor(src: &Source, t: &RawTerm, item: &str) -> Result<Sensor, SpecErro
 /// The term's sensing `axis` (0 = x, 1 = y, 2 = z); required except for a GNSS term (0).
 fn term_axis(src: &Source, t: &RawTerm, item: &str, sensor: Sensor) -> Result<usize, SpecError> {
     match &t.axis {
-        None if sensor == Sensor::Gnss => Ok(0),
+        None if sensor.enters_h() => Ok(0),
         None => Err(src.error(
             t.name.span(),
             item,
@@ -948,14 +962,14 @@ fn gnss_term_h(
         return Err(src.error(
             r.span(),
             item,
-            "a `gnss` term enters the measurements, not A: remove `regressor` and give its `h` entries",
+            "a `gnss` or `reference` term enters the measurements, not A: remove `regressor` and give its `h` entries",
         ));
     }
     if t.h.is_empty() {
         return Err(src.error(
             t.name.span(),
             item,
-            "a `gnss` term needs `h = [{ row = \"dp_n\", expr = \"...\" }, ...]`: the measurement rows it enters",
+            "a `gnss` or `reference` term needs `h = [{ row = \"dp_n\", expr = \"...\" }, ...]`: the measurement rows it enters",
         ));
     }
     let mut h = Vec::new();
@@ -1046,7 +1060,7 @@ fn check_term_dimension(
     let (sensor_unit, sensor_name) = match sensor {
         Sensor::Gyro => ("rad/s", "a gyro error"),
         Sensor::Accel => ("m/s^2", "an accelerometer error"),
-        Sensor::Gnss => unreachable!("a gnss term has no regressor"),
+        Sensor::Gnss | Sensor::Reference => unreachable!("a gnss term has no regressor"),
     };
     let want = units::parse_unit(sensor_unit)
         .expect("sensor unit parses")
@@ -1094,11 +1108,12 @@ fn load_measurements(
         let aiding = match m.aiding.get_ref().as_str() {
             "position" => Aiding::Position,
             "velocity" => Aiding::Velocity,
+            "body_velocity" => Aiding::BodyVelocity,
             other => {
                 return Err(src.error(
                     m.aiding.span(),
                     &item,
-                    format!("aiding: unknown record `{other}` (expected `position` or `velocity`)"),
+                    format!("aiding: unknown record `{other}` (expected `position`, `velocity` or `body_velocity`)"),
                 ))
             }
         };
@@ -1156,6 +1171,7 @@ fn residual_expr(
     let (fields, record): (&[&str], &str) = match aiding {
         Aiding::Position => (&expr::AID_POSITION_FIELDS, "position"),
         Aiding::Velocity => (&expr::AID_VELOCITY_FIELDS, "velocity"),
+        Aiding::BodyVelocity => (&expr::AID_BODY_VELOCITY_FIELDS, "body velocity"),
     };
     for sym in e.symbols() {
         if let Some(f) = sym.strip_prefix("aid.") {

@@ -443,10 +443,10 @@ fn residual_errors_name_the_measurement_and_the_record() {
     expect_error(
         "measurements.toml",
         "aiding = \"velocity\"",
-        "aiding = \"odometer\"",
-        "odometer",
+        "aiding = \"sonar\"",
+        "sonar",
         "measurement `vel_ne`",
-        "unknown record `odometer`",
+        "unknown record `sonar`",
     );
     expect_error(
         "measurements.toml",

@@ -132,31 +132,49 @@ fn on_data(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
 }
 
 /// The candidates of a run on data: without GNSS aiding (a static aid or ZUPTs have no antenna
-/// and no receiver clock) the GNSS terms are dropped, and refused when named.
+/// and no receiver clock) the GNSS terms are dropped, without a velocity reference its mounting
+/// terms; either is refused when named.
 fn data_candidates(args: &ExplainArgs, baseline: &Model) -> Result<Vec<usize>> {
+    use sinsmodel::model::catalog::Sensor;
     let mut cands = explain::parse_candidates(args.candidates.as_deref(), baseline)
         .map_err(anyhow::Error::msg)?;
-    if !args.data.has_gnss() {
-        let gnss = explain_data::gnss_terms(&cands);
-        // (named by the user: a list of withholdings only starts from every term)
-        let named = args.candidates.as_deref().is_some_and(|c| {
-            c.split(',')
-                .map(str::trim)
-                .any(|i| !i.is_empty() && !i.starts_with('!'))
-        });
-        if named && !gnss.is_empty() {
-            bail!(
-                "--candidates: {} {} GNSS term{} (entering the fixes of a GNSS receiver); without --aid there is none",
-                gnss.join(", "),
-                if gnss.len() == 1 { "is a" } else { "are" },
-                if gnss.len() == 1 { "" } else { "s" }
-            );
+    // (named by the user: a list of withholdings only starts from every term)
+    let named = args.candidates.as_deref().is_some_and(|c| {
+        c.split(',')
+            .map(str::trim)
+            .any(|i| !i.is_empty() && !i.starts_with('!'))
+    });
+    let reference = args.data.body_velocity.is_some()
+        && baseline.measurements().iter().any(|m| m.name == "vel_body");
+    for (sensor, present, one, many, without) in [
+        (
+            Sensor::Gnss,
+            args.data.has_gnss(),
+            "is a GNSS term",
+            "are GNSS terms",
+            " (entering the fixes of a GNSS receiver); without --aid there is none",
+        ),
+        (
+            Sensor::Reference,
+            reference,
+            "is a mounting of a velocity reference",
+            "are mountings of a velocity reference",
+            "; without --body-velocity (and a +vertical baseline) there is none",
+        ),
+    ] {
+        let absent = explain_data::terms_of(&cands, sensor);
+        if present || absent.is_empty() {
+            continue;
         }
-        explain_data::drop_gnss(&mut cands);
+        if named {
+            let verb = if absent.len() == 1 { one } else { many };
+            bail!("--candidates: {} {verb}{without}", absent.join(", "));
+        }
+        explain_data::drop_sensor(&mut cands, sensor);
     }
     if cands.is_empty() {
         bail!(
-            "--candidates: no candidate is left to test (the baseline {} holds every term named, or only GNSS terms were named and there is no --aid)",
+            "--candidates: no candidate is left to test (the baseline {} holds every term named, or only GNSS or reference terms were named without their aiding)",
             baseline.name
         );
     }

@@ -148,7 +148,10 @@ fn filter_pass(
     files: &mut EpochFiles,
 ) -> Result<FilterRun> {
     let pb = progress::bar(1000, "filter");
-    let mut epochs = inputs.aid.epochs_outside(&inputs.outages);
+    let mut epochs = sinsmodel::data::aid::with_body_velocity(
+        inputs.aid.epochs_outside(&inputs.outages),
+        &inputs.body_velocity,
+    );
     let mut io = filter::StreamIo {
         samples: &mut inputs.imu,
         aiding: &mut epochs,

@@ -76,6 +76,7 @@ fn list_text() -> String {
                 common::REGRESSORS[t.regressor],
             ),
             sinsmodel::model::catalog::Sensor::Gnss => ("gnss", "-", "enters H"),
+            sinsmodel::model::catalog::Sensor::Reference => ("reference", "-", "enters H"),
         };
         s.push_str(&format!(
             "  {:<9} {} {}  <{}>  [{}]  sigma {} {}\n",

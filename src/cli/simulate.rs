@@ -59,6 +59,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             &header,
         )?;
     }
+    if let Some(bv) = &sim.body_velocity {
+        aiding::write_body_velocity(&out.file("reference.txt"), bv, &header)?;
+    }
     if args.mat {
         write_mat(&out, &sim)?;
     }
@@ -122,7 +125,7 @@ fn write_mat(out: &OutputDir, sim: &SimOutput) -> Result<()> {
 /// Prints what was simulated and where it went.
 fn print_summary(args: &SimulateArgs, sc: &Scenario, sim: &SimOutput) {
     eprintln!(
-        "simulated {} IMU samples ({:.1} s at {} Hz{}), {} truth rows, {} GNSS fixes{} into {}{}",
+        "simulated {} IMU samples ({:.1} s at {} Hz{}), {} truth rows, {} GNSS fixes{}{} into {}{}",
         sim.imu.samples.len(),
         sim.imu.duration(),
         sc.imu_rate_hz,
@@ -141,6 +144,10 @@ fn print_summary(args: &SimulateArgs, sc: &Scenario, sim: &SimOutput) {
         } else {
             ""
         },
+        sim.body_velocity
+            .as_ref()
+            .map(|b| format!(", {} body-velocity reference rows (reference.txt)", b.len()))
+            .unwrap_or_default(),
         args.out.display(),
         if args.mat {
             " (and data.mat: arrays imu and avp)"

@@ -3,7 +3,7 @@
 
 use super::DataOptions;
 use crate::estimate::filter::AidingEpoch;
-use crate::io::aiding::{self, PositionFix, VelocityFix};
+use crate::io::aiding::{self, BodyVelocityFix, PositionFix, VelocityFix};
 use anyhow::{bail, Result};
 use nalgebra::Vector3;
 use std::path::Path;
@@ -69,6 +69,7 @@ impl AidPlan {
             t,
             vel: zupt.map(|s| (Vector3::zeros(), s)),
             pos: Some((f.lat, f.lon, f.h, f.sigma)),
+            body_vel: None,
         };
         match self {
             AidPlan::Fixes(f, zupt, use_pos) => Box::new(f.iter().map(move |(p, v)| {
@@ -276,5 +277,53 @@ impl DataOptions {
             );
         }
         Ok(outages)
+    }
+}
+
+/// Aiding epochs in time order merged with the body-velocity reference's rows (time order): a
+/// row at an epoch's time (within 1 µs) joins that epoch, the others are epochs of their own.
+pub struct WithBodyVelocity<'a, I: Iterator<Item = AidingEpoch>> {
+    epochs: std::iter::Peekable<I>,
+    body: &'a [BodyVelocityFix],
+}
+
+/// `epochs` (time order) with the rows of `body` merged in ([`WithBodyVelocity`]).
+pub fn with_body_velocity<I: Iterator<Item = AidingEpoch>>(
+    epochs: I,
+    body: &[BodyVelocityFix],
+) -> WithBodyVelocity<'_, I> {
+    WithBodyVelocity {
+        epochs: epochs.peekable(),
+        body,
+    }
+}
+
+/// Times closer than this are one epoch [s].
+const SAME_EPOCH_S: f64 = 1e-6;
+
+impl<I: Iterator<Item = AidingEpoch>> Iterator for WithBodyVelocity<'_, I> {
+    type Item = AidingEpoch;
+    fn next(&mut self) -> Option<AidingEpoch> {
+        let row = |b: &BodyVelocityFix| Some((Vector3::from(b.v_frd), b.sigma));
+        match (self.epochs.peek().map(|e| e.t), self.body.first()) {
+            (None, None) => None,
+            (Some(_), None) => self.epochs.next(),
+            (Some(t), Some(b)) if t < b.t - SAME_EPOCH_S => self.epochs.next(),
+            (Some(t), Some(b)) if t <= b.t + SAME_EPOCH_S => {
+                let mut e = self.epochs.next()?;
+                e.body_vel = row(b);
+                self.body = &self.body[1..];
+                Some(e)
+            }
+            (_, Some(b)) => {
+                self.body = &self.body[1..];
+                Some(AidingEpoch {
+                    t: b.t,
+                    vel: None,
+                    pos: None,
+                    body_vel: row(b),
+                })
+            }
+        }
     }
 }

@@ -5,7 +5,7 @@
 use super::aid::{AidPlan, Outage};
 use super::DataOptions;
 use crate::estimate::filter::AidingEpoch;
-use crate::io::aiding::PositionFix;
+use crate::io::aiding::{BodyVelocityFix, PositionFix};
 use crate::io::imu_stream::ImuStream;
 use crate::io::truth::{self, TruthRow};
 use crate::nav::earth;
@@ -22,6 +22,8 @@ pub struct Dataset {
     pub imu: ImuStream,
     /// Aiding epochs after the start.
     pub aid: AidPlan,
+    /// Rows of the body-velocity reference after the start (`--body-velocity`), time order.
+    pub body_velocity: Vec<BodyVelocityFix>,
     /// Truth, read as the run advances.
     pub truth: Option<truth::TruthReader>,
     /// Initial navigation state.
@@ -131,9 +133,11 @@ impl DataOptions {
         check_fixes(&mut plan, imu.first_t(), note)?;
         let aid = plan.after(t0);
         check_outages_drop_fixes(&aid, &outages, imu.first_t())?;
+        let body_velocity = self.body_velocity_after(t0, &aid, note)?;
         Ok(Dataset {
             imu,
             aid,
+            body_velocity,
             truth: truth_reader,
             start: start.state,
             outages,
@@ -279,11 +283,12 @@ impl DataOptions {
             None => None,
         };
         let start = opened.start;
-        let aid: Vec<AidingEpoch> = opened
-            .aid
-            .epochs_outside(&opened.outages)
-            .take_while(|e| e.t <= t_last + 1e-9)
-            .collect();
+        let aid: Vec<AidingEpoch> = super::aid::with_body_velocity(
+            opened.aid.epochs_outside(&opened.outages),
+            &opened.body_velocity,
+        )
+        .take_while(|e| e.t <= t_last + 1e-9)
+        .collect();
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
         Ok(PassInputs {
             init_sigma: opened.init_sigma,
@@ -618,5 +623,105 @@ fn rest_witness(plan: &AidPlan) -> Option<crate::estimate::imu_check::RestWitnes
                     .collect(),
             ))
         }
+    }
+}
+
+impl DataOptions {
+    /// The `--body-velocity` rows after the start `t0` [s], checked against the data: some fall
+    /// after the start, and their speeds agree with the GNSS fixes' (`aid`) where both move.
+    fn body_velocity_after(
+        &self,
+        t0: f64,
+        aid: &AidPlan,
+        note: &mut dyn FnMut(&str),
+    ) -> Result<Vec<BodyVelocityFix>> {
+        let Some(path) = &self.body_velocity else {
+            return Ok(Vec::new());
+        };
+        let rows = crate::io::aiding::read_body_velocity(path)?;
+        let (first, last) = (rows[0].t, rows[rows.len() - 1].t);
+        let after: Vec<BodyVelocityFix> = rows.into_iter().filter(|r| r.t > t0).collect();
+        if after.len() < 10 {
+            bail!(
+                "--body-velocity {}: {} of its rows (t = {first:.3} to {last:.3} s) fall after the run's start at t = {t0:.3} s; at least 10 are needed (its times must be on the IMU's clock: UTC for GPST, or ms for s?)",
+                path.display(),
+                after.len()
+            );
+        }
+        if let AidPlan::Fixes(fixes, _, _) = aid {
+            match reference_speed_ratio(fixes, &after) {
+                Some(r) if !(0.8..=1.25).contains(&r) => bail!(
+                    "--body-velocity {}: its speeds are {r:.2}× those of the GNSS fixes in {} over the same times ({}); the columns must be m/s on the IMU's clock",
+                    path.display(),
+                    self.aid.as_deref().map_or("--aid".into(), |p| p.display().to_string()),
+                    speed_slip(r)
+                ),
+                Some(r) => note(&format!(
+                    "body-velocity reference: {} rows after the start; speed {r:.3}× the GNSS fixes' (median over moving fixes)",
+                    after.len()
+                )),
+                None => note(&format!(
+                    "body-velocity reference: {} rows after the start; its speeds not compared with the GNSS (fewer than 10 fix pairs moving faster than 1 m/s)",
+                    after.len()
+                )),
+            }
+        }
+        Ok(after)
+    }
+}
+
+/// The median ratio of the reference's speed to the GNSS speed (from consecutive fixes at most 2 s
+/// apart, both moving faster than 1 m/s) over the fix pairs a reference row falls between; None
+/// with fewer than 10 such pairs.
+fn reference_speed_ratio(
+    fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
+    body: &[BodyVelocityFix],
+) -> Option<f64> {
+    let mut ratios = Vec::new();
+    let mut j = 0;
+    for w in fixes.windows(2) {
+        let (a, b) = (&w[0].0, &w[1].0);
+        let dt = b.t - a.t;
+        if !(dt > 0.0 && dt <= 2.0) {
+            continue;
+        }
+        let gnss_speed =
+            horizontal_distance_m(a.lat, a.lon, a.h, b.lat, b.lon).hypot(b.h - a.h) / dt;
+        while j < body.len() && body[j].t < a.t {
+            j += 1;
+        }
+        let inside: Vec<f64> = body[j..]
+            .iter()
+            .take_while(|r| r.t <= b.t)
+            .map(|r| nalgebra::Vector3::from(r.v_frd).norm())
+            .collect();
+        if inside.is_empty() || gnss_speed < 1.0 {
+            continue;
+        }
+        let ref_speed = inside.iter().sum::<f64>() / inside.len() as f64;
+        if ref_speed > 1.0 {
+            ratios.push(ref_speed / gnss_speed);
+        }
+    }
+    if ratios.len() < 10 {
+        return None;
+    }
+    ratios.sort_by(f64::total_cmp);
+    Some(ratios[ratios.len() / 2])
+}
+
+/// The likely slip behind a reference speed `r` times the GNSS speed.
+fn speed_slip(r: f64) -> &'static str {
+    let near = |x: f64| (r / x - 1.0).abs() < 0.1;
+    if near(3.6) {
+        "3.6×: km/h written as m/s?"
+    } else if near(1.0 / 3.6) {
+        "1/3.6: m/s converted to km/h twice, or km/h divided where m/s was given?"
+    } else if near(2.237) {
+        "2.24×: mph written as m/s?"
+    } else if near(1.944) {
+        "1.94×: knots written as m/s?"
+    } else {
+        "a scale, a clock (UTC for GPST) or another vehicle's file?"
     }
 }

@@ -178,6 +178,11 @@ pub struct DataOptions {
         arg(long, value_delimiter = ',', allow_hyphen_values = true)
     )]
     pub lever_arm: Option<Vec<String>>,
+    /// Body-frame velocity reference (odometer with the non-holonomic constraint, DVL): a file
+    /// of `t vx vy vz sigma` (s on the IMU's clock; forward, right, down m/s; m/s), used as
+    /// the `vel_body` measurement (needs a model with +vertical).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub body_velocity: Option<PathBuf>,
 }
 
 impl DataOptions {
@@ -203,6 +208,7 @@ impl DataOptions {
             outage: Vec::new(),
             gnss_delay: None,
             lever_arm: None,
+            body_velocity: None,
         }
     }
 
@@ -224,6 +230,7 @@ impl DataOptions {
             || !self.outage.is_empty()
             || self.gnss_delay.is_some()
             || self.lever_arm.is_some()
+            || self.body_velocity.is_some()
     }
 
     /// True when the aiding comes from a GNSS file (`--aid`): GNSS terms (time offset, lever
@@ -240,6 +247,7 @@ impl DataOptions {
             &self.aid,
             &self.noise,
             &self.truth,
+            &self.body_velocity,
         ]
         .into_iter()
         .flatten()
@@ -259,6 +267,9 @@ impl DataOptions {
         }
         if let Some(v) = &self.static_aid {
             s.push_str(&format!(", static at {v:?}"));
+        }
+        if let Some(p) = &self.body_velocity {
+            s.push_str(&format!(", body-velocity reference {}", p.display()));
         }
         if let Some(p) = &self.truth {
             s.push_str(&format!(", truth {}", p.display()));

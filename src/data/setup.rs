@@ -306,6 +306,7 @@ impl DataOptions {
                 bail!("--model {}: {t} is a GNSS term (it enters the fixes of a GNSS receiver); without --aid there is none", model.name);
             }
         }
+        check_reference_terms(model, args)?;
         if !model.vertical {
             cfg.vertical = Vertical::Fixed;
         }
@@ -602,4 +603,28 @@ pub(super) fn prior_for<'a>(specs: &'a [String], name: &str) -> Result<Option<(&
         }
     }
     Ok(best.map(|(_, spec, value)| (spec, value)))
+}
+
+/// A model's velocity-reference terms (mounting) need `--body-velocity`, and a reference given
+/// needs a model that forms its measurement (`vel_body` rows reference dv_d: `+vertical`).
+fn check_reference_terms(model: &Model, args: &DataOptions) -> Result<()> {
+    use crate::model::catalog::{Sensor, StateRef};
+    let reference_term = model.states.iter().find_map(|s| match *s {
+        StateRef::Term(k) if common::TERMS[k].sensor == Sensor::Reference => {
+            Some(common::TERMS[k].name)
+        }
+        _ => None,
+    });
+    match (&args.body_velocity, reference_term) {
+        (None, Some(t)) => bail!(
+            "--model {}: {t} is a mounting of a velocity reference (it enters the body-frame velocity measurement); without --body-velocity there is none",
+            model.name
+        ),
+        (Some(p), _) if !model.measurements().iter().any(|m| m.name == "vel_body") => bail!(
+            "--body-velocity {}: model {} cannot use it: the body-frame velocity measurement needs the vertical channel (write the model with +vertical, e.g. P13+vertical)",
+            p.display(),
+            model.name
+        ),
+        _ => Ok(()),
+    }
 }

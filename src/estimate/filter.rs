@@ -225,6 +225,9 @@ pub struct AidingEpoch {
     pub vel: Option<(Vector3<f64>, f64)>,
     /// Latitude [rad], longitude [rad], height [m] and 1-σ north, east, down [m].
     pub pos: Option<(f64, f64, f64, [f64; 3])>,
+    /// Body-frame (FRD) velocity from a reference (odometer, DVL) [m/s] and its 1-σ per
+    /// component.
+    pub body_vel: Option<(Vector3<f64>, f64)>,
 }
 
 /// An innovation of one scalar measurement component.
@@ -412,7 +415,12 @@ pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>,
             let (v, sig) = ep.vel?;
             (aid.vn, aid.ve, aid.vd, aid.sigma_v) = (v.x, v.y, v.z, sig);
         }
+        Aiding::BodyVelocity => {
+            let (v, sig) = ep.body_vel?;
+            (aid.vx, aid.vy, aid.vz, aid.sigma_b) = (v.x, v.y, v.z, sig);
+        }
     }
+    let c = s.dcm();
     let state = ResidualState {
         lat: s.lat,
         lon: s.lon,
@@ -422,6 +430,15 @@ pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>,
         vd: s.v.z,
         rm: earth::radius_meridian(s.lat) + s.h,
         rn: earth::radius_transverse(s.lat) + s.h,
+        c11: c[(0, 0)],
+        c12: c[(0, 1)],
+        c13: c[(0, 2)],
+        c21: c[(1, 0)],
+        c22: c[(1, 1)],
+        c23: c[(1, 2)],
+        c31: c[(2, 0)],
+        c32: c[(2, 1)],
+        c33: c[(2, 2)],
     };
     let k = info.rows.len();
     let (mut z, mut sigma) = (vec![0.0; k], vec![0.0; k]);
@@ -504,7 +521,7 @@ impl<'a> Engine<'a> {
             .iter()
             .enumerate()
             .filter_map(|(i, s)| match *s {
-                StateRef::Term(k) if common::TERMS[k].sensor == Sensor::Gnss => Some(i),
+                StateRef::Term(k) if common::TERMS[k].sensor.enters_h() => Some(i),
                 _ => None,
             })
             .collect();
@@ -566,7 +583,7 @@ impl<'a> Engine<'a> {
                         Sensor::Gyro => dth[info.axis] -= self.correction[i] * r * dt,
                         Sensor::Accel => dvel[info.axis] -= self.correction[i] * r * dt,
                         // a GNSS term's correction applies to the residuals (`update`)
-                        Sensor::Gnss => {}
+                        Sensor::Gnss | Sensor::Reference => {}
                     }
                 }
             }

@@ -93,12 +93,24 @@ pub fn add_attitude_disagreement(
     }
 }
 
-/// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`.
+/// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`,
+/// and a body-frame reference's `vel_bx`, `vel_by`, `vel_bz`.
 pub fn channel_name(meas: &str, component: usize) -> String {
-    match meas.strip_suffix("_ne") {
-        Some(prefix) => format!("{prefix}_{}", ["n", "e"].get(component).unwrap_or(&"?")),
-        None => meas.to_string(),
+    if let Some(prefix) = meas.strip_suffix("_ne") {
+        format!("{prefix}_{}", ["n", "e"].get(component).unwrap_or(&"?"))
+    } else if let Some(prefix) = meas.strip_suffix("_body") {
+        format!(
+            "{prefix}_b{}",
+            ["x", "y", "z"].get(component).unwrap_or(&"?")
+        )
+    } else {
+        meas.to_string()
     }
+}
+
+/// The measurement has one channel per component (named by [`channel_name`]), not one in all.
+fn per_component(meas: &str) -> bool {
+    meas.ends_with("_ne") || meas.ends_with("_body")
 }
 
 /// [`channel_name`] as a static string (what explain keeps per innovation: no allocation each),
@@ -106,16 +118,16 @@ pub fn channel_name(meas: &str, component: usize) -> String {
 pub fn channel_str(meas: &'static str, component: usize) -> &'static str {
     static TABLE: std::sync::OnceLock<Vec<(&'static str, usize, &'static str)>> =
         std::sync::OnceLock::new();
-    if !meas.ends_with("_ne") {
+    if !per_component(meas) {
         return meas;
     }
     TABLE
         .get_or_init(|| {
             crate::model::generated::common::MEASUREMENTS
                 .iter()
-                .filter(|m| m.name.ends_with("_ne"))
+                .filter(|m| per_component(m.name))
                 .flat_map(|m| {
-                    (0..2).map(move |c| {
+                    (0..m.rows.len()).map(move |c| {
                         let name: &'static str =
                             Box::leak(channel_name(m.name, c).into_boxed_str());
                         (m.name, c, name)

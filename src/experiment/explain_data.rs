@@ -11,19 +11,20 @@ use crate::model::generated::common;
 use crate::model::Model;
 use anyhow::Result;
 
-/// The names of the GNSS terms (entering the fixes of a GNSS receiver) among `cands`.
-pub fn gnss_terms(cands: &[usize]) -> Vec<&'static str> {
+/// The names of the terms of `sensor` among `cands` (the GNSS terms enter the fixes of a GNSS
+/// receiver, the reference terms a body-frame velocity reference).
+pub fn terms_of(cands: &[usize], sensor: Sensor) -> Vec<&'static str> {
     cands
         .iter()
-        .filter(|&&t| common::TERMS[t].sensor == Sensor::Gnss)
+        .filter(|&&t| common::TERMS[t].sensor == sensor)
         .map(|&t| common::TERMS[t].name)
         .collect()
 }
 
-/// Drops the GNSS terms from `cands` (a static aid or ZUPTs have no antenna and no receiver
-/// clock).
-pub fn drop_gnss(cands: &mut Vec<usize>) {
-    cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
+/// Drops the terms of `sensor` from `cands` (a static aid or ZUPTs have no antenna and no
+/// receiver clock; without a velocity reference there is no mounting).
+pub fn drop_sensor(cands: &mut Vec<usize>, sensor: Sensor) {
+    cands.retain(|&t| common::TERMS[t].sensor != sensor);
 }
 
 /// `base` with the data options' candidate priors (`--prior`), testing noise levels only with

@@ -226,7 +226,12 @@ pub fn aiding_from_truth(
             row.h,
             [sp, sp, sp],
         ));
-        out.push(AidingEpoch { t: row.t, vel, pos });
+        out.push(AidingEpoch {
+            t: row.t,
+            vel,
+            pos,
+            body_vel: None,
+        });
     }
     Ok(out)
 }

@@ -374,10 +374,15 @@ pub fn explain(
     opts: &ExplainOptions,
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Explanation> {
+    // a velocity reference's mounting is a candidate only where the data hold that reference
+    // and the baseline forms its measurement (else it would be listed as untestable noise)
+    let reference = data.aid.iter().any(|e| e.body_vel.is_some())
+        && baseline.measurements().iter().any(|m| m.name == "vel_body");
     let cands: Vec<usize> = cands
         .iter()
         .copied()
         .filter(|&t| !baseline.states.contains(&StateRef::Term(t)))
+        .filter(|&t| reference || common::TERMS[t].sensor != Sensor::Reference)
         .collect();
     let first = Context {
         baseline,
@@ -762,11 +767,11 @@ fn withheld_rivals(
     let mut out = vec![None; judged.len()];
     for (k, (f, n)) in judged.iter().zip(&r.named).enumerate() {
         let info = &common::TERMS[n.term];
-        if !f.is_cause() || info.sensor != Sensor::Gnss {
+        if !f.is_cause() || !info.sensor.enters_h() {
             continue;
         }
         let rivals = (0..common::TERMS.len()).filter(|&w| {
-            common::TERMS[w].sensor == Sensor::Gnss
+            common::TERMS[w].sensor == info.sensor
                 && !cands.contains(&w)
                 && !r.model.states.contains(&StateRef::Term(w))
         });
@@ -1222,14 +1227,14 @@ fn complete_findings(
                 Sensor::Accel => (effect_si / G0 * 1e3, "mg"),
                 Sensor::Gyro => (effect_si * 180.0 / std::f64::consts::PI * 3600.0, "deg/h"),
                 // a GNSS term acts on the aiding as itself
-                Sensor::Gnss => (estimate, info.display),
+                Sensor::Gnss | Sensor::Reference => (estimate, info.display),
             }
         };
         let (effect, effect_unit) = effect_of(c.mean);
         let (effect_excited, _) = effect_of(c.excited_mean);
         let mut f = Finding {
             term: info.name.to_string(),
-            kind: if info.sensor == Sensor::Gnss {
+            kind: if info.sensor.enters_h() {
                 "measurement"
             } else {
                 "sensor"

@@ -1,7 +1,7 @@
 //! Candidate signatures (Willsky–Jones GLR) riding along one filter pass.
 
 use crate::estimate::filter::Observer;
-use crate::model::catalog::{Sensor, StateRef};
+use crate::model::catalog::StateRef;
 use crate::model::generated::common;
 use crate::model::{Model, RegressorAccumulator};
 use crate::nav::nav_point::NavPoint;
@@ -226,7 +226,7 @@ impl Signatures {
             gnss: cands
                 .iter()
                 .enumerate()
-                .filter(|(_, &t)| common::TERMS[t].sensor == Sensor::Gnss)
+                .filter(|(_, &t)| common::TERMS[t].sensor.enters_h())
                 .map(|(c, &t)| (c, common::TERMS[t].name))
                 .collect(),
             np: None,

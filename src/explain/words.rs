@@ -73,9 +73,9 @@ pub fn separation_hint(a: usize, b: usize) -> String {
     );
     let ra = common::REGRESSORS[ta.regressor];
     let rb = common::REGRESSORS[tb.regressor];
-    if ta.sensor == Sensor::Gnss || tb.sensor == Sensor::Gnss {
+    if ta.sensor.enters_h() || tb.sensor.enters_h() {
         return format!(
-            "{} and {} act on the fixes through the velocity, acceleration or attitude at each one: turns and speed changes in other directions, or a longer run with them, separate them",
+            "{} and {} act on the aiding through the velocity, acceleration or attitude at each one: turns and speed changes in other directions, or a longer run with them, separate them",
             ta.name, tb.name
         );
     }
@@ -125,6 +125,7 @@ pub(super) fn sensor_word(s: Sensor) -> &'static str {
         Sensor::Gyro => "gyro",
         Sensor::Accel => "accelerometer",
         Sensor::Gnss => "GNSS",
+        Sensor::Reference => "velocity reference",
     }
 }
 
@@ -166,7 +167,7 @@ pub(super) fn finding_words(
     info: &crate::model::catalog::TermInfo,
     prior_display: f64,
 ) -> (String, String) {
-    if info.sensor == Sensor::Gnss {
+    if info.sensor.enters_h() {
         return gnss_finding_words(f, info);
     }
     let sensor = sensor_word(info.sensor);
@@ -342,6 +343,9 @@ pub(super) fn channel_word(c: &str) -> String {
         "pos_n" => "north position".into(),
         "pos_e" => "east position".into(),
         "pos_h" => "height".into(),
+        "vel_bx" => "forward velocity (reference)".into(),
+        "vel_by" => "right velocity (reference)".into(),
+        "vel_bz" => "down velocity (reference)".into(),
         other => other.to_string(),
     }
 }

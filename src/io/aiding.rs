@@ -214,3 +214,85 @@ pub fn time_from_first_sample(t: f64, first_t: f64) -> String {
         format!("t = {t:.3} s on the data's clock = {rel}")
     }
 }
+
+/// A body-frame velocity from a reference (odometer with the non-holonomic constraint, DVL):
+/// FRD velocity in the reference's frame and its 1-σ per component.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyVelocityFix {
+    /// Time on the IMU's clock [s].
+    pub t: f64,
+    /// Forward, right, down velocity [m/s].
+    pub v_frd: [f64; 3],
+    /// 1-σ of each component [m/s].
+    pub sigma: f64,
+}
+
+/// Header line of a body-velocity reference file.
+const BODY_VELOCITY_COLUMNS: &str = "t[s] v_x v_y v_z (forward right down) [m/s] sigma [m/s]";
+
+/// Writes body-frame velocities atomically: `t vx vy vz sigma` per row.
+pub fn write_body_velocity(path: &Path, rows: &[BodyVelocityFix], header: &str) -> Result<()> {
+    let mut f = AtomicFile::create(path)?;
+    let w = f.writer();
+    for l in header.lines() {
+        writeln!(w, "# {l}")?;
+    }
+    writeln!(w, "# {BODY_VELOCITY_COLUMNS}")?;
+    for r in rows {
+        writeln!(
+            w,
+            "{:.4} {:.6} {:.6} {:.6} {}",
+            r.t, r.v_frd[0], r.v_frd[1], r.v_frd[2], r.sigma
+        )?;
+    }
+    f.commit()
+}
+
+/// Largest speed a reference row may give [m/s] (a vehicle or vessel; beyond it a unit slip).
+const MAX_REFERENCE_SPEED: f64 = 300.0;
+
+/// Reads a body-velocity reference file (`t vx vy vz sigma`: s, FRD m/s, m/s): time strictly
+/// increasing, speeds within ±300 m/s, σ in [1e-4, 2] m/s; each error names the line and the
+/// likely slip.
+pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
+    let rows = read_table(path, 5, "body-velocity reference file")?;
+    if rows.is_empty() {
+        bail!(
+            "{}: the body-velocity reference file has no data rows ({BODY_VELOCITY_COLUMNS})",
+            path.display()
+        );
+    }
+    let mut out: Vec<BodyVelocityFix> = Vec::with_capacity(rows.len());
+    for (line, v) in rows {
+        let at = format!("{}:{line}", path.display());
+        if let Some(prev) = out.last() {
+            if v[0] <= prev.t {
+                bail!(
+                    "{at}: time {} s is not after the previous row's {} s (rows must be in time order, each time once)",
+                    v[0],
+                    prev.t
+                );
+            }
+        }
+        if v[1..4].iter().any(|x| x.abs() > MAX_REFERENCE_SPEED) {
+            bail!(
+                "{at}: a velocity component beyond ±{MAX_REFERENCE_SPEED} m/s ({}, {}, {}): km/h or mm/s written as m/s?",
+                v[1],
+                v[2],
+                v[3]
+            );
+        }
+        if !(1e-4..=2.0).contains(&v[4]) {
+            bail!(
+                "{at}: sigma {} must be in [1e-4, 2] m/s (a reference worse than 2 m/s carries nothing; cm/s or mm/s written as m/s?)",
+                v[4]
+            );
+        }
+        out.push(BodyVelocityFix {
+            t: v[0],
+            v_frd: [v[1], v[2], v[3]],
+            sigma: v[4],
+        });
+    }
+    Ok(out)
+}

@@ -12,6 +12,17 @@ pub enum Sensor {
     Accel,
     /// GNSS aiding: enters the measurements (H), not A — a time offset, an antenna lever arm.
     Gnss,
+    /// A body-frame velocity reference (odometer, DVL): enters its measurement (H), not A — a
+    /// mounting misalignment.
+    Reference,
+}
+
+impl Sensor {
+    /// The term enters the measurements (H), not A: its closed-loop correction applies to the
+    /// residuals, and it describes the aiding, not the IMU.
+    pub fn enters_h(self) -> bool {
+        matches!(self, Sensor::Gnss | Sensor::Reference)
+    }
 }
 
 /// A navigation error state as declared in `model-spec/navigation.toml`.
@@ -147,6 +158,8 @@ pub enum Aiding {
     Position,
     /// A velocity fix.
     Velocity,
+    /// A body-frame (FRD) velocity from a reference (odometer, DVL).
+    BodyVelocity,
 }
 
 /// The filter's navigation state at a fix, as a measurement residual sees it (SI units).
@@ -168,6 +181,24 @@ pub struct ResidualState {
     pub rm: f64,
     /// R_N + h at the state [m].
     pub rn: f64,
+    /// C_b^n at the state, row by row (`c11` … `c33`).
+    pub c11: f64,
+    /// C_b^n (1, 2).
+    pub c12: f64,
+    /// C_b^n (1, 3).
+    pub c13: f64,
+    /// C_b^n (2, 1).
+    pub c21: f64,
+    /// C_b^n (2, 2).
+    pub c22: f64,
+    /// C_b^n (2, 3).
+    pub c23: f64,
+    /// C_b^n (3, 1).
+    pub c31: f64,
+    /// C_b^n (3, 2).
+    pub c32: f64,
+    /// C_b^n (3, 3).
+    pub c33: f64,
 }
 
 /// One aiding record as a residual reads it (`aid.lat`, …): the fields of the record the
@@ -194,6 +225,14 @@ pub struct AidRecord {
     pub vd: f64,
     /// 1-σ of each velocity component [m/s].
     pub sigma_v: f64,
+    /// Body-frame (FRD) velocity of a reference, forward [m/s].
+    pub vx: f64,
+    /// Right [m/s].
+    pub vy: f64,
+    /// Down [m/s].
+    pub vz: f64,
+    /// 1-σ of each body-frame component [m/s].
+    pub sigma_b: f64,
 }
 
 impl AidRecord {
@@ -209,6 +248,10 @@ impl AidRecord {
         ve: f64::NAN,
         vd: f64::NAN,
         sigma_v: f64::NAN,
+        vx: f64::NAN,
+        vy: f64::NAN,
+        vz: f64::NAN,
+        sigma_b: f64::NAN,
     };
 }
 

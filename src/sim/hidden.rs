@@ -602,7 +602,7 @@ fn one_description(g: &str, p: &Parts, effect: f64) -> String {
             let t = info.expect("matched");
             format!("{:.1} {}", hidden[0].1 / t.display_to_si, t.display)
         }
-        Some(crate::model::catalog::Sensor::Gnss) => {
+        Some(crate::model::catalog::Sensor::Gnss | crate::model::catalog::Sensor::Reference) => {
             let t = info.expect("matched");
             format!("{:.3} {}", hidden[0].1 / t.display_to_si, t.display)
         }

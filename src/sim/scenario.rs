@@ -165,6 +165,25 @@ pub struct GnssSpec {
     pub sigma_v: Option<String>,
 }
 
+/// A body-frame velocity reference (odometer, DVL) written by the simulator: the true body
+/// velocity turned by the scenario's mounting terms (`mount_x` … in `[errors]`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// Rate [Hz].
+    pub rate_hz: f64,
+    /// 1-σ of each body-frame component (e.g. "0.05 m/s").
+    #[serde(default = "default_sigma_reference")]
+    pub sigma: String,
+    /// Add Gaussian noise with that σ (default true).
+    #[serde(default = "yes")]
+    pub noisy: bool,
+}
+
+fn default_sigma_reference() -> String {
+    "0.05 m/s".into()
+}
+
 fn default_sigma_ne() -> String {
     "0.5 m".into()
 }
@@ -214,6 +233,8 @@ struct RawScenario {
     #[serde(default)]
     gnss: Option<GnssSpec>,
     #[serde(default)]
+    reference: Option<ReferenceSpec>,
+    #[serde(default)]
     clock_jitter_periods: Option<u32>,
 }
 
@@ -246,6 +267,8 @@ pub struct Scenario {
     pub gnss: Option<(f64, f64, f64, bool)>,
     /// GNSS velocity 1-σ [m/s] when the fixes carry a velocity.
     pub gnss_sigma_v: Option<f64>,
+    /// A body-frame velocity reference (rate [Hz], 1-σ [m/s], noisy).
+    pub reference: Option<(f64, f64, bool)>,
     /// A jittered IMU clock: each output sample spans 1 to this many periods of `imu_rate_hz`
     /// at random (1: a uniform clock).
     pub clock_jitter_periods: u32,
@@ -359,6 +382,19 @@ impl Scenario {
         let noise = parse_noise(&raw.noise, &src)?;
         let gnss = parse_gnss(raw.gnss.as_ref(), &src, imu_rate_hz)?;
         let gnss_sigma_v = parse_gnss_sigma_v(raw.gnss.as_ref(), &src)?;
+        let reference = parse_reference(raw.reference.as_ref(), &src, imu_rate_hz)?;
+        if reference.is_none() {
+            if let Some(&(k, _)) = errors
+                .iter()
+                .find(|(k, _)| common::TERMS[*k].sensor == crate::model::catalog::Sensor::Reference)
+            {
+                bail!(
+                    "{}: {} is a mounting of a velocity reference; the scenario has no [reference] section to write one",
+                    src.at(common::TERMS[k].name),
+                    common::TERMS[k].name
+                );
+            }
+        }
         let clock_jitter_periods = raw.clock_jitter_periods.unwrap_or(1);
         if !(1..=4).contains(&clock_jitter_periods) {
             bail!(
@@ -378,6 +414,7 @@ impl Scenario {
             noise,
             gnss,
             gnss_sigma_v,
+            reference,
             clock_jitter_periods,
             text: text.to_string(),
             warnings,
@@ -744,6 +781,31 @@ fn parse_gnss(
         }
         None => None,
     })
+}
+
+/// A body-frame velocity reference as (rate [Hz], 1-σ [m/s], noisy): a rate in (0,
+/// imu_rate_hz] [Hz], a σ in [1e-4, 100] m/s.
+fn parse_reference(
+    r: Option<&ReferenceSpec>,
+    src: &Src,
+    imu_rate_hz: f64,
+) -> Result<Option<(f64, f64, bool)>> {
+    let Some(r) = r else { return Ok(None) };
+    if !(r.rate_hz > 0.0 && r.rate_hz <= imu_rate_hz) {
+        bail!(
+            "{}: [reference] rate_hz must be in (0, imu_rate_hz]",
+            src.at("rate_hz")
+        );
+    }
+    let s = units::parse_quantity_as(&r.sigma, "m/s")
+        .map_err(|e| anyhow!("{}: [reference] sigma: {e}", src.at("sigma")))?;
+    if !(1e-4..=100.0).contains(&s) {
+        bail!(
+            "{}: [reference] sigma must be in [1e-4, 100] m/s (reference.txt holds velocities to 1 um/s)",
+            src.at("sigma")
+        );
+    }
+    Ok(Some((r.rate_hz, s, r.noisy)))
 }
 
 /// The 1-σ [m/s] of the GNSS velocity written with each fix, if any (1e-4 to 100 m/s).

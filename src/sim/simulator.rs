@@ -30,6 +30,8 @@ pub struct SimOutput {
     pub gnss: Vec<PositionFix>,
     /// GNSS velocities, one per fix, when the scenario's `[gnss]` gives `sigma_v`.
     pub gnss_velocity: Option<Vec<crate::io::aiding::VelocityFix>>,
+    /// Body-frame velocities of the scenario's `[reference]`, turned by its mounting terms.
+    pub body_velocity: Option<Vec<crate::io::aiding::BodyVelocityFix>>,
     /// True navigation state at t = 0 (to start a navigator).
     pub start: NavState,
 }
@@ -110,6 +112,39 @@ fn gnss_shift(
     out
 }
 
+/// The true body velocity at `t` [s] as a reference mounted with the terms `terms` ((term, value
+/// SI)) reads it: each `vel_body` row moves by Σ H θ (the terms' H entries of the spec at the
+/// true point; z = computed − aided, so the aided value is the true one less H θ).
+fn reference_reading(
+    traj: &Trajectory,
+    e: &earth::LocalEarth,
+    t: f64,
+    lat: f64,
+    h: f64,
+    terms: &[(usize, f64)],
+) -> Vector3<f64> {
+    let k = traj.at(t);
+    let mut v_b = k.c.transpose() * k.v;
+    if terms.is_empty() {
+        return v_b;
+    }
+    let (f_b, w_b, _) = body_signals(e, &k);
+    let mut np = crate::nav::nav_point::NavPoint::new(lat, h, k.v, &k.c, &f_b);
+    np.set_rate(&w_b);
+    let m = common::MEASUREMENTS
+        .iter()
+        .position(|m| m.name == "vel_body")
+        .expect("the spec declares vel_body");
+    let v_true = v_b;
+    common::measurement_entries(m, &np, &mut |comp, state, value| {
+        if let Some(&(_, theta)) = terms.iter().find(|(t, _)| common::TERMS[*t].name == state) {
+            v_b[comp] -= value * theta;
+        }
+    });
+    debug_assert!((v_b - v_true).norm() <= v_true.norm() * 0.2 + 1e-9);
+    v_b
+}
+
 /// What stays fixed through a simulation: the trajectory, the step, the injected errors.
 struct Run<'a> {
     /// The scenario.
@@ -126,6 +161,8 @@ struct Run<'a> {
     needs_rates: bool,
     /// The scenario's GNSS terms: (term index in `common::TERMS`, SI value).
     gnss_terms: Vec<(usize, f64)>,
+    /// The scenario's velocity-reference terms (mounting): (term index, SI value).
+    reference_terms: Vec<(usize, f64)>,
 }
 
 impl<'a> Run<'a> {
@@ -154,6 +191,12 @@ impl<'a> Run<'a> {
             .copied()
             .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Gnss)
             .collect();
+        let reference_terms: Vec<(usize, f64)> = sc
+            .errors
+            .iter()
+            .copied()
+            .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Reference)
+            .collect();
         Run {
             sc,
             traj,
@@ -162,6 +205,7 @@ impl<'a> Run<'a> {
             injected,
             needs_rates,
             gnss_terms,
+            reference_terms,
         }
     }
 
@@ -198,7 +242,7 @@ impl<'a> Run<'a> {
                         Sensor::Gyro => om[inj.axis] += inj.value * r,
                         Sensor::Accel => fm[inj.axis] += inj.value * r,
                         // in the aiding (`gnss_shift`), not in the IMU
-                        Sensor::Gnss => {}
+                        Sensor::Gnss | Sensor::Reference => {}
                     }
                 }
                 let wt = 0.5 * hsub * w;
@@ -336,6 +380,12 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
     let mut rng = Rng::new(sc.seed);
     // GNSS velocity noise on a stream of its own: adding velocities changes no other draw
     let mut rng_v = Rng::new(sc.seed ^ 0xbb67_ae85_84ca_a73b);
+    // and the reference's noise on another
+    let mut rng_r = Rng::new(sc.seed ^ 0x3c6e_f372_fe94_f82b);
+    let reference_every = sc
+        .reference
+        .map(|r| (sc.imu_rate_hz / r.0).round().max(1.0) as usize);
+    let mut body_velocity = Vec::new();
     let d = std::f64::consts::PI / 180.0;
     let (mut lat, mut lon, mut h) = (sc.start.lat_deg * d, sc.start.lon_deg * d, sc.start.h_m);
     let k0 = traj.at(0.0);
@@ -409,6 +459,21 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                 gnss_velocity.extend(velocity);
             }
         }
+        if let (Some(every), Some((_, sigma, noisy))) = (reference_every, sc.reference) {
+            if (i + 1) % every == 0 {
+                let mut v = reference_reading(traj, &e, t1, lat, h, &run.reference_terms);
+                if noisy {
+                    for j in 0..3 {
+                        v[j] += sigma * rng_r.normal();
+                    }
+                }
+                body_velocity.push(crate::io::aiding::BodyVelocityFix {
+                    t: t1,
+                    v_frd: [v.x, v.y, v.z],
+                    sigma,
+                });
+            }
+        }
         if i % report_every == 0 {
             progress(i as f64 / n as f64);
         }
@@ -423,6 +488,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         gnss_truth,
         gnss,
         gnss_velocity: sc.gnss_sigma_v.map(|_| gnss_velocity),
+        body_velocity: sc.reference.map(|_| body_velocity),
         start,
     }
 }

@@ -1,0 +1,277 @@
+//! A body-frame velocity reference (odometer, DVL) end to end: the simulator writes it with a
+//! mounting misalignment, the filter estimates the mounting, explain names it (and nothing of
+//! the sensor), and bad reference input is refused with the likely slip.
+
+mod common;
+use common::sinsmodel;
+
+use std::path::{Path, PathBuf};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sinsmodel-reference-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The shipped drive with a reference mounted (0.5°, 1.5°), `edit` applied to its text,
+/// simulated into `dir`/sim; returns that directory.
+fn simulated(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/drive_reference.toml"),
+    )
+    .unwrap();
+    let scen = dir.join("drive.toml");
+    std::fs::write(&scen, edit(text)).unwrap();
+    let sim = dir.join("sim");
+    let (ok, _, stderr) = sinsmodel(&[
+        "simulate",
+        scen.to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("body-velocity reference rows"), "{stderr}");
+    sim
+}
+
+/// explain on the simulation in `sim` (baseline P13+vertical, tactical grade) with `extra`
+/// options: its JSON.
+fn explained(sim: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
+    let p = |f: &str| sim.join(f).to_str().unwrap().to_string();
+    let (imu, aid, reference, truth) = (
+        p("imu.txt"),
+        p("gnss.txt"),
+        p("reference.txt"),
+        p("truth.txt"),
+    );
+    let mut args = vec![
+        "explain",
+        "--model",
+        "P13+vertical",
+        "--grade",
+        "tactical",
+        "--imu",
+        &imu,
+        "--aid",
+        &aid,
+        "--body-velocity",
+        &reference,
+        "--truth",
+        &truth,
+        "--out",
+    ];
+    let out_s = out.to_str().unwrap();
+    args.push(out_s);
+    args.extend(extra);
+    let (ok, _, stderr) = sinsmodel(&args);
+    assert!(ok, "{stderr}");
+    serde_json::from_str(&std::fs::read_to_string(out.join("explain.json")).unwrap()).unwrap()
+}
+
+fn is_cause(f: &serde_json::Value) -> bool {
+    f["stand_in"].is_null() && f["not_attributed"].is_null()
+}
+
+/// The mounting's pitch and yaw are named as causes within 10 % of the truth, with kind
+/// `measurement`; no sensor term or noise level is named as a cause.
+#[test]
+fn explain_names_a_reference_mounting_and_no_sensor_term() {
+    let dir = tmp("named");
+    let sim = simulated(&dir, |t| t);
+    let j = explained(&sim, &dir.join("explain"), &[]);
+    let findings = j["findings"].as_array().unwrap();
+    for (name, truth) in [("mount_y", 0.5), ("mount_z", 1.5)] {
+        let f = findings
+            .iter()
+            .find(|f| f["term"] == name)
+            .unwrap_or_else(|| panic!("{name} not among the findings: {:#?}", j["summary"]));
+        assert!(is_cause(f), "{name}: {}", f["words"]);
+        assert_eq!(f["kind"], "measurement");
+        assert_eq!(f["unit"], "deg");
+        let est = f["estimate"].as_f64().unwrap();
+        assert!(
+            (est - truth).abs() < 0.1 * truth,
+            "{name} = {est} deg for {truth}"
+        );
+    }
+    for f in findings {
+        if f["term"] != "mount_y" && f["term"] != "mount_z" {
+            assert!(!is_cause(f), "named beside the mounting: {}", f["words"]);
+        }
+    }
+}
+
+/// The mounting withheld from the candidates: what fits in its place is not named as a cause.
+#[test]
+fn a_withheld_mounting_gives_no_confident_finding() {
+    let dir = tmp("withheld");
+    let sim = simulated(&dir, |t| t);
+    let j = explained(&sim, &dir.join("explain"), &["--candidates", "!mount_*"]);
+    for f in j["findings"].as_array().unwrap() {
+        assert!(
+            !is_cause(f),
+            "a stand-in named as the cause: {}",
+            f["words"]
+        );
+    }
+}
+
+/// A reference mounted true (no misalignment) and a consistent model: nothing is named.
+#[test]
+fn a_true_mounting_is_not_named() {
+    let dir = tmp("null");
+    let sim = simulated(&dir, |t| {
+        t.replace("mount_y = \"0.5 deg\"\n", "")
+            .replace("mount_z = \"1.5 deg\"\n", "")
+    });
+    let j = explained(&sim, &dir.join("explain"), &[]);
+    for f in j["findings"].as_array().unwrap() {
+        assert!(!is_cause(f), "named on a null case: {}", f["words"]);
+    }
+}
+
+/// The filter estimates the mounting given as states (closed loop), and reports the reference's
+/// three channels consistent.
+#[test]
+fn filter_estimates_the_mounting() {
+    let dir = tmp("filter");
+    let sim = simulated(&dir, |t| t);
+    let p = |f: &str| sim.join(f).to_str().unwrap().to_string();
+    let out = dir.join("filter");
+    let (ok, _, stderr) = sinsmodel(&[
+        "filter",
+        "--model",
+        "P13+vertical+mount_y+mount_z",
+        "--grade",
+        "tactical",
+        "--mode",
+        "closed",
+        "--imu",
+        &p("imu.txt"),
+        "--aid",
+        &p("gnss.txt"),
+        "--body-velocity",
+        &p("reference.txt"),
+        "--truth",
+        &p("truth.txt"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    for ch in ["vel_bx", "vel_by", "vel_bz"] {
+        let line = stderr
+            .lines()
+            .find(|l| l.trim_start().starts_with(ch))
+            .unwrap();
+        assert!(line.contains("consistent"), "{line}");
+    }
+    let text = std::fs::read_to_string(out.join("states.txt")).unwrap();
+    let header: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("# t "))
+        .unwrap()
+        .split_whitespace()
+        .skip(1)
+        .collect();
+    let last: Vec<f64> = text
+        .lines()
+        .rfind(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .unwrap()
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let n = (header.len() - 1) / 2;
+    for (name, truth) in [("mount_y", 0.5f64), ("mount_z", 1.5)] {
+        let i = header
+            .iter()
+            .position(|h| *h == format!("{name}[rad]"))
+            .unwrap();
+        let (est, sig) = (last[i].to_degrees(), last[i + n].to_degrees());
+        assert!(
+            (est - truth).abs() < 0.1 * truth && (est - truth).abs() < 4.0 * sig,
+            "{name} = {est} ± {sig} deg for {truth}"
+        );
+    }
+}
+
+/// Bad reference input: speeds in km/h, a mounting state without a reference, a reference with
+/// a model that cannot use it, a scenario mounting without a reference, and a σ in cm/s.
+#[test]
+fn bad_reference_input_is_refused_with_the_likely_slip() {
+    let dir = tmp("bad");
+    let sim = simulated(&dir, |t| t);
+    let p = |f: &str| sim.join(f).to_str().unwrap().to_string();
+    // km/h written as m/s: every velocity × 3.6
+    let kmh = dir.join("kmh.txt");
+    let text: String = std::fs::read_to_string(sim.join("reference.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                return format!("{l}\n");
+            }
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            format!(
+                "{} {} {} {} {}\n",
+                v[0],
+                v[1] * 3.6,
+                v[2] * 3.6,
+                v[3] * 3.6,
+                v[4]
+            )
+        })
+        .collect();
+    std::fs::write(&kmh, text).unwrap();
+    let run = |model: &str, reference: Option<&str>| {
+        let mut args = vec![
+            "filter".to_string(),
+            "--model".into(),
+            model.into(),
+            "--imu".into(),
+            p("imu.txt"),
+            "--aid".into(),
+            p("gnss.txt"),
+            "--truth".into(),
+            p("truth.txt"),
+            "--out".into(),
+            dir.join("out").to_str().unwrap().into(),
+        ];
+        if let Some(r) = reference {
+            args.extend(["--body-velocity".into(), r.to_string()]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (ok, _, stderr) = sinsmodel(&refs);
+        assert!(!ok, "accepted: {args:?}");
+        stderr
+    };
+    let e = run("P13+vertical", Some(kmh.to_str().unwrap()));
+    assert!(e.contains("3.6×: km/h written as m/s?"), "{e}");
+    let e = run("P13+vertical+mount_z", None);
+    assert!(
+        e.contains("mount_z") && e.contains("--body-velocity"),
+        "{e}"
+    );
+    let e = run("P13", Some(&p("reference.txt")));
+    assert!(e.contains("+vertical"), "{e}");
+    let cms = dir.join("cms.txt");
+    std::fs::write(&cms, "0.1 10 0 0 5\n").unwrap();
+    let e = run("P13+vertical", Some(cms.to_str().unwrap()));
+    assert!(e.contains("cms.txt:1") && e.contains("cm/s"), "{e}");
+    // a scenario mounting with nothing to mount
+    let scen = dir.join("noref.toml");
+    let text = std::fs::read_to_string(dir.join("drive.toml")).unwrap();
+    let cut = text.find("[reference]").unwrap();
+    std::fs::write(&scen, &text[..cut]).unwrap();
+    let (ok, _, stderr) = sinsmodel(&[
+        "simulate",
+        scen.to_str().unwrap(),
+        "--out",
+        dir.join("s2").to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("mount_y") && stderr.contains("[reference]"),
+        "{stderr}"
+    );
+}
