@@ -131,6 +131,61 @@ fn a_true_mounting_is_not_named() {
     }
 }
 
+/// The mounting given as known (`--mounting 0,0.5,1.5`, degrees) is applied in the residuals:
+/// explain then names nothing and says what it applied; an implausible or malformed mounting
+/// is refused, as is one without a reference.
+#[test]
+fn a_known_mounting_is_applied_and_checked() {
+    let dir = tmp("known");
+    let sim = simulated(&dir, |t| t);
+    let j = explained(&sim, &dir.join("explain"), &["--mounting", "0,0.5,1.5"]);
+    for f in j["findings"].as_array().unwrap() {
+        assert!(
+            !is_cause(f),
+            "named beside the known mounting: {}",
+            f["words"]
+        );
+    }
+    let summary = j["summary"].to_string();
+    assert!(
+        summary.contains("mount_y = 0.500 deg") && summary.contains("mount_z = 1.50 deg"),
+        "{summary}"
+    );
+    let p = |f: &str| sim.join(f).to_str().unwrap().to_string();
+    for (value, with_reference, expect) in [
+        ("0,0.5,30", true, "rotate the reference's velocities"),
+        ("0,0.5", true, "got 2 values"),
+        ("0,0.5,1.5 rad", true, "beyond"),
+        ("0,x,1", true, "expected degrees"),
+        ("0,0.5,1.5", false, "needs --body-velocity"),
+    ] {
+        let mut args = vec![
+            "filter".to_string(),
+            "--model".into(),
+            "P13+vertical".into(),
+            "--imu".into(),
+            p("imu.txt"),
+            "--aid".into(),
+            p("gnss.txt"),
+            "--truth".into(),
+            p("truth.txt"),
+            format!("--mounting={value}"),
+            "--out".into(),
+            dir.join("out").to_str().unwrap().into(),
+        ];
+        if with_reference {
+            args.extend(["--body-velocity".into(), p("reference.txt")]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (ok, _, stderr) = sinsmodel(&refs);
+        assert!(!ok, "accepted --mounting {value}");
+        assert!(
+            stderr.contains("--mounting") && stderr.contains(expect),
+            "{value}: {stderr}"
+        );
+    }
+}
+
 /// The filter estimates the mounting given as states (closed loop), and reports the reference's
 /// three channels consistent.
 #[test]

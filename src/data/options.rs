@@ -183,6 +183,14 @@ pub struct DataOptions {
     /// the `vel_body` measurement (needs a model with +vertical).
     #[cfg_attr(feature = "cli", arg(long))]
     pub body_velocity: Option<PathBuf>,
+    /// Known mounting of the velocity reference against the IMU body frame: ROLL,PITCH,YAW
+    /// [deg] (the spec terms mount_x mount_y mount_z; a unit may be given, `26 mrad`), applied
+    /// in the residuals; needs --body-velocity.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_delimiter = ',', allow_hyphen_values = true)
+    )]
+    pub mounting: Option<Vec<String>>,
 }
 
 impl DataOptions {
@@ -209,6 +217,7 @@ impl DataOptions {
             gnss_delay: None,
             lever_arm: None,
             body_velocity: None,
+            mounting: None,
         }
     }
 
@@ -231,6 +240,7 @@ impl DataOptions {
             || self.gnss_delay.is_some()
             || self.lever_arm.is_some()
             || self.body_velocity.is_some()
+            || self.mounting.is_some()
     }
 
     /// True when the aiding comes from a GNSS file (`--aid`): GNSS terms (time offset, lever
@@ -279,6 +289,12 @@ impl DataOptions {
         }
         if let Some(l) = &self.lever_arm {
             s.push_str(&format!(", known lever arm {} (m, FRD)", l.join(",")));
+        }
+        if let Some(m) = &self.mounting {
+            s.push_str(&format!(
+                ", known reference mounting {} (deg, roll pitch yaw)",
+                m.join(",")
+            ));
         }
         s
     }

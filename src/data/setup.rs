@@ -108,6 +108,12 @@ impl DataOptions {
         if !out.is_empty() && !self.has_gnss() {
             bail!("--gnss-delay and --lever-arm describe a GNSS receiver: they need --aid (a GNSS file)");
         }
+        if let Some(m) = &self.mounting {
+            if self.body_velocity.is_none() {
+                bail!("--mounting describes a velocity reference: it needs --body-velocity (the reference's file)");
+            }
+            out.extend(known_mounting(m)?);
+        }
         Ok(out)
     }
 
@@ -627,4 +633,37 @@ fn check_reference_terms(model: &Model, args: &DataOptions) -> Result<()> {
         ),
         _ => Ok(()),
     }
+}
+
+/// The `--mounting R,P,Y` values as (term, value [rad]): bare numbers are degrees, a unit may be
+/// given (`10 mrad`); each within the terms' small-angle limit (10°).
+fn known_mounting(m: &[String]) -> Result<Vec<(usize, f64)>> {
+    if m.len() != 3 {
+        bail!(
+            "--mounting: expected ROLL,PITCH,YAW of the reference against the IMU body frame in degrees, got {} values",
+            m.len()
+        );
+    }
+    let mut out = Vec::new();
+    for (item, name) in m.iter().zip(["mount_x", "mount_y", "mount_z"]) {
+        let item = item.trim();
+        let v = match item.parse::<f64>() {
+            Ok(v) => v.to_radians(),
+            Err(_) => crate::io::units::parse_quantity_as(item, "rad").with_context(|| {
+                format!("--mounting: {name} = `{item}`: expected degrees (`1.5`) or an angle with its unit (`26 mrad`)")
+            })?,
+        };
+        let k = common::TERMS
+            .iter()
+            .position(|t| t.name == name)
+            .with_context(|| format!("--mounting: the spec has no term `{name}`"))?;
+        if !v.is_finite() {
+            bail!("--mounting: {name} = `{item}` is not a number");
+        }
+        if let Some(why) = common::TERMS[k].beyond_limit(v) {
+            bail!("--mounting: {name} = `{item}`: {why}; a mounting this large is no small misalignment: rotate the reference's velocities into the IMU's axes first");
+        }
+        out.push((k, v));
+    }
+    Ok(out)
 }

@@ -38,7 +38,7 @@ pub fn known_gnss(known: &[(usize, f64)]) -> Option<String> {
         })
         .collect();
     Some(format!(
-        "Known GNSS values applied in every pass (--gnss-delay, --lever-arm): {}; a GNSS finding is what the data show on top of them.",
+        "Known aiding values applied in every pass (--gnss-delay, --lever-arm, --mounting): {}; a GNSS or reference finding is what the data show on top of them.",
         known.join(", ")
     ))
 }
