@@ -436,7 +436,7 @@ pub fn dataset_outcome(data: &[u8]) -> Option<anyhow::Result<()>> {
     o.grade = (flags & 8 != 0).then(|| "mems".to_string());
     o.force = flags & 16 != 0;
     if flags & 32 != 0 {
-        o.mode = "closed".into();
+        o.mode = Some("closed".into());
     }
     let mut ds = match o.open(&mut |_| {}) {
         Ok(ds) => ds,

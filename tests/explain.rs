@@ -48,7 +48,7 @@ fn check_found(kind: CaseKind, seed: u64) {
         let est = estimate_of(&out, name).unwrap();
         let rel = (est - truth).abs() / truth.abs();
         // a time offset within 10 % or 5 ms
-        let close = rel < 0.10 || (name == "dt_gnss" && (est - truth).abs() < 5.0);
+        let close = rel < 0.10 || (name.starts_with("dt_") && (est - truth).abs() < 5.0);
         assert!(
             close,
             "{}: {name} estimated {est} {}, true {truth} ({:.1} % off)",
@@ -74,7 +74,15 @@ fn check_found(kind: CaseKind, seed: u64) {
             .hidden
             .iter()
             .any(|(h, _)| &f.term == h || f.equivalent.iter().any(|x| x == h));
-        assert!(related, "{}: named {} too", case.description, f.term);
+        // a fit the words do not attribute ("Fitted, not attributed": its value is not fixed
+        // by the data) is no claim; anything else unrelated is a wrong name
+        let unattributed = f.not_attributed.is_some() && f.stand_in.is_none();
+        assert!(
+            related || unattributed,
+            "{}: named {} too",
+            case.description,
+            f.term
+        );
         // a hidden library term is a cause, never reported as a stand-in for something else
         assert!(
             f.stand_in.is_none(),
@@ -227,6 +235,40 @@ fn noise_levels_across_seeds() {
     eprint!("{table}");
 }
 
+/// Seeds 1–5 of each velocity-reference group (about 8 s a case; run with `--ignored`): how
+/// often every hidden term is named as a cause within 10 % (a time offset: or 5 ms), and what
+/// else is named as a cause.
+#[test]
+#[ignore]
+fn reference_groups_across_seeds() {
+    use sinsmodel::sim::hidden::REFERENCE_GROUPS;
+    let mut table = String::new();
+    for group in REFERENCE_GROUPS {
+        let (mut all_close, mut wrong) = (0, Vec::new());
+        for seed in 1..=5 {
+            let (case, out) = run(CaseKind::One(group), seed);
+            let close = case.hidden.iter().all(|(name, truth_si)| {
+                let info = common::TERMS.iter().find(|t| t.name == name).unwrap();
+                let truth = truth_si / info.display_to_si;
+                out.found(name)
+                    && estimate_of(&out, name).is_some_and(|est| {
+                        (est - truth).abs() < 0.1 * truth.abs()
+                            || (name.starts_with("dt_") && (est - truth).abs() < 5.0)
+                    })
+            });
+            all_close += usize::from(close);
+            let w = false_causes(&case, &out);
+            if !w.is_empty() {
+                wrong.push(format!("seed {seed}: {w:?}"));
+            }
+        }
+        table.push_str(&format!(
+            "{group}: every hidden term named within 10 % in {all_close}/5, false causes {wrong:?}\n"
+        ));
+    }
+    eprint!("{table}");
+}
+
 #[test]
 fn finds_gyro_noise_stated_too_small() {
     check_noise("noise_gyro", 1);
@@ -305,6 +347,26 @@ fn finds_a_time_offset_and_a_sensor_term_together() {
 #[test]
 fn finds_a_hidden_antenna_lever_arm() {
     check_found(CaseKind::One("gnss_lever"), 1);
+}
+
+/// A velocity reference mounted pitched and yawed (0.2–2° each): both named within 10 %, no
+/// sensor term named.
+#[test]
+fn finds_a_hidden_reference_mounting() {
+    check_found(CaseKind::One("reference_mount"), 1);
+}
+
+/// A velocity reference's time offset (20–300 ms) and its yaw mounting: both named within 10 %
+/// (or 5 ms), no sensor term named.
+#[test]
+fn finds_a_hidden_reference_time_offset() {
+    check_found(CaseKind::One("reference_time"), 1);
+}
+
+/// The mounting and a gyro g-sensitivity beside it: all three named.
+#[test]
+fn finds_a_reference_mounting_beside_a_sensor_term() {
+    check_found(CaseKind::One("reference_mount_kgf"), 1);
 }
 
 #[test]
@@ -519,6 +581,7 @@ fn probe() {
                 .chain(sinsmodel::sim::hidden::GNSS_GROUPS.iter())
                 .chain(sinsmodel::sim::hidden::TURNTABLE_GROUPS.iter())
                 .chain(sinsmodel::sim::hidden::NOISE_GROUPS.iter())
+                .chain(sinsmodel::sim::hidden::REFERENCE_GROUPS.iter())
                 .find(|x| **x == g)
                 .expect("a group, null or two"),
         ),

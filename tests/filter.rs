@@ -131,7 +131,7 @@ fn residual_matches_generated_h() {
             t: 1.0,
             vel: Some((truth.v, 0.01)),
             pos: Some((truth.lat, truth.lon, truth.h, [0.5, 0.5, 1.0])),
-            body_vel: Some((truth.dcm().transpose() * truth.v, 0.1)),
+            body_vel: Some(Box::new((truth.dcm().transpose() * truth.v, 0.1))),
         };
         // computed = truth + δ (δ in the model's error states)
         let mut dx = vec![0.0; n];
@@ -195,7 +195,7 @@ fn body_velocity_residual_matches_h_under_attitude_error() {
         t: 1.0,
         vel: None,
         pos: None,
-        body_vel: Some((truth.dcm().transpose() * truth.v, 0.05)),
+        body_vel: Some(Box::new((truth.dcm().transpose() * truth.v, 0.05))),
     };
     let phi = Vector3::new(2e-4, -3e-4, 5e-4);
     let dv = Vector3::new(0.02, -0.03, 0.01);

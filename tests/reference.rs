@@ -102,6 +102,95 @@ fn explain_names_a_reference_mounting_and_no_sensor_term() {
     }
 }
 
+/// The reference's rows stamped 0.1 s late (a latency, as odometers on a vehicle bus have): its
+/// time offset is named, -100 ms within 10 %, beside the mounting, and no sensor term or GNSS
+/// term takes it (an accelerometer delay acts alike on the reference's rows).
+#[test]
+fn explain_names_a_late_reference() {
+    let dir = tmp("late");
+    let sim = simulated(&dir, |t| t);
+    let late = dir.join("late.txt");
+    let text: String = std::fs::read_to_string(sim.join("reference.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| match l.split_once(' ') {
+            Some((t, rest)) if !l.starts_with('#') => {
+                format!("{:.4} {rest}\n", t.parse::<f64>().unwrap() + 0.1)
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&late, text).unwrap();
+    let p = |f: &str| sim.join(f).to_str().unwrap().to_string();
+    let out = dir.join("explain");
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P13+vertical",
+        "--grade",
+        "tactical",
+        "--imu",
+        &p("imu.txt"),
+        "--aid",
+        &p("gnss.txt"),
+        "--body-velocity",
+        late.to_str().unwrap(),
+        "--truth",
+        &p("truth.txt"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("explain.json")).unwrap()).unwrap();
+    let findings = j["findings"].as_array().unwrap();
+    let dt = findings
+        .iter()
+        .find(|f| f["term"] == "dt_ref")
+        .unwrap_or_else(|| panic!("dt_ref not named: {:#?}", j["summary"]));
+    assert!(is_cause(dt), "{}", dt["words"]);
+    let est = dt["estimate"].as_f64().unwrap();
+    assert!((est + 100.0).abs() < 10.0, "dt_ref = {est} ms for -100");
+    for f in findings {
+        let term = f["term"].as_str().unwrap();
+        if !["dt_ref", "mount_y", "mount_z"].contains(&term) {
+            assert!(!is_cause(f), "named beside the latency: {}", f["words"]);
+        }
+    }
+}
+
+/// A wheel odometer reading 2 % fast (`k_ref = 20000 ppm`, a worn or under-inflated tyre's
+/// radius): its scale is named within 10 % beside the mounting, and nothing else.
+#[test]
+fn explain_names_an_odometer_scale() {
+    let dir = tmp("scale");
+    let sim = simulated(&dir, |t| {
+        t.replace(
+            "mount_z = \"1.5 deg\"\n",
+            "mount_z = \"1.5 deg\"\nk_ref = \"20000 ppm\"\n",
+        )
+    });
+    let j = explained(&sim, &dir.join("explain"), &[]);
+    let findings = j["findings"].as_array().unwrap();
+    let k = findings
+        .iter()
+        .find(|f| f["term"] == "k_ref")
+        .unwrap_or_else(|| panic!("k_ref not named: {:#?}", j["summary"]));
+    assert!(is_cause(k), "{}", k["words"]);
+    assert_eq!(k["unit"], "ppm");
+    let est = k["estimate"].as_f64().unwrap();
+    assert!(
+        (est - 20000.0).abs() < 2000.0,
+        "k_ref = {est} ppm for 20000"
+    );
+    for f in findings {
+        let term = f["term"].as_str().unwrap();
+        if !["k_ref", "mount_y", "mount_z"].contains(&term) {
+            assert!(!is_cause(f), "named beside the scale: {}", f["words"]);
+        }
+    }
+}
+
 /// The mounting withheld from the candidates: what fits in its place is not named as a cause.
 #[test]
 fn a_withheld_mounting_gives_no_confident_finding() {
@@ -307,8 +396,55 @@ fn bad_reference_input_is_refused_with_the_likely_slip() {
         e.contains("mount_z") && e.contains("--body-velocity"),
         "{e}"
     );
+    // explain: a prior on a reference term without a reference would be ignored
+    let (ok, _, e) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P13+vertical",
+        "--imu",
+        &p("imu.txt"),
+        "--aid",
+        &p("gnss.txt"),
+        "--truth",
+        &p("truth.txt"),
+        "--prior",
+        "mount_z=1 deg",
+        "--out",
+        dir.join("e").to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && e.contains("mount_z") && e.contains("would be ignored"),
+        "{e}"
+    );
     let e = run("P13", Some(&p("reference.txt")));
     assert!(e.contains("+vertical"), "{e}");
+    // rows on another clock (GPS seconds), or in ms: they miss the GNSS fixes' times
+    let rows = |f: &dyn Fn(f64) -> f64| -> String {
+        std::fs::read_to_string(sim.join("reference.txt"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| {
+                let (t, rest) = l.split_once(' ').unwrap();
+                format!("{} {rest}\n", f(t.parse().unwrap()))
+            })
+            .collect()
+    };
+    for (name, shift) in [
+        ("gps.txt", &(|t: f64| t + 1.4e9) as &dyn Fn(f64) -> f64),
+        ("ms.txt", &|t: f64| t * 1000.0),
+    ] {
+        let f = dir.join(name);
+        std::fs::write(&f, rows(shift)).unwrap();
+        let e = run("P13+vertical", Some(f.to_str().unwrap()));
+        assert!(
+            e.contains("GNSS fixes' times") && e.contains("another clock"),
+            "{e}"
+        );
+    }
+    // the position aiding file given as the reference
+    let e = run("P13+vertical", Some(&p("gnss.txt")));
+    assert!(e.contains("position aiding file"), "{e}");
     let cms = dir.join("cms.txt");
     std::fs::write(&cms, "0.1 10 0 0 5\n").unwrap();
     let e = run("P13+vertical", Some(cms.to_str().unwrap()));

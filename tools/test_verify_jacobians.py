@@ -89,6 +89,11 @@ class MisprintsAreCaught(unittest.TestCase):
         self.assertEqual(code, 1, f"reversed attitude convention not caught:\n{out}")
         self.assertIn("H[vel_body]", out, f"wrong entry named:\n{out}")
 
+    def test_reference_time_offset_without_frame_rate_is_named(self):
+        code, out = run("--corrupt", "14", "--models", "P13+vertical+dt_ref")
+        self.assertEqual(code, 1, f"missing frame rate not caught:\n{out}")
+        self.assertIn("][dt_ref]:", out, f"wrong entry named:\n{out}")
+
     def test_every_spec_term_is_checked_by_default(self):
         models = vj.default_models()
         named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}

@@ -182,8 +182,11 @@ GNSS_PHYSICS = {
 # Velocity-reference terms, written independently of the spec: the reference (odometer, DVL)
 # measures the velocity in its own frame r, whose attitude against the IMU body frame is the
 # rotation of roll, pitch, yaw (mount_x, mount_y, mount_z): C_r^b = dcm_from_euler(mount), and
-# it reads v^r = (C_r^b)^T v^b.
-REFERENCE_PHYSICS = {"mount_x": 0, "mount_y": 1, "mount_z": 2}
+# it reads v^r = (C_r^b)^T v^b; ("time_offset",): the row stamped t is v^b at t + theta [s]
+# (the body velocity's rate from the true navigation equations); ("scale",): its forward reading
+# is (1 + theta) times the true one.
+REFERENCE_PHYSICS = {"mount_x": ("mount", 0), "mount_y": ("mount", 1), "mount_z": ("mount", 2),
+                     "dt_ref": ("time_offset",), "k_ref": ("scale",)}
 
 
 def load_spec_terms(spec_dir=SPEC_DIR):
@@ -334,12 +337,23 @@ def build_jacobian_function():
     v_arm = c @ ca.cross(w_b, arm)
     # the velocity reference: computed body velocity (C~^T (v + dv)) minus its reading
     mount = [0, 0, 0]
+    dt_ref = 0
+    scale = 0
     for k, name in enumerate(TERM_NAMES):
         if TERMS[name][0] == "reference":
-            mount[REFERENCE_PHYSICS[name]] = mount[REFERENCE_PHYSICS[name]] + theta[k]
+            kind = REFERENCE_PHYSICS[name]
+            if kind[0] == "mount":
+                mount[kind[1]] = mount[kind[1]] + theta[k]
+            elif kind[0] == "scale":
+                scale = scale + theta[k]
+            else:
+                dt_ref = dt_ref + theta[k]
     c_rb = dcm_from_euler(mount[0], mount[1], mount[2])
     v_b = c.T @ v
-    z_body = c_tilde.T @ (v + dv) - c_rb.T @ v_b
+    v_b_rate = cd_t.T @ v + c.T @ vd_t
+    reading = c_rb.T @ (v_b + dt_ref * v_b_rate)
+    reading[0] = (1 + scale) * reading[0]
+    z_body = c_tilde.T @ (v + dv) - reading
     z = ca.vertcat(dv[0] - dt * vd_t[0] - v_arm[0],
                    dv[1] - dt * vd_t[1] - v_arm[1],
                    (rm0 + h) * (dlat - dt * latd_t) - c_arm[0],
@@ -402,6 +416,15 @@ def corrupt(kind, out, pt):
         for r in range(3):
             for s in ("phi_n", "phi_e", "phi_d"):
                 out["h"]["vel_body"][r][idx[s]] = -out["h"]["vel_body"][r][idx[s]]
+    elif kind == 14 and "vel_body" in out["h"] and "dt_ref" in idx:
+        # a reference time offset without the navigation frame's rate (earth and transport)
+        cm = np.array(dcm_from_euler(*[math.radians(e) for e in pt["euler_deg"]]))
+        v = np.array(pt["v_ned"], dtype=float)
+        w_in = np.array([OMEGA * c + ve / rn, -pt["v_ned"][0] / (rm0 + pt["h_m"]),
+                         -OMEGA * s - ve * math.tan(lat) / rn])
+        extra = cm.T @ np.cross(w_in, v)
+        for r in range(3):
+            out["h"]["vel_body"][r][idx["dt_ref"]] += float(extra[r])
     elif kind == 11 and "tau_y" in idx:
         # an accelerometer delay with its sign reversed (a lead taken for a lag)
         for k, row in enumerate(["dv_n", "dv_e", "dv_d"]):
@@ -570,7 +593,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed, 12: a reference mounting's yaw reversed in H[vel_body], 13: the attitude error's sign reversed in H[vel_body]; the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed, 12: a reference mounting's yaw reversed in H[vel_body], 13: the attitude error's sign reversed in H[vel_body], 14: a reference time offset's H without the navigation frame's rate; the check must fail")
     args = ap.parse_args()
 
     models = args.models or default_models()

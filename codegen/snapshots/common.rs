@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 67;
+pub const TERM_COUNT: usize = 69;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -1144,6 +1144,36 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         doc: "velocity reference mounting yaw against the IMU body frame (small angle)",
         library: true,
     },
+    TermInfo {
+        name: "dt_ref",
+        sensor: Sensor::Reference,
+        axis: 0,
+        regressor: 0,
+        unit: "s",
+        display: "ms",
+        display_to_si: 0.001,
+        sigma: 0.1,
+        noise: 0.0,
+        limit: 1.0,
+        group: "reference time offset",
+        doc: "velocity reference time offset: the row stamped t is the body velocity at t + dt_ref",
+        library: true,
+    },
+    TermInfo {
+        name: "k_ref",
+        sensor: Sensor::Reference,
+        axis: 0,
+        regressor: 0,
+        unit: "1",
+        display: "ppm",
+        display_to_si: 1e-6,
+        sigma: 0.01,
+        noise: 0.0,
+        limit: 0.19999999999999998,
+        group: "reference scale",
+        doc: "velocity reference forward scale factor: it reads (1 + k_ref) times the forward velocity",
+        library: true,
+    },
 ];
 
 /// Structural non-zeros of the full navigation block.
@@ -1252,6 +1282,8 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[],
+    &[],
     &[],
     &[],
     &[],
@@ -1438,6 +1470,8 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.017453292519943295,
             0.017453292519943295,
             0.017453292519943295,
+            0.1,
+            0.01,
         ],
     },
     GradeInfo {
@@ -1526,6 +1560,8 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.017453292519943295,
             0.017453292519943295,
             0.017453292519943295,
+            0.1,
+            0.01,
         ],
     },
 ];
@@ -2427,6 +2463,12 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
         66 => {
             // mount_z: Reference x axis, regressor 1
         }
+        67 => {
+            // dt_ref: Reference x axis, regressor 1
+        }
+        68 => {
+            // k_ref: Reference x axis, regressor 1
+        }
         _ => panic!("term index {term} out of range"),
     }
 }
@@ -2562,9 +2604,13 @@ pub fn measurement_entries(
             emit(0, "lever_z", c33);
         }
         3 => {
+            let lat = nav.lat;
             let vn = nav.v_ned[0];
             let ve = nav.v_ned[1];
             let vd = nav.v_ned[2];
+            let rm = nav.rm;
+            let rn = nav.rn;
+            let omega = nav.omega;
             let c11 = nav.c[0][0];
             let c12 = nav.c[0][1];
             let c13 = nav.c[0][2];
@@ -2574,6 +2620,12 @@ pub fn measurement_entries(
             let c31 = nav.c[2][0];
             let c32 = nav.c[2][1];
             let c33 = nav.c[2][2];
+            let w_x = nav.w_b[0];
+            let w_y = nav.w_b[1];
+            let w_z = nav.w_b[2];
+            let ai_n = nav.a_step[0];
+            let ai_e = nav.a_step[1];
+            let ai_d = nav.a_step[2];
             emit(0, "phi_n", c31 * ve - c21 * vd);
             emit(0, "phi_e", c11 * vd - c31 * vn);
             emit(0, "phi_d", c21 * vn - c11 * ve);
@@ -2582,6 +2634,21 @@ pub fn measurement_entries(
             emit(0, "dv_d", c31);
             emit(0, "mount_y", c13 * vn + c23 * ve + c33 * vd);
             emit(0, "mount_z", -(c12 * vn + c22 * ve + c32 * vd));
+            emit(
+                0,
+                "dt_ref",
+                -(c11 * ai_n + c21 * ai_e + c31 * ai_d
+                    - (w_y * (c13 * vn + c23 * ve + c33 * vd)
+                        - w_z * (c12 * vn + c22 * ve + c32 * vd))
+                    + c11
+                        * ((-vn / rm) * vd
+                            - (-omega * lat.sin() - ve * lat.tan() / rn) * ve)
+                    + c21
+                        * ((-omega * lat.sin() - ve * lat.tan() / rn) * vn
+                            - (omega * lat.cos() + ve / rn) * vd)
+                    + c31 * ((omega * lat.cos() + ve / rn) * ve - (-vn / rm) * vn)),
+            );
+            emit(0, "k_ref", -(c11 * vn + c21 * ve + c31 * vd));
             emit(1, "phi_n", c32 * ve - c22 * vd);
             emit(1, "phi_e", c12 * vd - c32 * vn);
             emit(1, "phi_d", c22 * vn - c12 * ve);
@@ -2590,6 +2657,20 @@ pub fn measurement_entries(
             emit(1, "dv_d", c32);
             emit(1, "mount_x", -(c13 * vn + c23 * ve + c33 * vd));
             emit(1, "mount_z", c11 * vn + c21 * ve + c31 * vd);
+            emit(
+                1,
+                "dt_ref",
+                -(c12 * ai_n + c22 * ai_e + c32 * ai_d
+                    - (w_z * (c11 * vn + c21 * ve + c31 * vd)
+                        - w_x * (c13 * vn + c23 * ve + c33 * vd))
+                    + c12
+                        * ((-vn / rm) * vd
+                            - (-omega * lat.sin() - ve * lat.tan() / rn) * ve)
+                    + c22
+                        * ((-omega * lat.sin() - ve * lat.tan() / rn) * vn
+                            - (omega * lat.cos() + ve / rn) * vd)
+                    + c32 * ((omega * lat.cos() + ve / rn) * ve - (-vn / rm) * vn)),
+            );
             emit(2, "phi_n", c33 * ve - c23 * vd);
             emit(2, "phi_e", c13 * vd - c33 * vn);
             emit(2, "phi_d", c23 * vn - c13 * ve);
@@ -2598,6 +2679,20 @@ pub fn measurement_entries(
             emit(2, "dv_d", c33);
             emit(2, "mount_x", c12 * vn + c22 * ve + c32 * vd);
             emit(2, "mount_y", -(c11 * vn + c21 * ve + c31 * vd));
+            emit(
+                2,
+                "dt_ref",
+                -(c13 * ai_n + c23 * ai_e + c33 * ai_d
+                    - (w_x * (c12 * vn + c22 * ve + c32 * vd)
+                        - w_y * (c11 * vn + c21 * ve + c31 * vd))
+                    + c13
+                        * ((-vn / rm) * vd
+                            - (-omega * lat.sin() - ve * lat.tan() / rn) * ve)
+                    + c23
+                        * ((-omega * lat.sin() - ve * lat.tan() / rn) * vn
+                            - (omega * lat.cos() + ve / rn) * vd)
+                    + c33 * ((omega * lat.cos() + ve / rn) * ve - (-vn / rm) * vn)),
+            );
         }
         _ => panic!("measurement index {m} out of range"),
     }

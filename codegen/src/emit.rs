@@ -35,6 +35,9 @@ fn nav_accessor(sym: &str) -> TokenStream {
         "a_n" => quote!(nav.a_ned[0]),
         "a_e" => quote!(nav.a_ned[1]),
         "a_d" => quote!(nav.a_ned[2]),
+        "ai_n" => quote!(nav.a_step[0]),
+        "ai_e" => quote!(nav.a_step[1]),
+        "ai_d" => quote!(nav.a_step[2]),
         s if s.len() == 3
             && s.starts_with('c')
             && s[1..].chars().all(|c| ('1'..='3').contains(&c)) =>

@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 /// Navigation quantities an A or H expression may use, with what they are (SI units).
 /// The generated code binds each one from `NavPoint` (see `nav_accessor`).
-pub const NAV_SYMBOLS: [(&str, &str); 28] = [
+pub const NAV_SYMBOLS: [(&str, &str); 31] = [
     ("lat", "geodetic latitude [rad]"),
     ("h", "height above the ellipsoid, up [m]"),
     ("vn", "north velocity [m/s]"),
@@ -56,6 +56,18 @@ pub const NAV_SYMBOLS: [(&str, &str); 28] = [
         "a_d",
         "down acceleration, dv/dt over the last second [m/s^2]",
     ),
+    (
+        "ai_n",
+        "north acceleration of the solution over the last filter step, dv/dt [m/s^2]",
+    ),
+    (
+        "ai_e",
+        "east acceleration over the last filter step [m/s^2]",
+    ),
+    (
+        "ai_d",
+        "down acceleration over the last filter step [m/s^2]",
+    ),
 ];
 
 /// Dimension of a navigation symbol (an H entry's unit is checked with it), doubled exponents
@@ -67,7 +79,9 @@ fn nav_symbol_dim(name: &str) -> Option<crate::units::Dim> {
         "h" | "rm" | "rn" => Dim([2, 0, 0]),
         "vn" | "ve" | "vd" => Dim([2, -2, 0]),
         "omega" | "w_x" | "w_y" | "w_z" => crate::units::DIM_RATE,
-        "f_n" | "f_e" | "f_d" | "a_n" | "a_e" | "a_d" => crate::units::DIM_ACCEL,
+        "f_n" | "f_e" | "f_d" | "a_n" | "a_e" | "a_d" | "ai_n" | "ai_e" | "ai_d" => {
+            crate::units::DIM_ACCEL
+        }
         "dg_dlat" => Dim([2, -4, -2]),
         "dg_dh" => Dim([0, -4, 0]),
         c if c.len() == 3 && c.starts_with('c') => crate::units::DIM_ONE,

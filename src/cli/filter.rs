@@ -97,6 +97,15 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
     sinsmodel::data::check_inside(files.errors.len(), inputs.aid.len(), start.t, t_last)?;
+    sinsmodel::data::dataset::check_reference_inside(
+        args.data.body_velocity.as_deref(),
+        run.innovations
+            .iter()
+            .filter(|i| i.meas == "vel_body" && i.component == 0)
+            .count(),
+        start.t,
+        t_last,
+    )?;
     if let Some(w) = files.truth_disagreement() {
         super::data::note(&format!("warning: {w}"));
     }

@@ -304,7 +304,7 @@ const SAME_EPOCH_S: f64 = 1e-6;
 impl<I: Iterator<Item = AidingEpoch>> Iterator for WithBodyVelocity<'_, I> {
     type Item = AidingEpoch;
     fn next(&mut self) -> Option<AidingEpoch> {
-        let row = |b: &BodyVelocityFix| Some((Vector3::from(b.v_frd), b.sigma));
+        let row = |b: &BodyVelocityFix| Some(Box::new((Vector3::from(b.v_frd), b.sigma)));
         match (self.epochs.peek().map(|e| e.t), self.body.first()) {
             (None, None) => None,
             (Some(_), None) => self.epochs.next(),

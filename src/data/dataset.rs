@@ -71,6 +71,25 @@ pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<(
     Ok(())
 }
 
+/// With a `--body-velocity` reference (`path`), at least 10 of its rows must have been used
+/// inside the IMU data (t0, t_last] [s]: `used` were.
+pub fn check_reference_inside(
+    path: Option<&std::path::Path>,
+    used: usize,
+    t0: f64,
+    t_last: f64,
+) -> Result<()> {
+    if let Some(p) = path {
+        if used < 10 {
+            bail!(
+                "--body-velocity {}: only {used} of its rows fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (its times must be on the IMU's clock: GPS seconds against the IMU's, or ms for s?)",
+                p.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Horizontal distance [m] between two positions (lat, lon in rad) on the WGS-84 ellipsoid at
 /// the first one's latitude and height `h` [m] (a local flat approximation: enough to tell the
 /// same place from another town).
@@ -290,6 +309,12 @@ impl DataOptions {
         .take_while(|e| e.t <= t_last + 1e-9)
         .collect();
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
+        check_reference_inside(
+            self.body_velocity.as_deref(),
+            aid.iter().filter(|e| e.body_vel.is_some()).count(),
+            start.t,
+            t_last,
+        )?;
         Ok(PassInputs {
             init_sigma: opened.init_sigma,
             step_s: opened.step_s,
@@ -648,6 +673,10 @@ impl DataOptions {
                 after.len()
             );
         }
+        check_reference_times(path, &after, aid)?;
+        if let Some(w) = sideways_reference(&after) {
+            note(&format!("warning: --body-velocity {}: {w}", path.display()));
+        }
         if let AidPlan::Fixes(fixes, _, _) = aid {
             match reference_speed_ratio(fixes, &after) {
                 Some(r) if !(0.8..=1.25).contains(&r) => bail!(
@@ -724,4 +753,71 @@ fn speed_slip(r: f64) -> &'static str {
     } else {
         "a scale, a clock (UTC for GPST) or another vehicle's file?"
     }
+}
+
+/// The reference's rows against the other aiding: most must fall within the GNSS fixes' times
+/// (else another clock), and under a static aid the reference must not move.
+fn check_reference_times(
+    path: &std::path::Path,
+    rows: &[BodyVelocityFix],
+    aid: &AidPlan,
+) -> Result<()> {
+    let (first, last) = (rows[0].t, rows[rows.len() - 1].t);
+    match aid {
+        AidPlan::Fixes(fixes, _, _) if !fixes.is_empty() => {
+            let (f0, f1) = (fixes[0].0.t, fixes[fixes.len() - 1].0.t);
+            let inside = rows
+                .iter()
+                .filter(|r| r.t >= f0 - 1.0 && r.t <= f1 + 1.0)
+                .count();
+            if 2 * inside < rows.len() {
+                bail!(
+                    "--body-velocity {}: {inside} of its {} rows after the start fall within the GNSS fixes' times (t = {f0:.3} to {f1:.3} s); its rows run t = {first:.3} to {last:.3} s: another clock (GPS seconds against the IMU's, UTC against GPST: 18 s) or ms written as s?",
+                    path.display(),
+                    rows.len()
+                );
+            }
+        }
+        AidPlan::Static { .. } => {
+            let mut speeds: Vec<f64> = rows
+                .iter()
+                .map(|r| nalgebra::Vector3::from(r.v_frd).norm())
+                .collect();
+            speeds.sort_by(f64::total_cmp);
+            let median = speeds[speeds.len() / 2];
+            let sigma = rows[rows.len() / 2].sigma;
+            if median > 3.0 * sigma + 0.05 {
+                bail!(
+                    "--body-velocity {}: the reference moves (median speed {median:.3} m/s against its σ {sigma} m/s) while --static-aid says the vehicle stands still",
+                    path.display()
+                );
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// A reference whose forward component is not the larger part of its speed where it moves
+/// faster than 1 m/s (median |vx| / speed under 0.7): a vehicle moves forward, so its axes are
+/// likely swapped or its velocities NED, not body; the words, or None.
+fn sideways_reference(rows: &[BodyVelocityFix]) -> Option<String> {
+    let mut share: Vec<f64> = rows
+        .iter()
+        .filter_map(|r| {
+            let v = nalgebra::Vector3::from(r.v_frd);
+            (v.norm() > 1.0).then(|| r.v_frd[0].abs() / v.norm())
+        })
+        .collect();
+    if share.len() < 10 {
+        return None;
+    }
+    share.sort_by(f64::total_cmp);
+    let median = share[share.len() / 2];
+    (median < 0.7).then(|| {
+        format!(
+            "where it moves, its forward component vx is a median {:.0} % of its speed: a vehicle moves forward, so its columns may be swapped or its velocities NED instead of body (forward, right, down); a mounting found on it would be the axes' slip",
+            median * 100.0
+        )
+    })
 }

@@ -144,9 +144,10 @@ pub struct DataOptions {
     /// [default: 3].
     #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub init_speed: Option<f64>,
-    /// open (errors estimated only) or closed (fed back).
-    #[cfg_attr(feature = "cli", arg(long, default_value = "open"))]
-    pub mode: String,
+    /// open (errors estimated only) or closed (fed back) [default: open; closed with
+    /// --body-velocity, whose rows open loop would linearise about the free-inertial solution].
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub mode: Option<String>,
     /// Filter step [s] [default: 0.01, or the IMU's median interval when that is longer].
     #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub step: Option<f64>,
@@ -208,7 +209,7 @@ impl DataOptions {
             truth: None,
             init: None,
             init_speed: None,
-            mode: "open".into(),
+            mode: None,
             step: None,
             zupt: None,
             force: false,

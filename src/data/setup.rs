@@ -161,6 +161,15 @@ impl DataOptions {
                 o.map(|o| format!(", with {o}")).unwrap_or_default()
             )),
         }
+        match (&self.body_velocity, self.mode.as_deref()) {
+            (Some(_), None) => lines.push(
+                "mode: closed loop, the default with --body-velocity (its rows are linearised about the aided solution; --mode open would linearise them about the free-inertial one, which biases a mounting and couples it into gyro terms)".into(),
+            ),
+            (Some(_), Some("open")) => lines.push(
+                "warning: --mode open with --body-velocity: the reference's rows are linearised about the free-inertial solution, whose velocity error grows through the run; a mounting comes out biased and gyro terms (kg_33, eps_z) may take part of it; --mode closed avoids this".into(),
+            ),
+            _ => {}
+        }
         for (t, v) in self.known_gnss()? {
             let info = &common::TERMS[t];
             lines.push(format!(
@@ -255,6 +264,21 @@ impl DataOptions {
                     crate::model::did_you_mean(name.trim_end_matches('*'))
                 );
             }
+            // a term of an aiding the run does not have is no candidate: its prior would be
+            // ignored without a word
+            use crate::model::catalog::Sensor;
+            if let Some(t) = common::TERMS.iter().find(|t| t.name == name) {
+                let missing = match t.sensor {
+                    Sensor::Gnss if !self.has_gnss() => Some("a GNSS term; without --aid"),
+                    Sensor::Reference if self.body_velocity.is_none() => {
+                        Some("a velocity reference's term; without --body-velocity")
+                    }
+                    _ => None,
+                };
+                if let (Some(m), false) = (missing, model.names.contains(&name)) {
+                    bail!("--prior `{spec}`: {name} is {m} it is no candidate and the prior would be ignored");
+                }
+            }
         }
         Ok(())
     }
@@ -293,10 +317,13 @@ impl DataOptions {
             priors::apply_grade(model, g, &mut cfg.prior_sigma);
             cfg = cfg.with_sensor_noise(model, g.gyro_arw, g.accel_vrw);
         }
-        cfg.mode = match args.mode.as_str() {
-            "open" => Mode::OpenLoop,
-            "closed" => Mode::ClosedLoop,
-            m => bail!("--mode `{m}`: expected open or closed"),
+        cfg.mode = match args.mode.as_deref() {
+            Some("open") => Mode::OpenLoop,
+            Some("closed") => Mode::ClosedLoop,
+            Some(m) => bail!("--mode `{m}`: expected open or closed"),
+            // a velocity reference's rows hold only to first order about the aided solution
+            None if args.body_velocity.is_some() => Mode::ClosedLoop,
+            None => Mode::OpenLoop,
         };
         cfg.step_s = args.step_given()?.unwrap_or(DEFAULT_STEP_S);
         cfg.known_gnss = args.known_gnss()?;

@@ -217,7 +217,7 @@ fn white_noise_states(model: &Model) -> impl Iterator<Item = (usize, WhiteNoise)
 }
 
 /// One aiding epoch: velocity and/or position with their 1-σ.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct AidingEpoch {
     /// Time [s].
     pub t: f64,
@@ -226,8 +226,8 @@ pub struct AidingEpoch {
     /// Latitude [rad], longitude [rad], height [m] and 1-σ north, east, down [m].
     pub pos: Option<(f64, f64, f64, [f64; 3])>,
     /// Body-frame (FRD) velocity from a reference (odometer, DVL) [m/s] and its 1-σ per
-    /// component.
-    pub body_vel: Option<(Vector3<f64>, f64)>,
+    /// component (boxed: most epochs of a run held in memory have none).
+    pub body_vel: Option<Box<(Vector3<f64>, f64)>>,
 }
 
 /// An innovation of one scalar measurement component.
@@ -416,7 +416,7 @@ pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>,
             (aid.vn, aid.ve, aid.vd, aid.sigma_v) = (v.x, v.y, v.z, sig);
         }
         Aiding::BodyVelocity => {
-            let (v, sig) = ep.body_vel?;
+            let (v, sig) = **ep.body_vel.as_ref()?;
             (aid.vx, aid.vy, aid.vz, aid.sigma_b) = (v.x, v.y, v.z, sig);
         }
     }
@@ -476,6 +476,8 @@ struct Engine<'a> {
     accel: crate::nav::nav_point::AccelWindow,
     in_step: usize,
     step_t0: f64,
+    /// The solution's velocity at the start of the step [m/s] (for the step's acceleration).
+    step_v0: Vector3<f64>,
     /// (model index, term index) of every instrument term.
     terms: Vec<(usize, usize)>,
     /// Model indices of the GNSS terms (they enter H; their closed-loop corrections apply to
@@ -549,6 +551,7 @@ impl<'a> Engine<'a> {
             accel: crate::nav::nav_point::AccelWindow::default(),
             in_step: 0,
             step_t0: start.t,
+            step_v0: start.v,
             terms,
             gnss_terms,
             correction: vec![0.0; n],
@@ -615,6 +618,10 @@ impl<'a> Engine<'a> {
         self.np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
         self.np.set_rate(&(self.w_sum / self.in_step as f64));
         self.np.set_acceleration(&self.accel.push(t, s.v));
+        if step_dt > 0.0 {
+            self.np
+                .set_step_acceleration(&((s.v - self.step_v0) / step_dt));
+        }
         for &(i, j) in self.model.a_pattern() {
             self.a[i * n + j] = 0.0;
         }
@@ -646,6 +653,7 @@ impl<'a> Engine<'a> {
         self.w_sum = Vector3::zeros();
         self.in_step = 0;
         self.step_t0 = t;
+        self.step_v0 = s.v;
     }
 
     /// Sequential scalar updates for every spec measurement the epoch carries, with the
@@ -655,7 +663,7 @@ impl<'a> Engine<'a> {
         let f_ned = Vector3::from(self.np.f_ned);
         let c = s.dcm();
         let mut np = NavPoint::new(s.lat, s.h, s.v, &c, &(c.transpose() * f_ned));
-        (np.w_b, np.a_ned) = (self.np.w_b, self.np.a_ned);
+        (np.w_b, np.a_ned, np.a_step) = (self.np.w_b, self.np.a_ned, self.np.a_step);
         // the epoch is applied at the first sample at or after its time: the navigation state
         // is taken back to the fix time (a GNSS fix between two IMU samples, a jittered clock)
         let s_fix = state_at(&s, ep.t, &f_ned);
@@ -907,6 +915,8 @@ impl<'a> Engine<'a> {
         // C~ = (I − [φ×]) C  ⇒  C = exp([φ×]) C~
         s.q = UnitQuaternion::from_scaled_axis(phi) * s.q;
         s.v -= Vector3::from(dv);
+        // (the step's acceleration is the navigation's, not the correction's jump)
+        self.step_v0 -= Vector3::from(dv);
         s.lat -= dpos[0];
         s.lon -= dpos[1];
         s.h -= dpos[2];
@@ -962,7 +972,7 @@ pub fn run_observed(
     let mut truth = truth.map(TruthSlice::new);
     let mut stream = StreamIo {
         samples: &mut samples,
-        aiding: &mut aiding.iter().copied(),
+        aiding: &mut aiding.iter().cloned(),
         truth: truth.as_mut().map(|t| t as &mut dyn TruthLookup),
     };
     match run_stream(
@@ -1217,5 +1227,6 @@ fn joseph_update(
 }
 
 pub use super::metrics::{
-    channel_name, channel_str, model_error_rms_arcsec, nis_by_channel, ChannelNis,
+    channel_id, channel_name, channel_str, channels, model_error_rms_arcsec, nis_by_channel,
+    ChannelNis,
 };

@@ -140,6 +140,30 @@ pub fn channel_str(meas: &'static str, component: usize) -> &'static str {
         .map_or("?", |x| x.2)
 }
 
+/// Every channel of the spec's measurements ([`channel_str`] of each component), in spec order:
+/// an innovation kept for a plot holds its index here, not its name.
+pub fn channels() -> &'static [&'static str] {
+    static LIST: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    LIST.get_or_init(|| {
+        let mut out: Vec<&'static str> = Vec::new();
+        for m in crate::model::generated::common::MEASUREMENTS.iter() {
+            for c in 0..m.rows.len() {
+                let name = channel_str(m.name, c);
+                if !out.contains(&name) {
+                    out.push(name);
+                }
+            }
+        }
+        out
+    })
+}
+
+/// The index in [`channels`] of measurement `meas`'s component `component`.
+pub fn channel_id(meas: &'static str, component: usize) -> u16 {
+    let name = channel_str(meas, component);
+    channels().iter().position(|c| *c == name).unwrap_or(0) as u16
+}
+
 /// Mean normalised innovation squared (NIS) of one scalar channel against what a consistent
 /// filter gives (1, with the 95 % band of the mean of `count` χ²₁ values).
 #[derive(Debug, Clone, serde::Serialize)]

@@ -63,11 +63,18 @@ pub fn run_hidden_on(
         start: sim.start,
     };
     // the filter is told the case's stated noise (a noise case states one level wrongly)
-    let stated = |m: &Model| match case.stated_noise {
-        Some([arw, vrw, grw, arw_bias]) => FilterConfig::new(m)
-            .with_sensor_noise(m, arw, vrw)
-            .with_bias_random_walk(m, grw, arw_bias),
-        None => FilterConfig::new(m),
+    // (closed loop with a velocity reference, as the command line runs it)
+    let stated = |m: &Model| {
+        let mut c = match case.stated_noise {
+            Some([arw, vrw, grw, arw_bias]) => FilterConfig::new(m)
+                .with_sensor_noise(m, arw, vrw)
+                .with_bias_random_walk(m, grw, arw_bias),
+            None => FilterConfig::new(m),
+        };
+        if sim.body_velocity.is_some() {
+            c.mode = crate::estimate::filter::Mode::ClosedLoop;
+        }
+        c
     };
     let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(stated(m)) };
     let mut opts = opts.clone();

@@ -233,6 +233,10 @@ pub fn aiding_from_truth(
             body_vel: None,
         });
     }
+    // the simulation's velocity reference (a scenario with `[reference]`), as written
+    if let Some(body) = &sim.body_velocity {
+        out = crate::data::aid::with_body_velocity(out.into_iter(), body).collect();
+    }
     Ok(out)
 }
 

@@ -285,12 +285,12 @@ pub struct Explanation {
     pub baseline_priors_widened: bool,
     /// 2Δ log-likelihood of the baseline with the widened priors over the priors as given.
     pub baseline_priors_gain: Option<f64>,
-    /// Normalised innovations (t, channel, ν/√S) of the baseline and extended passes, for plots.
+    /// Normalised innovations of the baseline and extended passes, for plots.
     #[serde(skip)]
-    pub innovations_before: Vec<(f64, &'static str, f64)>,
+    pub innovations_before: Vec<Normalised>,
     /// Same for the extended pass.
     #[serde(skip)]
-    pub innovations_after: Vec<(f64, &'static str, f64)>,
+    pub innovations_after: Vec<Normalised>,
     /// Model error series (t [s], e_n, e_e [arcsec]) before and after (with truth).
     #[serde(skip)]
     pub model_error_before: Vec<(f64, f64, f64)>,
@@ -531,5 +531,33 @@ impl Consistency {
                 )
             }
         })
+    }
+}
+
+/// One normalised innovation kept for a plot: time, ν/√S and its channel (an index, not a
+/// name: a run keeps one per scalar update).
+#[derive(Debug, Clone, Copy)]
+pub struct Normalised {
+    /// Time [s].
+    pub t: f64,
+    /// ν/√S (1 = as predicted).
+    pub nu: f64,
+    /// Index into [`crate::estimate::filter::channels`].
+    channel: u16,
+}
+
+impl Normalised {
+    /// The normalised innovation of measurement `meas`'s `component` at `t` [s].
+    pub fn new(t: f64, meas: &'static str, component: usize, nu: f64) -> Normalised {
+        Normalised {
+            t,
+            nu,
+            channel: crate::estimate::filter::channel_id(meas, component),
+        }
+    }
+
+    /// Its channel: `vel_n`, `pos_e`, `vel_bx`, ….
+    pub fn channel(&self) -> &'static str {
+        crate::estimate::filter::channels()[self.channel as usize]
     }
 }

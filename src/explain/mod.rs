@@ -38,12 +38,12 @@ pub use diagnostics::{
 };
 pub use findings::{
     CandidateTest, Consistency, EquivalentTerm, Explanation, Finding, Gain, GroupEstimate,
-    Implausible, TightPrior,
+    Implausible, Normalised, TightPrior,
 };
 pub use selection::prior_sigma;
 pub use words::{finding_line, separation_hint, share_percent, sig3, verdict};
 
-use crate::estimate::filter::{self, channel_str, AidingEpoch, FilterConfig, FilterRun};
+use crate::estimate::filter::{self, AidingEpoch, FilterConfig, FilterRun};
 use crate::estimate::stats;
 use crate::io::imu::ImuData;
 use crate::io::truth::TruthRow;
@@ -339,7 +339,7 @@ fn run_pass(
     let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
     let mut io = filter::StreamIo {
         samples: &mut *samples,
-        aiding: &mut data.aid.iter().copied(),
+        aiding: &mut data.aid.iter().cloned(),
         truth: truth
             .as_mut()
             .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
@@ -374,16 +374,7 @@ pub fn explain(
     opts: &ExplainOptions,
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Explanation> {
-    // a velocity reference's mounting is a candidate only where the data hold that reference
-    // and the baseline forms its measurement (else it would be listed as untestable noise)
-    let reference = data.aid.iter().any(|e| e.body_vel.is_some())
-        && baseline.measurements().iter().any(|m| m.name == "vel_body");
-    let cands: Vec<usize> = cands
-        .iter()
-        .copied()
-        .filter(|&t| !baseline.states.contains(&StateRef::Term(t)))
-        .filter(|&t| reference || common::TERMS[t].sensor != Sensor::Reference)
-        .collect();
+    let cands = candidates_here(baseline, cands, data);
     let first = Context {
         baseline,
         data,
@@ -484,6 +475,8 @@ pub fn explain(
     }
     mark_passed_over(&mut findings, &stand_ins, &passed_over);
     companions_move(ctx, &r, &tests, &mut findings, progress)?;
+    aiding_and_sensor_confounded(ctx, &r, &mut findings, progress)?;
+    value_not_fixed(&mut findings);
     findings.extend(noise_findings);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
@@ -654,6 +647,98 @@ fn companions_move(
             sig3(gain)
         );
         not_named(f, why);
+    }
+    Ok(())
+}
+
+/// The candidates `cands` that are not in `baseline` and that these data can show: a velocity
+/// reference's terms only where the data hold that reference and the baseline forms its
+/// measurement (else they would be listed as untestable).
+fn candidates_here(baseline: &Model, cands: &[usize], data: &ExplainData) -> Vec<usize> {
+    let reference = data.aid.iter().any(|e| e.body_vel.is_some())
+        && baseline.measurements().iter().any(|m| m.name == "vel_body");
+    cands
+        .iter()
+        .copied()
+        .filter(|&t| !baseline.states.contains(&StateRef::Term(t)))
+        .filter(|&t| reference || common::TERMS[t].sensor != Sensor::Reference)
+        .collect()
+}
+
+/// A term cause whose value the extended filter leaves within 1σ of zero is no longer named:
+/// the likelihood it added in its round came while the other terms settled (a state with a
+/// wide prior absorbs their transients), not from a value the data fix.
+fn value_not_fixed(findings: &mut [Finding]) {
+    for f in findings
+        .iter_mut()
+        .filter(|f| f.is_cause() && f.kind != "noise")
+    {
+        if f.sigma > 0.0 && f.estimate.abs() < f.sigma {
+            let why = format!(
+                "its value in the extended filter, {} ± {} {}, is within 1σ of zero: the likelihood it added (2Δℓ {}) came while the other terms settled, not from a value the data fix",
+                sig3(f.estimate),
+                sig3(f.sigma),
+                f.unit,
+                sig3(f.two_delta_loglik)
+            );
+            not_named(f, why);
+        }
+    }
+}
+
+/// Largest |correlation| of two causes' estimates in the extended filter at which both stay
+/// named: beyond it the data fix only a combination of the two.
+const MAX_CAUSE_CORRELATION: f64 = 0.9;
+
+/// A cause of the aiding (a time offset, a lever arm, a mounting: it enters H) and a sensor cause
+/// whose estimates the extended model (`r`, one more pass keeping its covariance) correlates
+/// beyond ±0.9 are both no longer named: on this motion an aiding's timing and an
+/// accelerometer's delay (or a lever arm and a sensor term) look alike, and the data fix only
+/// their combination; the words say so with the correlation.
+fn aiding_and_sensor_confounded(
+    ctx: &Context,
+    r: &Rounds,
+    findings: &mut [Finding],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<()> {
+    let causes: Vec<(usize, usize)> = (0..findings.len())
+        .filter(|&k| findings[k].is_cause())
+        .filter_map(|k| Some((k, r.model.index_of(&findings[k].term)?)))
+        .collect();
+    let aids = |k: usize| term_sensor(&findings[k].term).is_some_and(|s| s.enters_h());
+    let mixed = causes.iter().any(|&(k, _)| aids(k)) && causes.iter().any(|&(k, _)| !aids(k));
+    if !mixed {
+        return Ok(());
+    }
+    let mut cfg = ctx.extended_config(&r.model, &r.widened)?;
+    cfg.keep_covariance = true;
+    let round = r.rounds + 1;
+    let pass = run_pass(&r.model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
+    let Some(p) = pass.run.records.last().and_then(|l| l.cov.clone()) else {
+        return Ok(());
+    };
+    let n = r.model.n();
+    let mut why: Vec<(usize, String)> = Vec::new();
+    for &(a, i) in causes.iter().filter(|&&(k, _)| aids(k)) {
+        for &(b, j) in causes.iter().filter(|&&(k, _)| !aids(k)) {
+            let rho = p[i * n + j] / (p[i * n + i] * p[j * n + j]).sqrt();
+            if rho.is_nan() || rho.abs() <= MAX_CAUSE_CORRELATION {
+                continue;
+            }
+            for (k, other) in [(a, b), (b, a)] {
+                why.push((
+                    k,
+                    format!(
+                        "the data cannot separate it from {} (their estimates correlate {} in the extended filter): an aiding's timing, lever arm or mounting and a sensor term act alike on this motion, and either may take the whole effect; a known value of the aiding's (--gnss-delay, --lever-arm, --mounting) or a run that excites them apart decides",
+                        findings[other].term,
+                        sig3(rho)
+                    ),
+                ));
+            }
+        }
+    }
+    for (k, w) in why {
+        not_named(&mut findings[k], w);
     }
     Ok(())
 }
@@ -870,7 +955,7 @@ struct Stage {
     /// What `--truth` contradicts in the baseline's estimate, in words.
     truth_warning: Option<String>,
     base_stats: PassStats,
-    innovations_before: Vec<(f64, &'static str, f64)>,
+    innovations_before: Vec<Normalised>,
     model_error_before: Vec<(f64, f64, f64)>,
     tests: Vec<CandidateTest>,
     not_testable: Vec<String>,
@@ -1497,10 +1582,10 @@ fn regressor_stats(data: &ExplainData, terms: &[usize]) -> anyhow::Result<Vec<Re
         .collect())
 }
 
-fn normalised(run: &FilterRun) -> Vec<(f64, &'static str, f64)> {
+fn normalised(run: &FilterRun) -> Vec<Normalised> {
     run.innovations
         .iter()
-        .map(|i| (i.t, channel_str(i.meas, i.component), i.nu / i.s.sqrt()))
+        .map(|i| Normalised::new(i.t, i.meas, i.component, i.nu / i.s.sqrt()))
         .collect()
 }
 

@@ -648,9 +648,14 @@ fn noise_finding(
         1 => Some(("≥", "larger", "at least")),
         _ => None,
     };
+    // a body-frame reference's rows are no fixes
+    let states = match f.level {
+        Level::Sigma(m) if m.ends_with("_body") => "the σ the reference's rows state",
+        _ => "the σ the fixes state",
+    };
     let words = match (bound, f.level) {
         (Some((cmp, way, _)), Level::Sigma(_)) => format!(
-            "the data show {what} at the search bound ({cmp} {}× the σ the fixes state; the likelihood still rises towards {way} values, so no estimate or interval; 2Δℓ {})",
+            "the data show {what} at the search bound ({cmp} {}× {states}; the likelihood still rises towards {way} values, so no estimate or interval; 2Δℓ {})",
             sig3(f.scale),
             sig3(f.two_delta_loglik)
         ),
@@ -662,7 +667,7 @@ fn noise_finding(
             sig3(f.two_delta_loglik)
         ),
         (None, Level::Sigma(_)) => format!(
-            "the data show {what} {}× the σ the fixes state (95 % interval {}–{}×; 2Δℓ {})",
+            "the data show {what} {}× {states} (95 % interval {}–{}×; 2Δℓ {})",
             sig3(f.scale),
             sig3(lo),
             sig3(hi),

@@ -312,6 +312,17 @@ fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> (S
         f.unit,
     );
     let mut s = format!("{headline} (extended filter; {})", info.doc);
+    if info.sensor == Sensor::Reference && info.unit == "rad" {
+        // the data cannot tell a reference turned by +m from one whose axis is written negated
+        s.push_str(&format!(
+            "; the angle of the reference's axes against the IMU's, both read as forward-right-down: a reference file whose {} column has the other sign gives the same data with the angle's sign reversed",
+            match info.name {
+                "mount_y" => "vz",
+                "mount_z" => "vy",
+                _ => "vy or vz",
+            }
+        ));
+    }
     if !f.equivalent.is_empty() {
         let others: Vec<String> = f
             .equivalent_estimates

@@ -255,7 +255,17 @@ const MAX_REFERENCE_SPEED: f64 = 300.0;
 /// increasing, speeds within ±300 m/s, σ in [1e-4, 2] m/s; each error names the line and the
 /// likely slip.
 pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
-    let rows = read_table(path, 5, "body-velocity reference file")?;
+    let rows = read_table(path, 5, "body-velocity reference file").map_err(|e| {
+        // a GNSS aiding file given here is the likeliest slip
+        if e.to_string().contains("found 7") || e.to_string().contains("found 11") {
+            e.context(format!(
+                "{}: 7 or 11 columns is the layout of a position aiding file (--aid); --body-velocity takes `t vx vy vz sigma` in the body frame",
+                path.display()
+            ))
+        } else {
+            e
+        }
+    })?;
     if rows.is_empty() {
         bail!(
             "{}: the body-velocity reference file has no data rows ({BODY_VELOCITY_COLUMNS})",

@@ -140,6 +140,7 @@ impl PointSpec {
         let g = Vector3::new(0.0, 0.0, crate::nav::earth::gravity(lat, h));
         let a = c * Vector3::from(self.f_b) + g - (2.0 * w_ie + w_en).cross(&v);
         np.set_acceleration(&a);
+        np.set_step_acceleration(&a);
         np
     }
 }

@@ -34,6 +34,9 @@ pub struct NavPoint {
     /// until set with [`NavPoint::set_acceleration`]): smooth where the specific force
     /// vibrates.
     pub a_ned: [f64; 3],
+    /// Acceleration of the navigation solution in NED over the last filter step, dv/dt [m/s²]
+    /// (zero until set with [`NavPoint::set_step_acceleration`]): prompt, not smoothed.
+    pub a_step: [f64; 3],
 }
 
 impl NavPoint {
@@ -49,9 +52,9 @@ impl NavPoint {
         f_b: &Vector3<f64>,
     ) {
         if (lat - self.lat).abs() > 1e-9 || (h - self.h).abs() > 1e-3 {
-            let (w_b, a_ned) = (self.w_b, self.a_ned);
+            let (w_b, a_ned, a_step) = (self.w_b, self.a_ned, self.a_step);
             *self = NavPoint::new(lat, h, v_ned, c_bn, f_b);
-            (self.w_b, self.a_ned) = (w_b, a_ned);
+            (self.w_b, self.a_ned, self.a_step) = (w_b, a_ned, a_step);
             return;
         }
         let f_n = c_bn * f_b;
@@ -93,6 +96,7 @@ impl NavPoint {
             dg_dh: earth::gravity_dh(lat, h),
             w_b: [0.0; 3],
             a_ned: [0.0; 3],
+            a_step: [0.0; 3],
         }
     }
 
@@ -100,6 +104,12 @@ impl NavPoint {
     /// point's H entries may use.
     pub fn set_acceleration(&mut self, a: &Vector3<f64>) {
         self.a_ned = [a.x, a.y, a.z];
+    }
+
+    /// Sets the navigation-frame acceleration over the last filter step [m/s²] (NED, dv/dt)
+    /// the point's H entries may use.
+    pub fn set_step_acceleration(&mut self, a: &Vector3<f64>) {
+        self.a_step = [a.x, a.y, a.z];
     }
 
     /// Sets the body angular rate w^b_ib [rad/s] (FRD) the point's H entries may use.

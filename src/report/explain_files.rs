@@ -93,8 +93,9 @@ fn innovations(
         ),
     ] {
         let mut channels: Vec<&str> = Vec::new();
-        for (_, c, _) in series.iter() {
-            if !channels.contains(c) {
+        for n in series.iter() {
+            let c = n.channel();
+            if !channels.contains(&c) {
                 channels.push(c);
             }
         }
@@ -104,8 +105,8 @@ fn innovations(
                 label: c.to_string(),
                 points: series
                     .iter()
-                    .filter(|(_, ch, _)| ch == c)
-                    .map(|(t, _, v)| (*t - t_ref, *v))
+                    .filter(|n| n.channel() == *c)
+                    .map(|n| (n.t - t_ref, n.nu))
                     .collect(),
             })
             .collect();

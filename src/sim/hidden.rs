@@ -15,6 +15,16 @@ pub const GROUPS: [&str; 7] = ["d", "kaq", "kas", "kao", "kgf", "kgq", "size"];
 /// step's specific force, which vibration faster than the offset would not average.
 pub const GNSS_GROUPS: [&str; 3] = ["gnss_time", "gnss_time_kgf", "gnss_lever"];
 
+/// Groups of a body-frame velocity reference's mounting (an odometer or DVL at 10 Hz, σ 0.05
+/// m/s) on the drive of the GNSS cases: its pitch and yaw against the IMU (`mount_y`,
+/// `mount_z`, each 0.2–2° times `effect`, either sign), alone (`reference_mount`) or with a
+/// gyro g-sensitivity kgf_yx beside it (`reference_mount_kgf`, as in `gnss_time_kgf`); and the
+/// reference's time offset (`dt_ref`, 20–300 ms times `effect`, either sign) with its yaw
+/// mounting (`reference_time`). The baseline has the vertical channel (the reference's rows
+/// need it).
+pub const REFERENCE_GROUPS: [&str; 3] =
+    ["reference_mount", "reference_mount_kgf", "reference_time"];
+
 /// Groups hidden on a turntable (a multi-position rotation sequence at rest, static aiding): an
 /// accelerometer's off-axis inner lever arm (`size_i_j`, 20–60 mm times `effect`), seen in
 /// the tangential kicks as a rotation starts and stops and in the centripetal terms.
@@ -406,6 +416,9 @@ fn draw_one(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
         "d" | "kaq" | "kas" | "kao" | "kgq" | "size" => draw_vibrated(g, rng, d, p),
         "kgf" => draw_kgf(rng, d, p),
         "gnss_time" | "gnss_time_kgf" | "gnss_lever" => draw_gnss(g, rng, d, p),
+        "reference_mount" | "reference_mount_kgf" | "reference_time" => {
+            draw_reference(g, rng, d, p)
+        }
         "inner_lever" | "accel_delay" | "inner_lever_delay" => draw_turntable(g, rng, d, p),
         g if NOISE_GROUPS.contains(&g) => draw_noise(g, rng, d, p),
         other => panic!("unknown group {other}"),
@@ -541,6 +554,35 @@ fn draw_gnss(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
     }
 }
 
+/// A velocity reference's mounting of group `g` on a drive: pitch and yaw (and kgf_yx beside
+/// them in `reference_mount_kgf`).
+fn draw_reference(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
+    p.segments = drive_segments(d.seconds);
+    p.baseline = "P31+vertical".into();
+    if g == "reference_time" {
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        // 20–300 ms
+        p.hidden.push((
+            "dt_ref".into(),
+            sgn * d.effect * (0.02 + 0.28 * rng.uniform()),
+        ));
+    }
+    let mounts: &[&str] = if g == "reference_time" {
+        &["mount_z"]
+    } else {
+        &["mount_y", "mount_z"]
+    };
+    for &name in mounts {
+        let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        // 0.2–2°
+        let deg = sgn * d.effect * (0.2 + 1.8 * rng.uniform());
+        p.hidden.push((name.into(), deg.to_radians()));
+    }
+    if g == "reference_mount_kgf" {
+        p.hidden.push(("kgf_yx".into(), 3.0 * d.effect_si_gyro));
+    }
+}
+
 /// A noise level of group `g` (white noise or bias random walk) stated wrongly on a drive (and
 /// kgf_yx beside it in `noise_accel_kgf`).
 fn draw_noise(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
@@ -653,7 +695,7 @@ fn assemble(
     // (from the truth rows) at 10 Hz sees the kicks of each rotation
     let (imu_rate, truth_rate) = if TURNTABLE_GROUPS.contains(&group.as_str()) {
         ("200.0", "10.0")
-    } else if NOISE_GROUPS.contains(&group.as_str()) {
+    } else if NOISE_GROUPS.contains(&group.as_str()) || REFERENCE_GROUPS.contains(&group.as_str()) {
         // a drive without vibration: 200 Hz samples its manoeuvres
         ("200.0", "1.0")
     } else {
@@ -674,13 +716,25 @@ fn assemble(
             )
         }
     };
+    let reference = if REFERENCE_GROUPS.contains(&group.as_str()) {
+        "[reference]\nrate_hz = 10.0\nsigma = \"0.05 m/s\"\n"
+    } else {
+        ""
+    };
     let scenario = format!(
         "name = \"hidden-{group}-{seed}\"\nimu_rate_hz = {imu_rate}\ntruth_rate_hz = {truth_rate}\nseed = {seed}\n\
-         [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}{noise}"
+         [start]\nlat_deg = {lat:.3}\nlon_deg = 112.0\n{segments}{vib}{errors}{noise}{reference}"
     );
     // g-sensitivities of several deg/h/g belong to a MEMS-class gyro, not to the spec's laser
     // gyro (0.01 deg/h/g): the case declares that class, as a user would with --prior
-    let priors = if ["kgf", "gnss_time_kgf", "noise_accel_kgf"].contains(&group.as_str()) {
+    let priors = if [
+        "kgf",
+        "gnss_time_kgf",
+        "noise_accel_kgf",
+        "reference_mount_kgf",
+    ]
+    .contains(&group.as_str())
+    {
         // 10 deg/h/g; a MEMS gyro's 200 deg/h/g beside MEMS noise
         let dhg = if group == "noise_accel_kgf" {
             200.0
