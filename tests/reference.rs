@@ -73,6 +73,31 @@ fn is_cause(f: &serde_json::Value) -> bool {
     f["stand_in"].is_null() && f["not_attributed"].is_null()
 }
 
+/// The finding of `term` in explain's JSON `j`, named as a cause (else the test fails with the
+/// summary), and its estimate (display unit).
+fn named_cause(j: &serde_json::Value, term: &str) -> f64 {
+    let f = j["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["term"] == term)
+        .unwrap_or_else(|| panic!("{term} not among the findings: {:#?}", j["summary"]));
+    assert!(is_cause(f), "{term}: {}", f["words"]);
+    f["estimate"].as_f64().unwrap()
+}
+
+/// No finding in `j` is a cause except those of `allowed` (`what`: the case, for the message).
+fn no_other_cause(j: &serde_json::Value, allowed: &[&str], what: &str) {
+    for f in j["findings"].as_array().unwrap() {
+        let term = f["term"].as_str().unwrap();
+        assert!(
+            allowed.contains(&term) || !is_cause(f),
+            "{what}: named {}",
+            f["words"]
+        );
+    }
+}
+
 /// The mounting's pitch and yaw are named as causes within 10 % of the truth, with kind
 /// `measurement`; no sensor term or noise level is named as a cause.
 #[test]
@@ -80,26 +105,20 @@ fn explain_names_a_reference_mounting_and_no_sensor_term() {
     let dir = tmp("named");
     let sim = simulated(&dir, |t| t);
     let j = explained(&sim, &dir.join("explain"), &[]);
-    let findings = j["findings"].as_array().unwrap();
     for (name, truth) in [("mount_y", 0.5), ("mount_z", 1.5)] {
-        let f = findings
-            .iter()
-            .find(|f| f["term"] == name)
-            .unwrap_or_else(|| panic!("{name} not among the findings: {:#?}", j["summary"]));
-        assert!(is_cause(f), "{name}: {}", f["words"]);
-        assert_eq!(f["kind"], "measurement");
-        assert_eq!(f["unit"], "deg");
-        let est = f["estimate"].as_f64().unwrap();
+        let est = named_cause(&j, name);
         assert!(
             (est - truth).abs() < 0.1 * truth,
             "{name} = {est} deg for {truth}"
         );
     }
-    for f in findings {
-        if f["term"] != "mount_y" && f["term"] != "mount_z" {
-            assert!(!is_cause(f), "named beside the mounting: {}", f["words"]);
+    for f in j["findings"].as_array().unwrap() {
+        if f["term"].as_str().unwrap().starts_with("mount_") {
+            assert_eq!(f["kind"], "measurement");
+            assert_eq!(f["unit"], "deg");
         }
     }
+    no_other_cause(&j, &["mount_y", "mount_z"], "beside the mounting");
 }
 
 /// The reference's rows stamped 0.1 s late (a latency, as odometers on a vehicle bus have): its
@@ -143,20 +162,9 @@ fn explain_names_a_late_reference() {
     assert!(ok, "{stderr}");
     let j: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("explain.json")).unwrap()).unwrap();
-    let findings = j["findings"].as_array().unwrap();
-    let dt = findings
-        .iter()
-        .find(|f| f["term"] == "dt_ref")
-        .unwrap_or_else(|| panic!("dt_ref not named: {:#?}", j["summary"]));
-    assert!(is_cause(dt), "{}", dt["words"]);
-    let est = dt["estimate"].as_f64().unwrap();
+    let est = named_cause(&j, "dt_ref");
     assert!((est + 100.0).abs() < 10.0, "dt_ref = {est} ms for -100");
-    for f in findings {
-        let term = f["term"].as_str().unwrap();
-        if !["dt_ref", "mount_y", "mount_z"].contains(&term) {
-            assert!(!is_cause(f), "named beside the latency: {}", f["words"]);
-        }
-    }
+    no_other_cause(&j, &["dt_ref", "mount_y", "mount_z"], "beside the latency");
 }
 
 /// A wheel odometer reading 2 % fast (`k_ref = 20000 ppm`, a worn or under-inflated tyre's
@@ -171,24 +179,12 @@ fn explain_names_an_odometer_scale() {
         )
     });
     let j = explained(&sim, &dir.join("explain"), &[]);
-    let findings = j["findings"].as_array().unwrap();
-    let k = findings
-        .iter()
-        .find(|f| f["term"] == "k_ref")
-        .unwrap_or_else(|| panic!("k_ref not named: {:#?}", j["summary"]));
-    assert!(is_cause(k), "{}", k["words"]);
-    assert_eq!(k["unit"], "ppm");
-    let est = k["estimate"].as_f64().unwrap();
+    let est = named_cause(&j, "k_ref");
     assert!(
         (est - 20000.0).abs() < 2000.0,
         "k_ref = {est} ppm for 20000"
     );
-    for f in findings {
-        let term = f["term"].as_str().unwrap();
-        if !["k_ref", "mount_y", "mount_z"].contains(&term) {
-            assert!(!is_cause(f), "named beside the scale: {}", f["words"]);
-        }
-    }
+    no_other_cause(&j, &["k_ref", "mount_y", "mount_z"], "beside the scale");
 }
 
 /// The mounting withheld from the candidates: what fits in its place is not named as a cause.
@@ -197,13 +193,7 @@ fn a_withheld_mounting_gives_no_confident_finding() {
     let dir = tmp("withheld");
     let sim = simulated(&dir, |t| t);
     let j = explained(&sim, &dir.join("explain"), &["--candidates", "!mount_*"]);
-    for f in j["findings"].as_array().unwrap() {
-        assert!(
-            !is_cause(f),
-            "a stand-in named as the cause: {}",
-            f["words"]
-        );
-    }
+    no_other_cause(&j, &[], "a stand-in for the withheld mounting");
 }
 
 /// A reference mounted true (no misalignment) and a consistent model: nothing is named.
@@ -215,9 +205,7 @@ fn a_true_mounting_is_not_named() {
             .replace("mount_z = \"1.5 deg\"\n", "")
     });
     let j = explained(&sim, &dir.join("explain"), &[]);
-    for f in j["findings"].as_array().unwrap() {
-        assert!(!is_cause(f), "named on a null case: {}", f["words"]);
-    }
+    no_other_cause(&j, &[], "a null case");
 }
 
 /// The mounting given as known (`--mounting 0,0.5,1.5`, degrees) is applied in the residuals:
@@ -228,13 +216,7 @@ fn a_known_mounting_is_applied_and_checked() {
     let dir = tmp("known");
     let sim = simulated(&dir, |t| t);
     let j = explained(&sim, &dir.join("explain"), &["--mounting", "0,0.5,1.5"]);
-    for f in j["findings"].as_array().unwrap() {
-        assert!(
-            !is_cause(f),
-            "named beside the known mounting: {}",
-            f["words"]
-        );
-    }
+    no_other_cause(&j, &[], "beside the known mounting");
     let summary = j["summary"].to_string();
     assert!(
         summary.contains("mount_y = 0.500 deg") && summary.contains("mount_z = 1.50 deg"),

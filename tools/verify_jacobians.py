@@ -189,6 +189,11 @@ REFERENCE_PHYSICS = {"mount_x": ("mount", 0), "mount_y": ("mount", 1), "mount_z"
                      "dt_ref": ("time_offset",), "k_ref": ("scale",)}
 
 
+# The tables of the terms that enter the measurements, by the spec's `sensor`.
+MEASUREMENT_PHYSICS = {"gnss": (GNSS_PHYSICS, "GNSS_PHYSICS", "GNSS"),
+                       "reference": (REFERENCE_PHYSICS, "REFERENCE_PHYSICS", "reference")}
+
+
 def load_spec_terms(spec_dir=SPEC_DIR):
     """Every term of the spec as name -> (sensor, axis index, regressor function), the library
     names, and the presets (name -> state list, `base` + `terms` resolved)."""
@@ -197,23 +202,14 @@ def load_spec_terms(spec_dir=SPEC_DIR):
     terms, library = {}, []
     for t in raw.get("term", []):
         name = t["name"]
-        if t["sensor"] == "gnss":
-            # a measurement term: its physics is this file's own (GNSS_PHYSICS), never the spec's H
-            if name not in GNSS_PHYSICS:
+        if t["sensor"] in MEASUREMENT_PHYSICS:
+            # a measurement term: its physics is this file's own table, never the spec's H
+            table, table_name, what = MEASUREMENT_PHYSICS[t["sensor"]]
+            if name not in table:
                 raise SpecTranslationError(
-                    f"GNSS term `{name}` is unknown to the checker's independent measurement model "
-                    f"(it knows {' '.join(sorted(GNSS_PHYSICS))}): write its physics in GNSS_PHYSICS")
-            terms[name] = ("gnss", None, None)
-            if t.get("library", False):
-                library.append(name)
-            continue
-        if t["sensor"] == "reference":
-            # a velocity reference's term: its physics is REFERENCE_PHYSICS, never the spec's H
-            if name not in REFERENCE_PHYSICS:
-                raise SpecTranslationError(
-                    f"reference term `{name}` is unknown to the checker's independent measurement model "
-                    f"(it knows {' '.join(sorted(REFERENCE_PHYSICS))}): write its physics in REFERENCE_PHYSICS")
-            terms[name] = ("reference", None, None)
+                    f"{what} term `{name}` is unknown to the checker's independent measurement model "
+                    f"(it knows {' '.join(sorted(table))}): write its physics in {table_name}")
+            terms[name] = (t["sensor"], None, None)
             if t.get("library", False):
                 library.append(name)
             continue
