@@ -735,8 +735,7 @@ fn reference_speed_ratio(
     if ratios.len() < 10 {
         return None;
     }
-    ratios.sort_by(f64::total_cmp);
-    Some(ratios[ratios.len() / 2])
+    crate::estimate::stats::median(&mut ratios)
 }
 
 /// The likely slip behind a reference speed `r` times the GNSS speed.
@@ -783,8 +782,7 @@ fn check_reference_times(
                 .iter()
                 .map(|r| nalgebra::Vector3::from(r.v_frd).norm())
                 .collect();
-            speeds.sort_by(f64::total_cmp);
-            let median = speeds[speeds.len() / 2];
+            let median = crate::estimate::stats::median(&mut speeds).unwrap_or(0.0);
             let sigma = rows[rows.len() / 2].sigma;
             if median > 3.0 * sigma + 0.05 {
                 bail!(
@@ -812,8 +810,7 @@ fn sideways_reference(rows: &[BodyVelocityFix]) -> Option<String> {
     if share.len() < 10 {
         return None;
     }
-    share.sort_by(f64::total_cmp);
-    let median = share[share.len() / 2];
+    let median = crate::estimate::stats::median(&mut share)?;
     (median < 0.7).then(|| {
         format!(
             "where it moves, its forward component vx is a median {:.0} % of its speed: a vehicle moves forward, so its columns may be swapped or its velocities NED instead of body (forward, right, down); a mounting found on it would be the axes' slip",

@@ -49,14 +49,6 @@ impl DataOptions {
     /// The known GNSS term values of `--gnss-delay` and `--lever-arm`: (term index, SI), each
     /// checked for syntax and physics.
     pub fn known_gnss(&self) -> Result<Vec<(usize, f64)>> {
-        let term = |name: &str, option: &str| -> Result<usize> {
-            common::TERMS
-                .iter()
-                .position(|t| t.name == name)
-                .with_context(|| {
-                    format!("{option}: the spec has no term `{name}` (model-spec/terms.toml)")
-                })
-        };
         let mut out = Vec::new();
         if let Some(text) = &self.gnss_delay {
             let dt = crate::io::units::parse_quantity_as(text, "s").with_context(|| {
@@ -680,10 +672,7 @@ fn known_mounting(m: &[String]) -> Result<Vec<(usize, f64)>> {
                 format!("--mounting: {name} = `{item}`: expected degrees (`1.5`) or an angle with its unit (`26 mrad`)")
             })?,
         };
-        let k = common::TERMS
-            .iter()
-            .position(|t| t.name == name)
-            .with_context(|| format!("--mounting: the spec has no term `{name}`"))?;
+        let k = term(name, "--mounting")?;
         if !v.is_finite() {
             bail!("--mounting: {name} = `{item}` is not a number");
         }
@@ -693,4 +682,12 @@ fn known_mounting(m: &[String]) -> Result<Vec<(usize, f64)>> {
         out.push((k, v));
     }
     Ok(out)
+}
+
+/// The index of spec term `name`, which `option` gives a value of.
+fn term(name: &str, option: &str) -> Result<usize> {
+    common::TERMS
+        .iter()
+        .position(|t| t.name == name)
+        .with_context(|| format!("{option}: the spec has no term `{name}` (model-spec/terms.toml)"))
 }

@@ -1,6 +1,13 @@
 //! Statistics of the filter's tests: χ² quantiles and tail probabilities, the normal
 //! distribution, the Ljung–Box whiteness test, multiple-test corrections.
 
+/// The median of `values` (the upper one of an even count; NaN-safe order), sorting them in
+/// place; None when empty.
+pub fn median(values: &mut [f64]) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied()
+}
+
 /// Wilson–Hilferty approximation of the χ² quantile with `k` degrees of freedom at normal z.
 pub fn chi2_quantile(k: f64, z: f64) -> f64 {
     let a = 2.0 / (9.0 * k);

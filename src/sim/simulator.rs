@@ -82,15 +82,7 @@ fn gnss_shift(
         return *row;
     }
     let t = row.t - KINEMATICS_BEFORE;
-    let k = traj.at(t);
-    let (f_b, w_b, _) = body_signals(e, &k);
-    let mut np = crate::nav::nav_point::NavPoint::new(row.lat, row.h, row.v, &k.c, &f_b);
-    np.set_rate(&w_b);
-    // dv/dt over the last second, as the filter forms it from its solution
-    let t0 = (t - crate::nav::nav_point::AccelWindow::SECONDS).max(0.0);
-    if t > t0 {
-        np.set_acceleration(&((k.v - traj.at(t0).v) / (t - t0)));
-    }
+    let np = true_point(e, traj, &traj.at(t), t, row.lat, row.h, row.v);
     let mut out = *row;
     for (m, info) in common::MEASUREMENTS.iter().enumerate() {
         common::measurement_entries(m, &np, &mut |comp, state, value| {
@@ -112,6 +104,29 @@ fn gnss_shift(
     out
 }
 
+/// The navigation point at `t` [s] of the true kinematics `k` (at latitude `lat` [rad], height
+/// `h` [m], NED velocity `v` [m/s]) as the filter forms it from its solution, for the H entries
+/// of the aiding terms: the body rate, dv/dt over the last second and the instantaneous one.
+fn true_point(
+    e: &earth::LocalEarth,
+    traj: &Trajectory,
+    k: &crate::sim::trajectory::Kinematics,
+    t: f64,
+    lat: f64,
+    h: f64,
+    v: Vector3<f64>,
+) -> crate::nav::nav_point::NavPoint {
+    let (f_b, w_b, _) = body_signals(e, k);
+    let mut np = crate::nav::nav_point::NavPoint::new(lat, h, v, &k.c, &f_b);
+    np.set_rate(&w_b);
+    let t0 = (t - crate::nav::nav_point::AccelWindow::SECONDS).max(0.0);
+    if t > t0 {
+        np.set_acceleration(&((k.v - traj.at(t0).v) / (t - t0)));
+    }
+    np.set_step_acceleration(&k.a);
+    np
+}
+
 /// The true body velocity at `t` [s] as a reference mounted with the terms `terms` ((term, value
 /// SI)) reads it: each `vel_body` row moves by Σ H θ (the terms' H entries of the spec at the
 /// true point; z = computed − aided, so the aided value is the true one less H θ).
@@ -128,15 +143,7 @@ fn reference_reading(
     if terms.is_empty() {
         return v_b;
     }
-    let (f_b, w_b, _) = body_signals(e, &k);
-    let mut np = crate::nav::nav_point::NavPoint::new(lat, h, k.v, &k.c, &f_b);
-    np.set_rate(&w_b);
-    // dv/dt over the last second, as the filter forms it from its solution
-    let t0 = (t - crate::nav::nav_point::AccelWindow::SECONDS).max(0.0);
-    if t > t0 {
-        np.set_acceleration(&((k.v - traj.at(t0).v) / (t - t0)));
-    }
-    np.set_step_acceleration(&k.a);
+    let np = true_point(e, traj, &k, t, lat, h, k.v);
     let m = common::MEASUREMENTS
         .iter()
         .position(|m| m.name == "vel_body")
