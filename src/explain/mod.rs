@@ -1140,6 +1140,9 @@ struct Rounds {
     implausible: Vec<Implausible>,
     /// Filter passes made.
     rounds: usize,
+    /// Each pass that named a term: its round, candidates (term indices) and prior-scaled
+    /// information per group, for the terms' consistency splits.
+    split_passes: Vec<(usize, Vec<usize>, selection::Scaled)>,
 }
 
 /// The rounds with the model that holds only the causes among `findings` (no stand-in, no
@@ -1188,6 +1191,7 @@ fn select_and_retest(
         unconfirmed: Vec::new(),
         implausible,
         rounds: 1,
+        split_passes: Vec::new(),
     };
     let mut excluded: Vec<usize> = Vec::new(); // term indices in a class or added
     let mut pool_terms = cands;
@@ -1195,6 +1199,11 @@ fn select_and_retest(
         let mut added = Vec::new();
         let (named_before, widened_before) = (r.named.len(), r.widened.len());
         let tests_now = candidate_tests(&r.pass.sig, opts).0;
+        r.split_passes.push((
+            r.rounds,
+            r.pass.sig.cands.clone(),
+            selection::scaled(&r.pass.sig, opts),
+        ));
         for s in &selected_now {
             let named = Named::new(s, &r.pass.sig, &tests_now, r.rounds, opts);
             let t = named.term;
@@ -1271,7 +1280,31 @@ fn select_and_retest(
             }
         }
     }
+    resplit(&mut r);
     Ok(r)
+}
+
+/// Each named term's group estimates again from the pass that named it, with every other term
+/// named in the end free there too (terms named in later rounds were candidates of that pass;
+/// left out, a later term's effect would bias the groups of an earlier one and fail its
+/// consistency test, though the extended filter holds both).
+fn resplit(r: &mut Rounds) {
+    let all: Vec<usize> = r.named.iter().map(|n| n.term).collect();
+    for n in &mut r.named {
+        let Some((_, cands, sc)) = r.split_passes.iter().find(|p| p.0 == n.round) else {
+            continue;
+        };
+        let Some(me) = cands.iter().position(|&c| c == n.term) else {
+            continue;
+        };
+        let others: Vec<usize> = all
+            .iter()
+            .filter(|&&t| t != n.term)
+            .filter_map(|&t| cands.iter().position(|&c| c == t))
+            .collect();
+        n.splits = selection::split_estimates(sc, cands, me, &others);
+    }
+    r.split_passes.clear();
 }
 
 /// The findings of the rounds: each named term with the extended filter's estimate, its prior,

@@ -253,29 +253,38 @@ fn select(
     // there too (given only those named before it, a term selected first would carry what the
     // later ones describe, and its groups would disagree)
     for sel in &mut out {
-        let named = sel.idx;
-        let others: Vec<usize> = chosen.iter().copied().filter(|&c| c != named).collect();
-        let to_display = sd[named] / common::TERMS[cands[named]].display_to_si;
-        sel.splits = sc
-            .splits
-            .iter()
-            .map(|(split, groups)| {
-                let est = groups
-                    .iter()
-                    .map(|(jh, bh)| {
-                        let (ih, bch) = conditional(jh, bh, &others, named);
-                        if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
-                            (bch / ih * to_display, to_display / ih.sqrt())
-                        } else {
-                            (f64::NAN, f64::INFINITY)
-                        }
-                    })
-                    .collect();
-                (*split, est)
-            })
-            .collect();
+        let others: Vec<usize> = chosen.iter().copied().filter(|&c| c != sel.idx).collect();
+        sel.splits = split_estimates(sc, cands, sel.idx, &others);
     }
     (out, implausible)
+}
+
+/// Candidate `named`'s estimate and σ (display unit) from each group of each split of the
+/// updates in `sc` alone, the candidates `others` free there too (indices into `cands`).
+pub(super) fn split_estimates(
+    sc: &Scaled,
+    cands: &[usize],
+    named: usize,
+    others: &[usize],
+) -> Vec<(Split, Vec<(f64, f64)>)> {
+    let to_display = sc.sd[named] / common::TERMS[cands[named]].display_to_si;
+    sc.splits
+        .iter()
+        .map(|(split, groups)| {
+            let est = groups
+                .iter()
+                .map(|(jh, bh)| {
+                    let (ih, bch) = conditional(jh, bh, others, named);
+                    if ih > 1e-12 * jh[(named, named)].max(f64::MIN_POSITIVE) {
+                        (bch / ih * to_display, to_display / ih.sqrt())
+                    } else {
+                        (f64::NAN, f64::INFINITY)
+                    }
+                })
+                .collect();
+            (*split, est)
+        })
+        .collect()
 }
 
 /// Every candidate's test alone in this pass, and which may be named: testable and not
