@@ -377,6 +377,13 @@ fn finds_a_hidden_reference_mounting() {
     check_found(CaseKind::One("reference_mount"), 1);
 }
 
+/// An attitude reference's (a second INS, an AHRS) roll and yaw mounting (0.2–2° each): both
+/// named within 10 %, no sensor term named.
+#[test]
+fn finds_a_hidden_attitude_reference_mounting() {
+    check_found(CaseKind::One("attitude_mount"), 1);
+}
+
 /// A velocity reference's time offset (20–300 ms) and its yaw mounting: both named within 10 %
 /// (or 5 ms), no sensor term named.
 #[test]

@@ -132,6 +132,7 @@ fn residual_matches_generated_h() {
             vel: Some((truth.v, 0.01)),
             pos: Some((truth.lat, truth.lon, truth.h, [0.5, 0.5, 1.0])),
             body_vel: Some(Box::new((truth.dcm().transpose() * truth.v, 0.1))),
+            att: None,
         };
         // computed = truth + δ (δ in the model's error states)
         let mut dx = vec![0.0; n];
@@ -154,7 +155,8 @@ fn residual_matches_generated_h() {
             &comp.dcm(),
             &nalgebra::Vector3::new(0.0, 0.0, -9.8),
         );
-        for m in model.measurements() {
+        // (the attitude reference's rows see no attitude error here: their own test below)
+        for m in model.measurements().iter().filter(|m| m.name != "att_ref") {
             let (z, _) = residual(m.name, &comp, &ep).expect("epoch carries it");
             let mut h = vec![0.0; m.rows.len() * n];
             model.fill_h(m.name, &np, &mut h).unwrap();
@@ -196,6 +198,7 @@ fn body_velocity_residual_matches_h_under_attitude_error() {
         vel: None,
         pos: None,
         body_vel: Some(Box::new((truth.dcm().transpose() * truth.v, 0.05))),
+        att: None,
     };
     let phi = Vector3::new(2e-4, -3e-4, 5e-4);
     let dv = Vector3::new(0.02, -0.03, 0.01);
@@ -239,6 +242,7 @@ fn body_velocity_residual_matches_h_under_attitude_error() {
     // without a body velocity in the epoch there is no such measurement
     let none = AidingEpoch {
         body_vel: None,
+        att: None,
         ..ep
     };
     assert!(residual("vel_body", &comp, &none).is_none());
@@ -275,6 +279,7 @@ fn position_update_at(lat_deg: &str) {
         vel: None,
         pos: Some((row.lat, row.lon, row.h, [0.001, 0.001, 0.001])),
         body_vel: None,
+        att: None,
     }];
     let run = filter::run(
         &model,
@@ -404,4 +409,79 @@ fn divergence_stops_at_its_step_with_time_state_and_cause() {
         "{err}"
     );
     assert!(run.records.is_empty());
+}
+
+/// The attitude reference's residual agrees to first order with the generated H under an
+/// attitude error and a mounting, at a tilted and turned attitude: the reference reads
+/// C_r^n = C exp([m×]) and the computed C~ = (I − [φ×]) C, so z = φ + C m; a mounting through
+/// C's row instead of its column, or φ's sign reversed, fails this.
+#[test]
+fn attitude_residual_matches_h_under_attitude_error_and_mounting() {
+    use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+    use sinsmodel::estimate::filter::{residual, AidingEpoch};
+    use sinsmodel::io::aiding::AttitudeFix;
+    use sinsmodel::nav::attitude::euler_from_dcm;
+    use sinsmodel::nav::nav_point::NavPoint;
+    use sinsmodel::nav::strapdown::NavState;
+    let model = Model::parse("P13+att_mount_x+att_mount_y+att_mount_z").unwrap();
+    let n = model.n();
+    let truth = NavState {
+        t: 1.0,
+        lat: 0.7,
+        lon: 0.3,
+        h: 100.0,
+        v: Vector3::new(12.0, -7.0, 0.5),
+        q: UnitQuaternion::from_euler_angles(0.2, -0.1, 2.3),
+    };
+    let m = Vector3::new(3e-3, -2e-3, 5e-3);
+    let c_r = truth.dcm() * *Rotation3::from_scaled_axis(m).matrix();
+    let rpy = euler_from_dcm(&c_r);
+    let ep = AidingEpoch {
+        t: 1.0,
+        vel: None,
+        pos: None,
+        body_vel: None,
+        att: Some(Box::new(AttitudeFix {
+            t: 1.0,
+            rpy: [rpy.x, rpy.y, rpy.z],
+            sigma_tilt: 1e-3,
+            sigma_yaw: 2e-3,
+        })),
+    };
+    let phi = Vector3::new(2e-4, -3e-4, 5e-4);
+    let skew = Matrix3::new(0.0, -phi.z, phi.y, phi.z, 0.0, -phi.x, -phi.y, phi.x, 0.0);
+    let mut comp = truth;
+    comp.q = UnitQuaternion::from_matrix(&((Matrix3::identity() - skew) * truth.dcm()));
+    let mut dx = vec![0.0; n];
+    for (name, v) in [
+        ("phi_n", phi.x),
+        ("phi_e", phi.y),
+        ("phi_d", phi.z),
+        ("att_mount_x", m.x),
+        ("att_mount_y", m.y),
+        ("att_mount_z", m.z),
+    ] {
+        dx[model.index_of(name).unwrap()] = v;
+    }
+    let np = NavPoint::new(
+        comp.lat,
+        comp.h,
+        comp.v,
+        &comp.dcm(),
+        &Vector3::new(0.0, 0.0, -9.8),
+    );
+    let (z, sigma) = residual("att_ref", &comp, &ep).expect("the epoch carries an attitude");
+    assert_eq!(sigma, vec![1e-3, 1e-3, 2e-3]);
+    let mut h = vec![0.0; 3 * n];
+    model.fill_h("att_ref", &np, &mut h).unwrap();
+    // first order leaves out products of the small angles (~1e-5 rad here); a mounting through
+    // C's row or φ reversed is ~1e-3
+    let second_order = 2.0 * (phi.norm() + m.norm()).powi(2);
+    for (c, zc) in z.iter().enumerate() {
+        let hx: f64 = (0..n).map(|j| h[c * n + j] * dx[j]).sum();
+        assert!(
+            (zc - hx).abs() < second_order,
+            "att_ref component {c}: z {zc} vs H dx {hx} (second order {second_order:.1e})"
+        );
+    }
 }

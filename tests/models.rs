@@ -162,7 +162,8 @@ fn preset_path_equals_runtime_path() {
 fn measurement_support_follows_the_states() {
     let m = Model::parse("P31").unwrap();
     let names: Vec<_> = m.measurements().iter().map(|x| x.name).collect();
-    assert_eq!(names, ["vel_ne", "pos_ne"]);
+    // (an attitude reference's rows reference the attitude errors only)
+    assert_eq!(names, ["vel_ne", "pos_ne", "att_ref"]);
     let mut h = vec![0.0; 33];
     let e = m
         .fill_h("pos_h", &random_point(&mut Rng(3)).0, &mut h)
@@ -172,7 +173,7 @@ fn measurement_support_follows_the_states() {
     // reference dv_d)
     let v = Model::parse("P31+vertical").unwrap();
     let names: Vec<_> = v.measurements().iter().map(|x| x.name).collect();
-    assert_eq!(names, ["vel_ne", "pos_ne", "pos_h", "vel_body"]);
+    assert_eq!(names, ["vel_ne", "pos_ne", "pos_h", "vel_body", "att_ref"]);
 }
 
 /// Generated sparse kernel, run-time sparse propagation and dense Φ P Φᵀ + Q agree.

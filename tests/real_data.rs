@@ -86,6 +86,7 @@ fn mems_drive_mounting_and_noise_identification() {
                 ],
             )),
             body_vel: None,
+            att: None,
         })
         .collect();
     let base = || {

@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 69;
+pub const TERM_COUNT: usize = 72;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -1174,6 +1174,51 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         doc: "velocity reference forward scale factor: it reads (1 + k_ref) times the forward velocity",
         library: true,
     },
+    TermInfo {
+        name: "att_mount_x",
+        sensor: Sensor::Attitude,
+        axis: 0,
+        regressor: 0,
+        unit: "rad",
+        display: "deg",
+        display_to_si: 0.017453292519943295,
+        sigma: 0.017453292519943295,
+        noise: 0.0,
+        limit: 0.17453292519943295,
+        group: "attitude reference mounting",
+        doc: "attitude reference mounting roll against the IMU body frame (small angle)",
+        library: true,
+    },
+    TermInfo {
+        name: "att_mount_y",
+        sensor: Sensor::Attitude,
+        axis: 0,
+        regressor: 0,
+        unit: "rad",
+        display: "deg",
+        display_to_si: 0.017453292519943295,
+        sigma: 0.017453292519943295,
+        noise: 0.0,
+        limit: 0.17453292519943295,
+        group: "attitude reference mounting",
+        doc: "attitude reference mounting pitch against the IMU body frame (small angle)",
+        library: true,
+    },
+    TermInfo {
+        name: "att_mount_z",
+        sensor: Sensor::Attitude,
+        axis: 0,
+        regressor: 0,
+        unit: "rad",
+        display: "deg",
+        display_to_si: 0.017453292519943295,
+        sigma: 0.017453292519943295,
+        noise: 0.0,
+        limit: 0.17453292519943295,
+        group: "attitude reference mounting",
+        doc: "attitude reference mounting yaw against the IMU body frame (small angle)",
+        library: true,
+    },
 ];
 
 /// Structural non-zeros of the full navigation block.
@@ -1282,6 +1327,9 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[],
+    &[],
+    &[],
     &[],
     &[],
     &[],
@@ -1472,6 +1520,9 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.017453292519943295,
             0.1,
             0.01,
+            0.017453292519943295,
+            0.017453292519943295,
+            0.017453292519943295,
         ],
     },
     GradeInfo {
@@ -1562,12 +1613,15 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.017453292519943295,
             0.1,
             0.01,
+            0.017453292519943295,
+            0.017453292519943295,
+            0.017453292519943295,
         ],
     },
 ];
 
 /// Number of measurement types.
-pub const MEASUREMENT_COUNT: usize = 4;
+pub const MEASUREMENT_COUNT: usize = 5;
 
 /// Measurement types.
 pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
@@ -1638,6 +1692,27 @@ pub const MEASUREMENTS: [MeasurementInfo; MEASUREMENT_COUNT] = [
             },
         ],
         states: &["dv_d", "dv_e", "dv_n", "phi_d", "phi_e", "phi_n"],
+    },
+    MeasurementInfo {
+        name: "att_ref",
+        doc: "attitude error against an attitude reference (second INS, AHRS), navigation frame, rad",
+        sigma: 0.0017453292519943296,
+        aiding: Aiding::Attitude,
+        rows: &[
+            MeasRowInfo {
+                name: "datt_n",
+                unit: "rad",
+            },
+            MeasRowInfo {
+                name: "datt_e",
+                unit: "rad",
+            },
+            MeasRowInfo {
+                name: "datt_d",
+                unit: "rad",
+            },
+        ],
+        states: &["phi_d", "phi_e", "phi_n"],
     },
 ];
 
@@ -2469,6 +2544,15 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
         68 => {
             // k_ref: Reference x axis, regressor 1
         }
+        69 => {
+            // att_mount_x: Attitude x axis, regressor 1
+        }
+        70 => {
+            // att_mount_y: Attitude x axis, regressor 1
+        }
+        71 => {
+            // att_mount_z: Attitude x axis, regressor 1
+        }
         _ => panic!("term index {term} out of range"),
     }
 }
@@ -2534,6 +2618,32 @@ pub fn residual(
             // dvb_z: c13 * vn + c23 * ve + c33 * vd - aid.vz [m/s], 1-σ aid.sigma_b
             z[2] = c13 * vn + c23 * ve + c33 * vd - aid.vz;
             sigma[2] = aid.sigma_b;
+        }
+        4 => {
+            let c11 = s.c11;
+            let c12 = s.c12;
+            let c13 = s.c13;
+            let c21 = s.c21;
+            let c22 = s.c22;
+            let c23 = s.c23;
+            let c31 = s.c31;
+            let c32 = s.c32;
+            let c33 = s.c33;
+            // datt_n: 0.5 * (c21 * aid.r31 + c22 * aid.r32 + c23 * aid.r33 - c31 * aid.r21 - c32 * aid.r22 - c33 * aid.r23) [rad], 1-σ aid.sigma_tilt
+            z[0] = 0.5
+                * (c21 * aid.r31 + c22 * aid.r32 + c23 * aid.r33 - c31 * aid.r21
+                    - c32 * aid.r22 - c33 * aid.r23);
+            sigma[0] = aid.sigma_tilt;
+            // datt_e: 0.5 * (c31 * aid.r11 + c32 * aid.r12 + c33 * aid.r13 - c11 * aid.r31 - c12 * aid.r32 - c13 * aid.r33) [rad], 1-σ aid.sigma_tilt
+            z[1] = 0.5
+                * (c31 * aid.r11 + c32 * aid.r12 + c33 * aid.r13 - c11 * aid.r31
+                    - c12 * aid.r32 - c13 * aid.r33);
+            sigma[1] = aid.sigma_tilt;
+            // datt_d: 0.5 * (c11 * aid.r21 + c12 * aid.r22 + c13 * aid.r23 - c21 * aid.r11 - c22 * aid.r12 - c23 * aid.r13) [rad], 1-σ aid.sigma_yaw
+            z[2] = 0.5
+                * (c11 * aid.r21 + c12 * aid.r22 + c13 * aid.r23 - c21 * aid.r11
+                    - c22 * aid.r12 - c23 * aid.r13);
+            sigma[2] = aid.sigma_yaw;
         }
         _ => panic!("measurement index {m} out of range"),
     }
@@ -2693,6 +2803,29 @@ pub fn measurement_entries(
                             - (omega * lat.cos() + ve / rn) * vd)
                     + c33 * ((omega * lat.cos() + ve / rn) * ve - (-vn / rm) * vn)),
             );
+        }
+        4 => {
+            let c11 = nav.c[0][0];
+            let c12 = nav.c[0][1];
+            let c13 = nav.c[0][2];
+            let c21 = nav.c[1][0];
+            let c22 = nav.c[1][1];
+            let c23 = nav.c[1][2];
+            let c31 = nav.c[2][0];
+            let c32 = nav.c[2][1];
+            let c33 = nav.c[2][2];
+            emit(0, "phi_n", 1.0);
+            emit(0, "att_mount_x", c11);
+            emit(0, "att_mount_y", c12);
+            emit(0, "att_mount_z", c13);
+            emit(1, "phi_e", 1.0);
+            emit(1, "att_mount_x", c21);
+            emit(1, "att_mount_y", c22);
+            emit(1, "att_mount_z", c23);
+            emit(2, "phi_d", 1.0);
+            emit(2, "att_mount_x", c31);
+            emit(2, "att_mount_y", c32);
+            emit(2, "att_mount_z", c33);
         }
         _ => panic!("measurement index {m} out of range"),
     }

@@ -137,7 +137,7 @@ pub const A_PATTERN: [(usize, usize); A_NNZ] = [
 ];
 
 /// Measurements this model supports.
-pub const MEASUREMENTS: [&str; 2] = ["vel_ne", "pos_ne"];
+pub const MEASUREMENTS: [&str; 3] = ["vel_ne", "pos_ne", "att_ref"];
 
 /// Number of accumulated regressors.
 pub const NR: usize = 0;
@@ -267,6 +267,13 @@ pub fn fill_h_pos_ne(nav: &NavPoint, h: &mut [[f64; N]; 2]) {
     h[1][DLON] = rn * lat.cos();
 }
 
+/// Writes the non-zeros of H for `att_ref`: attitude error against an attitude reference (second INS, AHRS), navigation frame, rad.
+pub fn fill_h_att_ref(_nav: &NavPoint, h: &mut [[f64; N]; 3]) {
+    h[0][PHI_N] = 1.0;
+    h[1][PHI_E] = 1.0;
+    h[2][PHI_D] = 1.0;
+}
+
 /// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
 pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
     if name == "vel_ne" {
@@ -280,6 +287,14 @@ pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
     if name == "pos_ne" {
         let mut m = [[0.0; N]; 2];
         fill_h_pos_ne(nav, &mut m);
+        for (i, row) in m.iter().enumerate() {
+            h[i * N..(i + 1) * N].copy_from_slice(row);
+        }
+        return true;
+    }
+    if name == "att_ref" {
+        let mut m = [[0.0; N]; 3];
+        fill_h_att_ref(nav, &mut m);
         for (i, row) in m.iter().enumerate() {
             h[i * N..(i + 1) * N].copy_from_slice(row);
         }

@@ -254,7 +254,13 @@ pub const A_PATTERN: [(usize, usize); A_NNZ] = [
 ];
 
 /// Measurements this model supports.
-pub const MEASUREMENTS: [&str; 4] = ["vel_ne", "pos_ne", "pos_h", "vel_body"];
+pub const MEASUREMENTS: [&str; 5] = [
+    "vel_ne",
+    "pos_ne",
+    "pos_h",
+    "vel_body",
+    "att_ref",
+];
 
 /// Number of accumulated regressors.
 pub const NR: usize = 6;
@@ -529,6 +535,13 @@ pub fn fill_h_vel_body(nav: &NavPoint, h: &mut [[f64; N]; 3]) {
     h[2][DV_D] = c33;
 }
 
+/// Writes the non-zeros of H for `att_ref`: attitude error against an attitude reference (second INS, AHRS), navigation frame, rad.
+pub fn fill_h_att_ref(_nav: &NavPoint, h: &mut [[f64; N]; 3]) {
+    h[0][PHI_N] = 1.0;
+    h[1][PHI_E] = 1.0;
+    h[2][PHI_D] = 1.0;
+}
+
 /// Writes H of measurement `name` (rows × N, row-major) into `h`; false if unsupported.
 pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
     if name == "vel_ne" {
@@ -558,6 +571,14 @@ pub fn fill_h_dyn(name: &str, nav: &NavPoint, h: &mut [f64]) -> bool {
     if name == "vel_body" {
         let mut m = [[0.0; N]; 3];
         fill_h_vel_body(nav, &mut m);
+        for (i, row) in m.iter().enumerate() {
+            h[i * N..(i + 1) * N].copy_from_slice(row);
+        }
+        return true;
+    }
+    if name == "att_ref" {
+        let mut m = [[0.0; N]; 3];
+        fill_h_att_ref(nav, &mut m);
         for (i, row) in m.iter().enumerate() {
             h[i * N..(i + 1) * N].copy_from_slice(row);
         }

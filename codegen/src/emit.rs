@@ -238,6 +238,7 @@ fn common_terms(spec: &Spec) -> TokenStream {
             Sensor::Accel => quote!(Sensor::Accel),
             Sensor::Gnss => quote!(Sensor::Gnss),
             Sensor::Reference => quote!(Sensor::Reference),
+            Sensor::Attitude => quote!(Sensor::Attitude),
         };
         let axis = t.axis;
         let reg = t.regressor;
@@ -273,7 +274,7 @@ fn common_patterns(spec: &Spec, nav_entries: &[SymEntry]) -> TokenStream {
         let rows: &[usize] = match t.sensor {
             Sensor::Gyro => &spec.compose.gyro_rows,
             Sensor::Accel => &spec.compose.accel_rows,
-            Sensor::Gnss | Sensor::Reference => &[],
+            Sensor::Gnss | Sensor::Reference | Sensor::Attitude => &[],
         };
         let rows = rows.iter().map(|r| const_name(&spec.nav_states[*r].name));
         quote!(&[#(#rows),*])
@@ -360,6 +361,7 @@ fn common_measurements(spec: &Spec) -> TokenStream {
             crate::spec::Aiding::Position => quote!(Aiding::Position),
             crate::spec::Aiding::Velocity => quote!(Aiding::Velocity),
             crate::spec::Aiding::BodyVelocity => quote!(Aiding::BodyVelocity),
+            crate::spec::Aiding::Attitude => quote!(Aiding::Attitude),
         };
         quote!(MeasurementInfo { name: #name, doc: #doc, sigma: #sigma, aiding: #aiding, rows: &[#(#rows),*], states: &[#(#states),*] })
     });

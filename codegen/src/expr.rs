@@ -119,6 +119,21 @@ pub const AID_VELOCITY_FIELDS: [&str; 4] = ["vn", "ve", "vd", "sigma_v"];
 /// Fields of a body-frame velocity fix from a reference (odometer, DVL; `aid.vx`, …; one 1-σ
 /// for every component).
 pub const AID_BODY_VELOCITY_FIELDS: [&str; 4] = ["vx", "vy", "vz", "sigma_b"];
+/// Fields of an attitude from a reference (a second INS, an AHRS): its frame's C_r^n row by row
+/// (`aid.r11` … `aid.r33`) and the 1-σ of its tilt and of its yaw [rad].
+pub const AID_ATTITUDE_FIELDS: [&str; 11] = [
+    "r11",
+    "r12",
+    "r13",
+    "r21",
+    "r22",
+    "r23",
+    "r31",
+    "r32",
+    "r33",
+    "sigma_tilt",
+    "sigma_yaw",
+];
 
 /// Body-frame IMU signals a regressor may use: `f.x f.y f.z` [m/s²], `w.x w.y w.z` [rad/s],
 /// `dw.x dw.y dw.z` [rad/s²] (angular acceleration) and `df.x df.y df.z` [m/s³] (the specific
@@ -445,15 +460,17 @@ fn check_field(f: &syn::ExprField, kind: ExprKind) -> Result<(), String> {
     let ok_member = matches!(member.as_str(), "x" | "y" | "z");
     let aid_field = AID_POSITION_FIELDS.contains(&member.as_str())
         || AID_VELOCITY_FIELDS.contains(&member.as_str())
-        || AID_BODY_VELOCITY_FIELDS.contains(&member.as_str());
+        || AID_BODY_VELOCITY_FIELDS.contains(&member.as_str())
+        || AID_ATTITUDE_FIELDS.contains(&member.as_str());
     match (kind, base.as_deref()) {
         (ExprKind::Residual, Some("aid")) if aid_field => Ok(()),
         (ExprKind::Residual, _) => Err(format!(
-            "unknown field `{}` (the aiding record has aid.{}, aid.{} and aid.{})",
+            "unknown field `{}` (the aiding record has aid.{}, aid.{}, aid.{} and aid.{})",
             f.to_token_stream().to_string().replace(' ', ""),
             AID_POSITION_FIELDS.join(" aid."),
             AID_VELOCITY_FIELDS.join(" aid."),
-            AID_BODY_VELOCITY_FIELDS.join(" aid.")
+            AID_BODY_VELOCITY_FIELDS.join(" aid."),
+            AID_ATTITUDE_FIELDS.join(" aid.")
         )),
         (ExprKind::Regressor, Some(b)) if IMU_SIGNALS.contains(&b) && ok_member => Ok(()),
         (ExprKind::Regressor, _) => Err(format!(

@@ -190,7 +190,7 @@ fn grade_term_sigma(
                 Sensor::Gyro => *g.unlisted.gyro.get_ref(),
                 Sensor::Accel => *g.unlisted.accel.get_ref(),
                 // the IMU's grade says nothing about the aiding: its own prior
-                Sensor::Gnss | Sensor::Reference => 1.0,
+                Sensor::Gnss | Sensor::Reference | Sensor::Attitude => 1.0,
             };
             (t.sigma * k, GradeRule::Unlisted)
         };

@@ -181,7 +181,7 @@ pub fn term_column(spec: &Spec, t: usize, rval: TokenStream) -> Vec<(usize, SymE
         Sensor::Gyro => (&spec.compose.gyro_rows, spec.compose.gyro_sign),
         Sensor::Accel => (&spec.compose.accel_rows, spec.compose.accel_sign),
         // a GNSS term enters the measurements, not A
-        Sensor::Gnss | Sensor::Reference => return Vec::new(),
+        Sensor::Gnss | Sensor::Reference | Sensor::Attitude => return Vec::new(),
     };
     let mut out = Vec::new();
     for (k, &nav_row) in rows.iter().enumerate() {

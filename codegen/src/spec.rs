@@ -63,12 +63,15 @@ pub enum Sensor {
     /// A body-frame velocity reference (odometer, DVL): the term enters its measurement (its H
     /// entries), not A — a mounting misalignment.
     Reference,
+    /// An attitude reference (a second INS, an AHRS): the term enters its measurement (its H
+    /// entries), not A — a mounting misalignment.
+    Attitude,
 }
 
 impl Sensor {
     /// The term enters the measurements (its `h` entries), not A.
     pub fn enters_h(self) -> bool {
-        matches!(self, Sensor::Gnss | Sensor::Reference)
+        matches!(self, Sensor::Gnss | Sensor::Reference | Sensor::Attitude)
     }
 }
 
@@ -194,6 +197,9 @@ pub enum Aiding {
     /// A body-frame (FRD) velocity from a reference: odometer, DVL (`aid.vx`, `aid.vy`,
     /// `aid.vz`, `aid.sigma_b`).
     BodyVelocity,
+    /// An attitude from a reference: a second INS, an AHRS (`aid.r11` … `aid.r33`, its frame's
+    /// C_r^n; `aid.sigma_tilt`, `aid.sigma_yaw`).
+    Attitude,
 }
 
 /// A measurement type (`vel_ne`, `pos_ne`, `pos_h`).
@@ -771,7 +777,7 @@ fn load_term(
         .map_err(|e| src.error(t.unit.span(), &item, format!("unit: {e}")))?;
     let axis = term_axis(src, t, &item, sensor)?;
     let (rexpr, h) = match sensor {
-        Sensor::Gnss | Sensor::Reference => gnss_term_h(src, t, &item)?,
+        Sensor::Gnss | Sensor::Reference | Sensor::Attitude => gnss_term_h(src, t, &item)?,
         _ => (
             sensor_term_regressor(src, t, &item, sensor, unit.dim)?,
             Vec::new(),
@@ -809,10 +815,11 @@ fn term_sensor(src: &Source, t: &RawTerm, item: &str) -> Result<Sensor, SpecErro
         "accel" => Ok(Sensor::Accel),
         "gnss" => Ok(Sensor::Gnss),
         "reference" => Ok(Sensor::Reference),
+        "attitude" => Ok(Sensor::Attitude),
         other => Err(src.error(
             t.sensor.span(),
             item,
-            format!("unknown sensor `{other}` (expected `gyro`, `accel`, `gnss` or `reference`)"),
+            format!("unknown sensor `{other}` (expected `gyro`, `accel`, `gnss`, `reference` or `attitude`)"),
         )),
     }
 }
@@ -1060,7 +1067,9 @@ fn check_term_dimension(
     let (sensor_unit, sensor_name) = match sensor {
         Sensor::Gyro => ("rad/s", "a gyro error"),
         Sensor::Accel => ("m/s^2", "an accelerometer error"),
-        Sensor::Gnss | Sensor::Reference => unreachable!("a gnss term has no regressor"),
+        Sensor::Gnss | Sensor::Reference | Sensor::Attitude => {
+            unreachable!("a gnss term has no regressor")
+        }
     };
     let want = units::parse_unit(sensor_unit)
         .expect("sensor unit parses")
@@ -1109,11 +1118,12 @@ fn load_measurements(
             "position" => Aiding::Position,
             "velocity" => Aiding::Velocity,
             "body_velocity" => Aiding::BodyVelocity,
+            "attitude" => Aiding::Attitude,
             other => {
                 return Err(src.error(
                     m.aiding.span(),
                     &item,
-                    format!("aiding: unknown record `{other}` (expected `position`, `velocity` or `body_velocity`)"),
+                    format!("aiding: unknown record `{other}` (expected `position`, `velocity`, `body_velocity` or `attitude`)"),
                 ))
             }
         };
@@ -1172,6 +1182,7 @@ fn residual_expr(
         Aiding::Position => (&expr::AID_POSITION_FIELDS, "position"),
         Aiding::Velocity => (&expr::AID_VELOCITY_FIELDS, "velocity"),
         Aiding::BodyVelocity => (&expr::AID_BODY_VELOCITY_FIELDS, "body velocity"),
+        Aiding::Attitude => (&expr::AID_ATTITUDE_FIELDS, "attitude"),
     };
     for sym in e.symbols() {
         if let Some(f) = sym.strip_prefix("aid.") {

@@ -161,6 +161,13 @@ fn data_candidates(args: &ExplainArgs, baseline: &Model) -> Result<Vec<usize>> {
             "are mountings of a velocity reference",
             "; without --body-velocity (and a +vertical baseline) there is none",
         ),
+        (
+            Sensor::Attitude,
+            args.data.attitude.is_some(),
+            "is a mounting of an attitude reference",
+            "are mountings of an attitude reference",
+            "; without --attitude there is none",
+        ),
     ] {
         let absent = explain_data::terms_of(&cands, sensor);
         if present || absent.is_empty() {

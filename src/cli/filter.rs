@@ -97,15 +97,21 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     }
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
     sinsmodel::data::check_inside(files.errors.len(), inputs.aid.len(), start.t, t_last)?;
-    sinsmodel::data::dataset::check_reference_inside(
-        args.data.body_velocity.as_deref(),
-        run.innovations
-            .iter()
-            .filter(|i| i.meas == "vel_body" && i.component == 0)
-            .count(),
-        start.t,
-        t_last,
-    )?;
+    for (option, path, meas) in [
+        ("--body-velocity", &args.data.body_velocity, "vel_body"),
+        ("--attitude", &args.data.attitude, "att_ref"),
+    ] {
+        sinsmodel::data::dataset::check_reference_inside(
+            option,
+            path.as_deref(),
+            run.innovations
+                .iter()
+                .filter(|i| i.meas == meas && i.component == 0)
+                .count(),
+            start.t,
+            t_last,
+        )?;
+    }
     if let Some(w) = files.truth_disagreement() {
         super::data::note(&format!("warning: {w}"));
     }
@@ -157,9 +163,12 @@ fn filter_pass(
     files: &mut EpochFiles,
 ) -> Result<FilterRun> {
     let pb = progress::bar(1000, "filter");
-    let mut epochs = sinsmodel::data::aid::with_body_velocity(
-        inputs.aid.epochs_outside(&inputs.outages),
-        &inputs.body_velocity,
+    let mut epochs = sinsmodel::data::aid::with_rows(
+        sinsmodel::data::aid::with_body_velocity(
+            inputs.aid.epochs_outside(&inputs.outages),
+            &inputs.body_velocity,
+        ),
+        &inputs.attitude,
     );
     let mut io = filter::StreamIo {
         samples: &mut inputs.imu,

@@ -77,6 +77,7 @@ fn list_text() -> String {
             ),
             sinsmodel::model::catalog::Sensor::Gnss => ("gnss", "-", "enters H"),
             sinsmodel::model::catalog::Sensor::Reference => ("reference", "-", "enters H"),
+            sinsmodel::model::catalog::Sensor::Attitude => ("attitude", "-", "enters H"),
         };
         s.push_str(&format!(
             "  {:<9} {} {}  <{}>  [{}]  sigma {} {}\n",

@@ -62,6 +62,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let Some(bv) = &sim.body_velocity {
         aiding::write_body_velocity(&out.file("reference.txt"), bv, &header)?;
     }
+    if let Some(a) = &sim.attitude {
+        aiding::write_attitude(&out.file("attitude.txt"), a, &header)?;
+    }
     if args.mat {
         write_mat(&out, &sim)?;
     }
@@ -147,7 +150,12 @@ fn print_summary(args: &SimulateArgs, sc: &Scenario, sim: &SimOutput) {
         sim.body_velocity
             .as_ref()
             .map(|b| format!(", {} body-velocity reference rows (reference.txt)", b.len()))
-            .unwrap_or_default(),
+            .unwrap_or_default()
+            + &sim
+                .attitude
+                .as_ref()
+                .map(|a| format!(", {} attitude reference rows (attitude.txt)", a.len()))
+                .unwrap_or_default(),
         args.out.display(),
         if args.mat {
             " (and data.mat: arrays imu and avp)"

@@ -3,7 +3,7 @@
 
 use super::DataOptions;
 use crate::estimate::filter::AidingEpoch;
-use crate::io::aiding::{self, BodyVelocityFix, PositionFix, VelocityFix};
+use crate::io::aiding::{self, AttitudeFix, BodyVelocityFix, PositionFix, VelocityFix};
 use anyhow::{bail, Result};
 use nalgebra::Vector3;
 use std::path::Path;
@@ -70,6 +70,7 @@ impl AidPlan {
             vel: zupt.map(|s| (Vector3::zeros(), s)),
             pos: Some((f.lat, f.lon, f.h, f.sigma)),
             body_vel: None,
+            att: None,
         };
         match self {
             AidPlan::Fixes(f, zupt, use_pos) => Box::new(f.iter().map(move |(p, v)| {
@@ -280,49 +281,85 @@ impl DataOptions {
     }
 }
 
-/// Aiding epochs in time order merged with the body-velocity reference's rows (time order): a
-/// row at an epoch's time (within 1 µs) joins that epoch, the others are epochs of their own.
-pub struct WithBodyVelocity<'a, I: Iterator<Item = AidingEpoch>> {
-    epochs: std::iter::Peekable<I>,
-    body: &'a [BodyVelocityFix],
+/// A reference's row that joins the aiding epochs: its time [s] and how it sets an epoch's field.
+pub trait ReferenceRow {
+    /// Time on the IMU's clock [s].
+    fn t(&self) -> f64;
+    /// Sets this row's field of epoch `e`.
+    fn set(&self, e: &mut AidingEpoch);
 }
 
-/// `epochs` (time order) with the rows of `body` merged in ([`WithBodyVelocity`]).
+impl ReferenceRow for BodyVelocityFix {
+    fn t(&self) -> f64 {
+        self.t
+    }
+    fn set(&self, e: &mut AidingEpoch) {
+        e.body_vel = Some(Box::new((Vector3::from(self.v_frd), self.sigma)));
+    }
+}
+
+impl ReferenceRow for AttitudeFix {
+    fn t(&self) -> f64 {
+        self.t
+    }
+    fn set(&self, e: &mut AidingEpoch) {
+        e.att = Some(Box::new(*self));
+    }
+}
+
+/// Aiding epochs in time order merged with a reference's rows (time order): a row at an epoch's
+/// time (within 1 µs) joins that epoch, the others are epochs of their own.
+pub struct WithRows<'a, I: Iterator<Item = AidingEpoch>, R: ReferenceRow> {
+    epochs: std::iter::Peekable<I>,
+    rows: &'a [R],
+}
+
+/// `epochs` (time order) with the body-velocity reference's rows `body` merged in ([`WithRows`]).
 pub fn with_body_velocity<I: Iterator<Item = AidingEpoch>>(
     epochs: I,
     body: &[BodyVelocityFix],
-) -> WithBodyVelocity<'_, I> {
-    WithBodyVelocity {
+) -> WithRows<'_, I, BodyVelocityFix> {
+    with_rows(epochs, body)
+}
+
+/// `epochs` (time order) with a reference's rows merged in ([`WithRows`]).
+pub fn with_rows<I: Iterator<Item = AidingEpoch>, R: ReferenceRow>(
+    epochs: I,
+    rows: &[R],
+) -> WithRows<'_, I, R> {
+    WithRows {
         epochs: epochs.peekable(),
-        body,
+        rows,
     }
 }
 
 /// Times closer than this are one epoch [s].
 const SAME_EPOCH_S: f64 = 1e-6;
 
-impl<I: Iterator<Item = AidingEpoch>> Iterator for WithBodyVelocity<'_, I> {
+impl<I: Iterator<Item = AidingEpoch>, R: ReferenceRow> Iterator for WithRows<'_, I, R> {
     type Item = AidingEpoch;
     fn next(&mut self) -> Option<AidingEpoch> {
-        let row = |b: &BodyVelocityFix| Some(Box::new((Vector3::from(b.v_frd), b.sigma)));
-        match (self.epochs.peek().map(|e| e.t), self.body.first()) {
+        match (self.epochs.peek().map(|e| e.t), self.rows.first()) {
             (None, None) => None,
             (Some(_), None) => self.epochs.next(),
-            (Some(t), Some(b)) if t < b.t - SAME_EPOCH_S => self.epochs.next(),
-            (Some(t), Some(b)) if t <= b.t + SAME_EPOCH_S => {
+            (Some(t), Some(b)) if t < b.t() - SAME_EPOCH_S => self.epochs.next(),
+            (Some(t), Some(b)) if t <= b.t() + SAME_EPOCH_S => {
                 let mut e = self.epochs.next()?;
-                e.body_vel = row(b);
-                self.body = &self.body[1..];
+                b.set(&mut e);
+                self.rows = &self.rows[1..];
                 Some(e)
             }
             (_, Some(b)) => {
-                self.body = &self.body[1..];
-                Some(AidingEpoch {
-                    t: b.t,
+                self.rows = &self.rows[1..];
+                let mut e = AidingEpoch {
+                    t: b.t(),
                     vel: None,
                     pos: None,
-                    body_vel: row(b),
-                })
+                    body_vel: None,
+                    att: None,
+                };
+                b.set(&mut e);
+                Some(e)
             }
         }
     }

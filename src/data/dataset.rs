@@ -5,7 +5,7 @@
 use super::aid::{AidPlan, Outage};
 use super::DataOptions;
 use crate::estimate::filter::AidingEpoch;
-use crate::io::aiding::{BodyVelocityFix, PositionFix};
+use crate::io::aiding::{AttitudeFix, BodyVelocityFix, PositionFix};
 use crate::io::imu_stream::ImuStream;
 use crate::io::truth::{self, TruthRow};
 use crate::nav::earth;
@@ -24,6 +24,8 @@ pub struct Dataset {
     pub aid: AidPlan,
     /// Rows of the body-velocity reference after the start (`--body-velocity`), time order.
     pub body_velocity: Vec<BodyVelocityFix>,
+    /// Rows of the attitude reference after the start (`--attitude`), time order.
+    pub attitude: Vec<AttitudeFix>,
     /// Truth, read as the run advances.
     pub truth: Option<truth::TruthReader>,
     /// Initial navigation state.
@@ -71,9 +73,10 @@ pub fn check_inside(used: usize, total: usize, t0: f64, t_last: f64) -> Result<(
     Ok(())
 }
 
-/// With a `--body-velocity` reference (`path`), at least 10 of its rows must have been used
-/// inside the IMU data (t0, t_last] [s]: `used` were.
+/// With a reference file (`path`, given as `option`: `--body-velocity`, `--attitude`), at least
+/// 10 of its rows must have been used inside the IMU data (t0, t_last] [s]: `used` were.
 pub fn check_reference_inside(
+    option: &str,
     path: Option<&std::path::Path>,
     used: usize,
     t0: f64,
@@ -82,7 +85,7 @@ pub fn check_reference_inside(
     if let Some(p) = path {
         if used < 10 {
             bail!(
-                "--body-velocity {}: only {used} of its rows fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (its times must be on the IMU's clock: GPS seconds against the IMU's, or ms for s?)",
+                "{option} {}: only {used} of its rows fall inside the IMU data ({t0:.3} to {t_last:.3} s); at least 10 are needed (its times must be on the IMU's clock: GPS seconds against the IMU's, or ms for s?)",
                 p.display()
             );
         }
@@ -153,10 +156,12 @@ impl DataOptions {
         let aid = plan.after(t0);
         check_outages_drop_fixes(&aid, &outages, imu.first_t())?;
         let body_velocity = self.body_velocity_after(t0, &aid, note)?;
+        let attitude = self.attitude_after(t0, &aid, note)?;
         Ok(Dataset {
             imu,
             aid,
             body_velocity,
+            attitude,
             truth: truth_reader,
             start: start.state,
             outages,
@@ -302,16 +307,27 @@ impl DataOptions {
             None => None,
         };
         let start = opened.start;
-        let aid: Vec<AidingEpoch> = super::aid::with_body_velocity(
-            opened.aid.epochs_outside(&opened.outages),
-            &opened.body_velocity,
+        let aid: Vec<AidingEpoch> = super::aid::with_rows(
+            super::aid::with_body_velocity(
+                opened.aid.epochs_outside(&opened.outages),
+                &opened.body_velocity,
+            ),
+            &opened.attitude,
         )
         .take_while(|e| e.t <= t_last + 1e-9)
         .collect();
         check_inside(aid.len(), opened.aid.len(), start.t, t_last)?;
         check_reference_inside(
+            "--body-velocity",
             self.body_velocity.as_deref(),
             aid.iter().filter(|e| e.body_vel.is_some()).count(),
+            start.t,
+            t_last,
+        )?;
+        check_reference_inside(
+            "--attitude",
+            self.attitude.as_deref(),
+            aid.iter().filter(|e| e.att.is_some()).count(),
             start.t,
             t_last,
         )?;
@@ -697,6 +713,153 @@ impl DataOptions {
         }
         Ok(after)
     }
+}
+
+impl DataOptions {
+    /// The `--attitude` rows after the start `t0` [s], checked against the data: at least 10
+    /// after the start, most within the GNSS fixes' times, and their yaw along the GNSS course
+    /// where the fixes move.
+    fn attitude_after(
+        &self,
+        t0: f64,
+        aid: &AidPlan,
+        note: &mut dyn FnMut(&str),
+    ) -> Result<Vec<AttitudeFix>> {
+        let Some(path) = &self.attitude else {
+            return Ok(Vec::new());
+        };
+        let rows = crate::io::aiding::read_attitude(path)?;
+        let (first, last) = (rows[0].t, rows[rows.len() - 1].t);
+        let after: Vec<AttitudeFix> = rows.into_iter().filter(|r| r.t > t0).collect();
+        if after.len() < 10 {
+            bail!(
+                "--attitude {}: {} of its rows (t = {first:.3} to {last:.3} s) fall after the run's start at t = {t0:.3} s; at least 10 are needed (its times must be on the IMU's clock: UTC for GPST, or ms for s?)",
+                path.display(),
+                after.len()
+            );
+        }
+        if let AidPlan::Fixes(fixes, _, _) = aid {
+            if !fixes.is_empty() {
+                let (f0, f1) = (fixes[0].0.t, fixes[fixes.len() - 1].0.t);
+                let inside = after
+                    .iter()
+                    .filter(|r| r.t >= f0 - 1.0 && r.t <= f1 + 1.0)
+                    .count();
+                if 2 * inside < after.len() {
+                    bail!(
+                        "--attitude {}: {inside} of its {} rows after the start fall within the GNSS fixes' times (t = {f0:.3} to {f1:.3} s); its rows run t = {first:.3} to {last:.3} s: another clock (GPS seconds against the IMU's, UTC against GPST: 18 s) or ms written as s?",
+                        path.display(),
+                        after.len()
+                    );
+                }
+            }
+            let yaw = |r: &AttitudeFix| r.rpy[2];
+            match heading_offset(fixes, &after, &yaw) {
+                Some((d, spread)) if !follows_course(d, spread) => {
+                    let slip = yaw_slip(fixes, &after, d);
+                    bail!(
+                        "--attitude {}: its yaw is {d:.1} deg from the GNSS course (median over moving fixes; the middle 80 % of the differences span {spread:.1} deg); a vehicle heads along its course, within a slip and a mounting: {slip}",
+                        path.display()
+                    );
+                }
+                Some((d, _)) => note(&format!(
+                    "attitude reference: {} rows after the start; yaw {d:.2} deg from the GNSS course (median over moving fixes)",
+                    after.len()
+                )),
+                None => note(&format!(
+                    "attitude reference: {} rows after the start; its yaw not compared with the GNSS course (fewer than 10 fix pairs moving faster than 3 m/s)",
+                    after.len()
+                )),
+            }
+        }
+        Ok(after)
+    }
+}
+
+/// A reading of an attitude row's yaw [rad] under a hypothesis about its file.
+type YawReading = fn(&AttitudeFix) -> f64;
+
+/// The likely slip behind a reference yaw `d` degrees (median) from the GNSS course: the first
+/// reading of the rows that brings it within [`MAX_COURSE_OFFSET_DEG`], else a guess from `d`.
+fn yaw_slip(
+    fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
+    rows: &[AttitudeFix],
+    d: f64,
+) -> String {
+    let slips: [(&str, YawReading); 3] = [
+        ("radians written as degrees", |r| r.rpy[2].to_degrees()),
+        (
+            "a heading counter-clockwise from east (ENU) where NED's clockwise from north is meant",
+            |r| std::f64::consts::FRAC_PI_2 - r.rpy[2],
+        ),
+        ("the yaw's sign reversed", |r| -r.rpy[2]),
+    ];
+    match slips.into_iter().find(|(_, f)| {
+        heading_offset(fixes, rows, &|r| f(r)).is_some_and(|(d, spread)| follows_course(d, spread))
+    }) {
+        Some((s, _)) => format!("{s}?"),
+        None if (d.abs() - 180.0).abs() < MAX_COURSE_OFFSET_DEG => {
+            "the reference faces backwards, or its axes are not FRD?".into()
+        }
+        None => "another vehicle's file, another clock, or its axes are not FRD?".into(),
+    }
+}
+
+/// Largest median difference between a reference's yaw and the GNSS course, and largest spread
+/// of the differences (10th to 90th percentile) [deg]: a vehicle's slip and a mounting are
+/// degrees and stay through its turns; beyond these the file's angles are not what they say (a
+/// yaw in radians read as degrees stays near zero while the course turns).
+const MAX_COURSE_OFFSET_DEG: f64 = 45.0;
+
+/// A yaw `d` degrees from the course (median) with the differences spreading `spread` degrees
+/// follows the course ([`MAX_COURSE_OFFSET_DEG`]).
+fn follows_course(d: f64, spread: f64) -> bool {
+    d.abs() <= MAX_COURSE_OFFSET_DEG && spread <= MAX_COURSE_OFFSET_DEG
+}
+
+/// The median of `yaw` (rad) minus the GNSS course [deg, wrapped to ±180] over the rows between
+/// consecutive fixes at most 2 s apart that move faster than 3 m/s, and the spread of those
+/// differences (10th to 90th percentile, deg); None with fewer than 10 such rows.
+fn heading_offset(
+    fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
+    rows: &[AttitudeFix],
+    yaw: &dyn Fn(&AttitudeFix) -> f64,
+) -> Option<(f64, f64)> {
+    let mut diffs = Vec::new();
+    let mut j = 0;
+    for w in fixes.windows(2) {
+        let (a, b) = (&w[0].0, &w[1].0);
+        let dt = b.t - a.t;
+        if !(dt > 0.0 && dt <= 2.0) {
+            continue;
+        }
+        let dn = (b.lat - a.lat) * (earth::radius_meridian(a.lat) + a.h);
+        let de = earth::lon_difference(b.lon, a.lon)
+            * (earth::radius_transverse(a.lat) + a.h)
+            * a.lat.cos();
+        if dn.hypot(de) / dt < 3.0 {
+            continue;
+        }
+        let course = de.atan2(dn);
+        while j < rows.len() && rows[j].t < a.t {
+            j += 1;
+        }
+        for r in rows[j..].iter().take_while(|r| r.t <= b.t) {
+            let d = (yaw(r) - course).rem_euclid(std::f64::consts::TAU);
+            let d = if d > std::f64::consts::PI {
+                d - std::f64::consts::TAU
+            } else {
+                d
+            };
+            diffs.push(d.to_degrees());
+        }
+    }
+    if diffs.len() < 10 {
+        return None;
+    }
+    diffs.sort_by(f64::total_cmp);
+    let at = |q: f64| diffs[((diffs.len() - 1) as f64 * q).round() as usize];
+    Some((at(0.5), at(0.9) - at(0.1)))
 }
 
 /// The median ratio of the reference's speed to the GNSS speed (from consecutive fixes at most 2 s

@@ -192,6 +192,11 @@ pub struct DataOptions {
         arg(long, value_delimiter = ',', allow_hyphen_values = true)
     )]
     pub mounting: Option<Vec<String>>,
+    /// Attitude reference (a second INS, an AHRS): a file of `t roll pitch yaw sigma_tilt
+    /// sigma_yaw` (s on the IMU's clock; the reference frame's FRD axes against NED, deg; deg),
+    /// used as the `att_ref` measurement.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub attitude: Option<PathBuf>,
 }
 
 impl DataOptions {
@@ -219,6 +224,7 @@ impl DataOptions {
             lever_arm: None,
             body_velocity: None,
             mounting: None,
+            attitude: None,
         }
     }
 
@@ -242,6 +248,7 @@ impl DataOptions {
             || self.lever_arm.is_some()
             || self.body_velocity.is_some()
             || self.mounting.is_some()
+            || self.attitude.is_some()
     }
 
     /// True when the aiding comes from a GNSS file (`--aid`): GNSS terms (time offset, lever
@@ -259,6 +266,7 @@ impl DataOptions {
             &self.noise,
             &self.truth,
             &self.body_velocity,
+            &self.attitude,
         ]
         .into_iter()
         .flatten()
@@ -281,6 +289,9 @@ impl DataOptions {
         }
         if let Some(p) = &self.body_velocity {
             s.push_str(&format!(", body-velocity reference {}", p.display()));
+        }
+        if let Some(p) = &self.attitude {
+            s.push_str(&format!(", attitude reference {}", p.display()));
         }
         if let Some(p) = &self.truth {
             s.push_str(&format!(", truth {}", p.display()));

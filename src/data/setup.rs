@@ -153,13 +153,18 @@ impl DataOptions {
                 o.map(|o| format!(", with {o}")).unwrap_or_default()
             )),
         }
-        match (&self.body_velocity, self.mode.as_deref()) {
-            (Some(_), None) => lines.push(
-                "mode: closed loop, the default with --body-velocity (its rows are linearised about the aided solution; --mode open would linearise them about the free-inertial one, which biases a mounting and couples it into gyro terms)".into(),
-            ),
-            (Some(_), Some("open")) => lines.push(
-                "warning: --mode open with --body-velocity: the reference's rows are linearised about the free-inertial solution, whose velocity error grows through the run; a mounting comes out biased and gyro terms (kg_33, eps_z) may take part of it; --mode closed avoids this".into(),
-            ),
+        let reference = match (&self.body_velocity, &self.attitude) {
+            (Some(_), _) => Some("--body-velocity"),
+            (None, Some(_)) => Some("--attitude"),
+            (None, None) => None,
+        };
+        match (reference, self.mode.as_deref()) {
+            (Some(r), None) => lines.push(format!(
+                "mode: closed loop, the default with {r} (its rows are linearised about the aided solution; --mode open would linearise them about the free-inertial one, which biases a mounting and couples it into gyro terms)"
+            )),
+            (Some(r), Some("open")) => lines.push(format!(
+                "warning: --mode open with {r}: the reference's rows are linearised about the free-inertial solution, whose error grows through the run; a mounting comes out biased and gyro terms (kg_33, eps_z) may take part of it; --mode closed avoids this"
+            )),
             _ => {}
         }
         for (t, v) in self.known_gnss()? {
@@ -265,6 +270,9 @@ impl DataOptions {
                     Sensor::Reference if self.body_velocity.is_none() => {
                         Some("a velocity reference's term; without --body-velocity")
                     }
+                    Sensor::Attitude if self.attitude.is_none() => {
+                        Some("an attitude reference's term; without --attitude")
+                    }
                     _ => None,
                 };
                 if let (Some(m), false) = (missing, model.names.contains(&name)) {
@@ -314,7 +322,7 @@ impl DataOptions {
             Some("closed") => Mode::ClosedLoop,
             Some(m) => bail!("--mode `{m}`: expected open or closed"),
             // a velocity reference's rows hold only to first order about the aided solution
-            None if args.body_velocity.is_some() => Mode::ClosedLoop,
+            None if args.body_velocity.is_some() || args.attitude.is_some() => Mode::ClosedLoop,
             None => Mode::OpenLoop,
         };
         cfg.step_s = args.step_given()?.unwrap_or(DEFAULT_STEP_S);
@@ -650,8 +658,21 @@ fn check_reference_terms(model: &Model, args: &DataOptions) -> Result<()> {
             p.display(),
             model.name
         ),
-        _ => Ok(()),
+        _ => Ok::<(), anyhow::Error>(()),
+    }?;
+    let attitude_term = model.states.iter().find_map(|s| match *s {
+        StateRef::Term(k) if common::TERMS[k].sensor == Sensor::Attitude => {
+            Some(common::TERMS[k].name)
+        }
+        _ => None,
+    });
+    if let (None, Some(t)) = (&args.attitude, attitude_term) {
+        bail!(
+            "--model {}: {t} is a mounting of an attitude reference (it enters the attitude measurement); without --attitude there is none",
+            model.name
+        );
     }
+    Ok(())
 }
 
 /// The `--mounting R,P,Y` values as (term, value [rad]): bare numbers are degrees, a unit may be

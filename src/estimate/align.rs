@@ -587,6 +587,7 @@ fn fine_align(
             vel: Some((Vector3::zeros(), 0.01)),
             pos: Some((lat_used, lon, h, [0.1, 0.1, 0.1])),
             body_vel: None,
+            att: None,
         })
         .collect();
     let imu = ImuData { samples: used };

@@ -228,6 +228,8 @@ pub struct AidingEpoch {
     /// Body-frame (FRD) velocity from a reference (odometer, DVL) [m/s] and its 1-σ per
     /// component (boxed: most epochs of a run held in memory have none).
     pub body_vel: Option<Box<(Vector3<f64>, f64)>>,
+    /// Attitude from a reference (a second INS, an AHRS), boxed as `body_vel` is.
+    pub att: Option<Box<crate::io::aiding::AttitudeFix>>,
 }
 
 /// An innovation of one scalar measurement component.
@@ -419,6 +421,14 @@ pub fn residual(meas: &str, s: &NavState, ep: &AidingEpoch) -> Option<(Vec<f64>,
             let (v, sig) = **ep.body_vel.as_ref()?;
             (aid.vx, aid.vy, aid.vz, aid.sigma_b) = (v.x, v.y, v.z, sig);
         }
+        Aiding::Attitude => {
+            let a = ep.att.as_ref()?;
+            let r = crate::nav::attitude::dcm_from_euler(a.rpy[0], a.rpy[1], a.rpy[2]);
+            (aid.r11, aid.r12, aid.r13) = (r[(0, 0)], r[(0, 1)], r[(0, 2)]);
+            (aid.r21, aid.r22, aid.r23) = (r[(1, 0)], r[(1, 1)], r[(1, 2)]);
+            (aid.r31, aid.r32, aid.r33) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+            (aid.sigma_tilt, aid.sigma_yaw) = (a.sigma_tilt, a.sigma_yaw);
+        }
     }
     let c = s.dcm();
     let state = ResidualState {
@@ -586,7 +596,7 @@ impl<'a> Engine<'a> {
                         Sensor::Gyro => dth[info.axis] -= self.correction[i] * r * dt,
                         Sensor::Accel => dvel[info.axis] -= self.correction[i] * r * dt,
                         // a GNSS term's correction applies to the residuals (`update`)
-                        Sensor::Gnss | Sensor::Reference => {}
+                        Sensor::Gnss | Sensor::Reference | Sensor::Attitude => {}
                     }
                 }
             }

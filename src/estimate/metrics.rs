@@ -94,8 +94,12 @@ pub fn add_attitude_disagreement(
 }
 
 /// Name of one scalar channel of a measurement: `vel_n`, `vel_e`, `pos_n`, `pos_e`, `pos_h`,
-/// and a body-frame reference's `vel_bx`, `vel_by`, `vel_bz`.
+/// a body-frame reference's `vel_bx`, `vel_by`, `vel_bz` and an attitude reference's `att_n`,
+/// `att_e`, `att_d`.
 pub fn channel_name(meas: &str, component: usize) -> String {
+    if meas == "att_ref" {
+        return format!("att_{}", ["n", "e", "d"].get(component).unwrap_or(&"?"));
+    }
     if let Some(prefix) = meas.strip_suffix("_ne") {
         format!("{prefix}_{}", ["n", "e"].get(component).unwrap_or(&"?"))
     } else if let Some(prefix) = meas.strip_suffix("_body") {
@@ -110,7 +114,7 @@ pub fn channel_name(meas: &str, component: usize) -> String {
 
 /// The measurement has one channel per component (named by [`channel_name`]), not one in all.
 fn per_component(meas: &str) -> bool {
-    meas.ends_with("_ne") || meas.ends_with("_body")
+    meas.ends_with("_ne") || meas.ends_with("_body") || meas == "att_ref"
 }
 
 /// [`channel_name`] as a static string (what explain keeps per innovation: no allocation each),

@@ -150,7 +150,7 @@ pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
             Sensor::Accel => smp.dv[info.axis] += theta * r * dt,
             Sensor::Gyro => smp.dtheta[info.axis] += theta * r * dt,
             // a GNSS term is in the aiding, not in the IMU's increments
-            Sensor::Gnss | Sensor::Reference => {}
+            Sensor::Gnss | Sensor::Reference | Sensor::Attitude => {}
         }
     }
 }

@@ -231,11 +231,16 @@ pub fn aiding_from_truth(
             vel,
             pos,
             body_vel: None,
+            att: None,
         });
     }
     // the simulation's velocity reference (a scenario with `[reference]`), as written
     if let Some(body) = &sim.body_velocity {
         out = crate::data::aid::with_body_velocity(out.into_iter(), body).collect();
+    }
+    // and its attitude reference (`[attitude_reference]`)
+    if let Some(att) = &sim.attitude {
+        out = crate::data::aid::with_rows(out.into_iter(), att).collect();
     }
     Ok(out)
 }

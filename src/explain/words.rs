@@ -126,6 +126,7 @@ pub(super) fn sensor_word(s: Sensor) -> &'static str {
         Sensor::Accel => "accelerometer",
         Sensor::Gnss => "GNSS",
         Sensor::Reference => "velocity reference",
+        Sensor::Attitude => "attitude reference",
     }
 }
 
@@ -323,6 +324,11 @@ fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> (S
             }
         ));
     }
+    if info.sensor == Sensor::Attitude {
+        s.push_str(
+            "; the reference's frame is turned by this angle against the IMU's: it reports the IMU's attitude turned by it (roll, pitch, yaw of the reference's FRD axes in the IMU's)",
+        );
+    }
     if !f.equivalent.is_empty() {
         let others: Vec<String> = f
             .equivalent_estimates
@@ -357,6 +363,9 @@ pub(super) fn channel_word(c: &str) -> String {
         "vel_bx" => "forward velocity (reference)".into(),
         "vel_by" => "right velocity (reference)".into(),
         "vel_bz" => "down velocity (reference)".into(),
+        "att_n" => "north tilt (attitude reference)".into(),
+        "att_e" => "east tilt (attitude reference)".into(),
+        "att_d" => "heading (attitude reference)".into(),
         other => other.to_string(),
     }
 }

@@ -306,3 +306,101 @@ pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
     }
     Ok(out)
 }
+
+/// An attitude from a reference (a second INS, an AHRS): the roll, pitch and yaw of its own
+/// frame (FRD) against NED, and the 1-σ of its tilt and of its yaw.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttitudeFix {
+    /// Time on the IMU's clock [s].
+    pub t: f64,
+    /// Roll, pitch, yaw (z-y-x Euler angles of C_r^n) [rad].
+    pub rpy: [f64; 3],
+    /// 1-σ of roll and pitch [rad].
+    pub sigma_tilt: f64,
+    /// 1-σ of yaw [rad].
+    pub sigma_yaw: f64,
+}
+
+/// Header line of an attitude reference file.
+const ATTITUDE_COLUMNS: &str =
+    "t[s] roll pitch yaw [deg] (the reference's FRD frame against NED) sigma_tilt sigma_yaw [deg]";
+
+/// Writes reference attitudes atomically: `t roll pitch yaw sigma_tilt sigma_yaw` per row, angles
+/// in degrees.
+pub fn write_attitude(path: &Path, rows: &[AttitudeFix], header: &str) -> Result<()> {
+    let mut f = AtomicFile::create(path)?;
+    let w = f.writer();
+    for l in header.lines() {
+        writeln!(w, "# {l}")?;
+    }
+    writeln!(w, "# {ATTITUDE_COLUMNS}")?;
+    for r in rows {
+        let d = |x: f64| x.to_degrees();
+        writeln!(
+            w,
+            "{:.4} {:.6} {:.6} {:.6} {} {}",
+            r.t,
+            d(r.rpy[0]),
+            d(r.rpy[1]),
+            d(r.rpy[2]),
+            d(r.sigma_tilt),
+            d(r.sigma_yaw)
+        )?;
+    }
+    f.commit()
+}
+
+/// Reads an attitude reference file (`t roll pitch yaw sigma_tilt sigma_yaw`: s, then degrees):
+/// time strictly increasing, roll within ±180°, pitch within ±90°, yaw within −180…360°, each σ
+/// in [0.001, 10]°; each error names the line and the likely slip. Angles are returned in rad.
+pub fn read_attitude(path: &Path) -> Result<Vec<AttitudeFix>> {
+    let rows = read_table(path, 6, "attitude reference file").map_err(|e| {
+        if e.to_string().contains("found 5") {
+            e.context(format!(
+                "{}: 5 columns is the layout of a body-velocity reference (--body-velocity); --attitude takes `t roll pitch yaw sigma_tilt sigma_yaw` in degrees",
+                path.display()
+            ))
+        } else {
+            e
+        }
+    })?;
+    if rows.is_empty() {
+        bail!(
+            "{}: the attitude reference file has no data rows ({ATTITUDE_COLUMNS})",
+            path.display()
+        );
+    }
+    let mut out: Vec<AttitudeFix> = Vec::with_capacity(rows.len());
+    for (line, v) in rows {
+        let at = format!("{}:{line}", path.display());
+        if let Some(prev) = out.last() {
+            if v[0] <= prev.t {
+                bail!(
+                    "{at}: time {} s is not after the previous row's {} s (rows must be in time order, each time once)",
+                    v[0],
+                    prev.t
+                );
+            }
+        }
+        let (roll, pitch, yaw) = (v[1], v[2], v[3]);
+        if roll.abs() > 180.0 || pitch.abs() > 90.0 || !(-180.0..=360.0).contains(&yaw) {
+            bail!(
+                "{at}: roll {roll}, pitch {pitch}, yaw {yaw} deg: roll must be within ±180, pitch within ±90, yaw within -180..360 (angles are degrees; a pitch beyond 90 is a roll and pitch swapped, or another Euler order)"
+            );
+        }
+        for (name, s) in [("sigma_tilt", v[4]), ("sigma_yaw", v[5])] {
+            if !(0.001..=10.0).contains(&s) {
+                bail!(
+                    "{at}: {name} {s} must be in [0.001, 10] deg (degrees, not radians; a reference worse than 10 deg carries nothing)"
+                );
+            }
+        }
+        out.push(AttitudeFix {
+            t: v[0],
+            rpy: [roll.to_radians(), pitch.to_radians(), yaw.to_radians()],
+            sigma_tilt: v[4].to_radians(),
+            sigma_yaw: v[5].to_radians(),
+        });
+    }
+    Ok(out)
+}

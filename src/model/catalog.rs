@@ -15,13 +15,16 @@ pub enum Sensor {
     /// A body-frame velocity reference (odometer, DVL): enters its measurement (H), not A — a
     /// mounting misalignment.
     Reference,
+    /// An attitude reference (a second INS, an AHRS): enters its measurement (H), not A — a
+    /// mounting misalignment.
+    Attitude,
 }
 
 impl Sensor {
     /// The term enters the measurements (H), not A: its closed-loop correction applies to the
     /// residuals, and it describes the aiding, not the IMU.
     pub fn enters_h(self) -> bool {
-        matches!(self, Sensor::Gnss | Sensor::Reference)
+        matches!(self, Sensor::Gnss | Sensor::Reference | Sensor::Attitude)
     }
 }
 
@@ -160,6 +163,8 @@ pub enum Aiding {
     Velocity,
     /// A body-frame (FRD) velocity from a reference (odometer, DVL).
     BodyVelocity,
+    /// An attitude from a reference (a second INS, an AHRS).
+    Attitude,
 }
 
 /// The filter's navigation state at a fix, as a measurement residual sees it (SI units).
@@ -233,6 +238,28 @@ pub struct AidRecord {
     pub vz: f64,
     /// 1-σ of each body-frame component [m/s].
     pub sigma_b: f64,
+    /// C_r^n of an attitude reference's frame, row by row (`r11` … `r33`).
+    pub r11: f64,
+    /// C_r^n (1, 2).
+    pub r12: f64,
+    /// C_r^n (1, 3).
+    pub r13: f64,
+    /// C_r^n (2, 1).
+    pub r21: f64,
+    /// C_r^n (2, 2).
+    pub r22: f64,
+    /// C_r^n (2, 3).
+    pub r23: f64,
+    /// C_r^n (3, 1).
+    pub r31: f64,
+    /// C_r^n (3, 2).
+    pub r32: f64,
+    /// C_r^n (3, 3).
+    pub r33: f64,
+    /// 1-σ of the reference's tilt (roll, pitch) [rad].
+    pub sigma_tilt: f64,
+    /// 1-σ of its yaw [rad].
+    pub sigma_yaw: f64,
 }
 
 impl AidRecord {
@@ -252,6 +279,17 @@ impl AidRecord {
         vy: f64::NAN,
         vz: f64::NAN,
         sigma_b: f64::NAN,
+        r11: f64::NAN,
+        r12: f64::NAN,
+        r13: f64::NAN,
+        r21: f64::NAN,
+        r22: f64::NAN,
+        r23: f64::NAN,
+        r31: f64::NAN,
+        r32: f64::NAN,
+        r33: f64::NAN,
+        sigma_tilt: f64::NAN,
+        sigma_yaw: f64::NAN,
     };
 }
 

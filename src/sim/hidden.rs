@@ -20,10 +20,16 @@ pub const GNSS_GROUPS: [&str; 3] = ["gnss_time", "gnss_time_kgf", "gnss_lever"];
 /// `mount_z`, each 0.2–2° times `effect`, either sign), alone (`reference_mount`) or with a
 /// gyro g-sensitivity kgf_yx beside it (`reference_mount_kgf`, as in `gnss_time_kgf`); and the
 /// reference's time offset (`dt_ref`, 20–300 ms times `effect`, either sign) with its yaw
-/// mounting (`reference_time`). The baseline has the vertical channel (the reference's rows
+/// mounting (`reference_time`); and an attitude reference's mounting (a second INS or an AHRS at
+/// 10 Hz, σ 0.05° tilt and 0.1° yaw): its roll and yaw, 0.2–2° each times `effect`, either sign
+/// (`attitude_mount`). The baseline has the vertical channel (the velocity reference's rows
 /// need it).
-pub const REFERENCE_GROUPS: [&str; 3] =
-    ["reference_mount", "reference_mount_kgf", "reference_time"];
+pub const REFERENCE_GROUPS: [&str; 4] = [
+    "reference_mount",
+    "reference_mount_kgf",
+    "reference_time",
+    "attitude_mount",
+];
 
 /// Groups hidden on a turntable (a multi-position rotation sequence at rest, static aiding): an
 /// accelerometer's off-axis inner lever arm (`size_i_j`, 20–60 mm times `effect`), seen in
@@ -416,7 +422,7 @@ fn draw_one(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
         "d" | "kaq" | "kas" | "kao" | "kgq" | "size" => draw_vibrated(g, rng, d, p),
         "kgf" => draw_kgf(rng, d, p),
         "gnss_time" | "gnss_time_kgf" | "gnss_lever" => draw_gnss(g, rng, d, p),
-        "reference_mount" | "reference_mount_kgf" | "reference_time" => {
+        "reference_mount" | "reference_mount_kgf" | "reference_time" | "attitude_mount" => {
             draw_reference(g, rng, d, p)
         }
         "inner_lever" | "accel_delay" | "inner_lever_delay" => draw_turntable(g, rng, d, p),
@@ -567,10 +573,10 @@ fn draw_reference(g: &str, rng: &mut Rng, d: &Draw, p: &mut Parts) {
             sgn * d.effect * (0.02 + 0.28 * rng.uniform()),
         ));
     }
-    let mounts: &[&str] = if g == "reference_time" {
-        &["mount_z"]
-    } else {
-        &["mount_y", "mount_z"]
+    let mounts: &[&str] = match g {
+        "reference_time" => &["mount_z"],
+        "attitude_mount" => &["att_mount_x", "att_mount_z"],
+        _ => &["mount_y", "mount_z"],
     };
     for &name in mounts {
         let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
@@ -716,7 +722,9 @@ fn assemble(
             )
         }
     };
-    let reference = if REFERENCE_GROUPS.contains(&group.as_str()) {
+    let reference = if group == "attitude_mount" {
+        "[attitude_reference]\nrate_hz = 10.0\nsigma_tilt = \"0.05 deg\"\nsigma_yaw = \"0.1 deg\"\n"
+    } else if REFERENCE_GROUPS.contains(&group.as_str()) {
         "[reference]\nrate_hz = 10.0\nsigma = \"0.05 m/s\"\n"
     } else {
         ""

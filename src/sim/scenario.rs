@@ -180,6 +180,31 @@ pub struct ReferenceSpec {
     pub noisy: bool,
 }
 
+/// An attitude reference (a second INS, an AHRS) written by the simulator: the true attitude
+/// turned by the scenario's mounting terms (`att_mount_x` … in `[errors]`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttitudeReferenceSpec {
+    /// Rate [Hz].
+    pub rate_hz: f64,
+    /// 1-σ of roll and pitch (e.g. "0.05 deg").
+    #[serde(default = "default_sigma_tilt")]
+    pub sigma_tilt: String,
+    /// 1-σ of yaw (e.g. "0.2 deg").
+    #[serde(default = "default_sigma_yaw")]
+    pub sigma_yaw: String,
+    /// Add Gaussian noise with those σ (default true).
+    #[serde(default = "yes")]
+    pub noisy: bool,
+}
+
+fn default_sigma_tilt() -> String {
+    "0.05 deg".into()
+}
+fn default_sigma_yaw() -> String {
+    "0.2 deg".into()
+}
+
 fn default_sigma_reference() -> String {
     "0.05 m/s".into()
 }
@@ -234,6 +259,7 @@ struct RawScenario {
     gnss: Option<GnssSpec>,
     #[serde(default)]
     reference: Option<ReferenceSpec>,
+    attitude_reference: Option<AttitudeReferenceSpec>,
     #[serde(default)]
     clock_jitter_periods: Option<u32>,
 }
@@ -269,6 +295,8 @@ pub struct Scenario {
     pub gnss_sigma_v: Option<f64>,
     /// A body-frame velocity reference (rate [Hz], 1-σ [m/s], noisy).
     pub reference: Option<(f64, f64, bool)>,
+    /// An attitude reference (rate [Hz], 1-σ tilt and yaw [rad], noisy).
+    pub attitude_reference: Option<(f64, f64, f64, bool)>,
     /// A jittered IMU clock: each output sample spans 1 to this many periods of `imu_rate_hz`
     /// at random (1: a uniform clock).
     pub clock_jitter_periods: u32,
@@ -395,6 +423,20 @@ impl Scenario {
                 );
             }
         }
+        let attitude_reference =
+            parse_attitude_reference(raw.attitude_reference.as_ref(), &src, imu_rate_hz)?;
+        if attitude_reference.is_none() {
+            if let Some(&(k, _)) = errors
+                .iter()
+                .find(|(k, _)| common::TERMS[*k].sensor == crate::model::catalog::Sensor::Attitude)
+            {
+                bail!(
+                    "{}: {} is a mounting of an attitude reference; the scenario has no [attitude_reference] section to write one",
+                    src.at(common::TERMS[k].name),
+                    common::TERMS[k].name
+                );
+            }
+        }
         let clock_jitter_periods = raw.clock_jitter_periods.unwrap_or(1);
         if !(1..=4).contains(&clock_jitter_periods) {
             bail!(
@@ -415,6 +457,7 @@ impl Scenario {
             gnss,
             gnss_sigma_v,
             reference,
+            attitude_reference,
             clock_jitter_periods,
             text: text.to_string(),
             warnings,
@@ -806,6 +849,38 @@ fn parse_reference(
         );
     }
     Ok(Some((r.rate_hz, s, r.noisy)))
+}
+
+/// An attitude reference as (rate [Hz], 1-σ tilt and yaw [rad], noisy): a rate in (0,
+/// imu_rate_hz] [Hz], each σ in [0.001, 10] deg.
+fn parse_attitude_reference(
+    r: Option<&AttitudeReferenceSpec>,
+    src: &Src,
+    imu_rate_hz: f64,
+) -> Result<Option<(f64, f64, f64, bool)>> {
+    let Some(r) = r else { return Ok(None) };
+    if !(r.rate_hz > 0.0 && r.rate_hz <= imu_rate_hz) {
+        bail!(
+            "{}: [attitude_reference] rate_hz must be in (0, imu_rate_hz]",
+            src.at("rate_hz")
+        );
+    }
+    let mut sig = [0.0; 2];
+    for (k, (name, text)) in [("sigma_tilt", &r.sigma_tilt), ("sigma_yaw", &r.sigma_yaw)]
+        .into_iter()
+        .enumerate()
+    {
+        let s = units::parse_quantity_as(text, "rad")
+            .map_err(|e| anyhow!("{}: [attitude_reference] {name}: {e}", src.at(name)))?;
+        if !(0.001f64.to_radians()..=10f64.to_radians()).contains(&s) {
+            bail!(
+                "{}: [attitude_reference] {name} must be in [0.001, 10] deg (attitude.txt holds angles to 1e-6 deg)",
+                src.at(name)
+            );
+        }
+        sig[k] = s;
+    }
+    Ok(Some((r.rate_hz, sig[0], sig[1], r.noisy)))
 }
 
 /// The 1-σ [m/s] of the GNSS velocity written with each fix, if any (1e-4 to 100 m/s).

@@ -32,6 +32,8 @@ pub struct SimOutput {
     pub gnss_velocity: Option<Vec<crate::io::aiding::VelocityFix>>,
     /// Body-frame velocities of the scenario's `[reference]`, turned by its mounting terms.
     pub body_velocity: Option<Vec<crate::io::aiding::BodyVelocityFix>>,
+    /// Attitudes of the scenario's `[attitude_reference]`, turned by its mounting terms.
+    pub attitude: Option<Vec<crate::io::aiding::AttitudeFix>>,
     /// True navigation state at t = 0 (to start a navigator).
     pub start: NavState,
 }
@@ -156,6 +158,23 @@ fn reference_reading(
     v_b
 }
 
+/// The true attitude at `t` [s] as a reference mounted with the terms `terms` ((term, value
+/// rad)) reads it: C_r^n = C_b^n exp([m×]), as roll, pitch, yaw [rad].
+fn attitude_reading(traj: &Trajectory, t: f64, terms: &[(usize, f64)]) -> Vector3<f64> {
+    let mut m = Vector3::zeros();
+    for &(k, v) in terms {
+        let axis = match common::TERMS[k].name {
+            "att_mount_x" => 0,
+            "att_mount_y" => 1,
+            "att_mount_z" => 2,
+            other => unreachable!("{other} is no attitude reference mounting"),
+        };
+        m[axis] = v;
+    }
+    let c_r = traj.at(t).c * *nalgebra::Rotation3::from_scaled_axis(m).matrix();
+    crate::nav::attitude::euler_from_dcm(&c_r)
+}
+
 /// What stays fixed through a simulation: the trajectory, the step, the injected errors.
 struct Run<'a> {
     /// The scenario.
@@ -174,6 +193,8 @@ struct Run<'a> {
     gnss_terms: Vec<(usize, f64)>,
     /// The scenario's velocity-reference terms (mounting): (term index, SI value).
     reference_terms: Vec<(usize, f64)>,
+    /// The scenario's attitude-reference terms (mounting): (term index, rad).
+    attitude_terms: Vec<(usize, f64)>,
 }
 
 impl<'a> Run<'a> {
@@ -208,6 +229,12 @@ impl<'a> Run<'a> {
             .copied()
             .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Reference)
             .collect();
+        let attitude_terms: Vec<(usize, f64)> = sc
+            .errors
+            .iter()
+            .copied()
+            .filter(|&(k, _)| common::TERMS[k].sensor == Sensor::Attitude)
+            .collect();
         Run {
             sc,
             traj,
@@ -217,6 +244,7 @@ impl<'a> Run<'a> {
             needs_rates,
             gnss_terms,
             reference_terms,
+            attitude_terms,
         }
     }
 
@@ -253,7 +281,7 @@ impl<'a> Run<'a> {
                         Sensor::Gyro => om[inj.axis] += inj.value * r,
                         Sensor::Accel => fm[inj.axis] += inj.value * r,
                         // in the aiding (`gnss_shift`), not in the IMU
-                        Sensor::Gnss | Sensor::Reference => {}
+                        Sensor::Gnss | Sensor::Reference | Sensor::Attitude => {}
                     }
                 }
                 let wt = 0.5 * hsub * w;
@@ -397,6 +425,12 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         .reference
         .map(|r| (sc.imu_rate_hz / r.0).round().max(1.0) as usize);
     let mut body_velocity = Vec::new();
+    // and the attitude reference's on another
+    let mut rng_a = Rng::new(sc.seed ^ 0xa54f_f53a_5f1d_36f1);
+    let attitude_every = sc
+        .attitude_reference
+        .map(|r| (sc.imu_rate_hz / r.0).round().max(1.0) as usize);
+    let mut attitude = Vec::new();
     let d = std::f64::consts::PI / 180.0;
     let (mut lat, mut lon, mut h) = (sc.start.lat_deg * d, sc.start.lon_deg * d, sc.start.h_m);
     let k0 = traj.at(0.0);
@@ -485,6 +519,24 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
                 });
             }
         }
+        if let (Some(every), Some((_, s_tilt, s_yaw, noisy))) =
+            (attitude_every, sc.attitude_reference)
+        {
+            if (i + 1) % every == 0 {
+                let mut rpy = attitude_reading(traj, t1, &run.attitude_terms);
+                if noisy {
+                    rpy[0] += s_tilt * rng_a.normal();
+                    rpy[1] += s_tilt * rng_a.normal();
+                    rpy[2] += s_yaw * rng_a.normal();
+                }
+                attitude.push(crate::io::aiding::AttitudeFix {
+                    t: t1,
+                    rpy: [rpy.x, rpy.y, rpy.z],
+                    sigma_tilt: s_tilt,
+                    sigma_yaw: s_yaw,
+                });
+            }
+        }
         if i % report_every == 0 {
             progress(i as f64 / n as f64);
         }
@@ -500,6 +552,7 @@ pub fn simulate(sc: &Scenario, mut progress: impl FnMut(f64)) -> SimOutput {
         gnss,
         gnss_velocity: sc.gnss_sigma_v.map(|_| gnss_velocity),
         body_velocity: sc.reference.map(|_| body_velocity),
+        attitude: sc.attitude_reference.map(|_| attitude),
         start,
     }
 }
