@@ -105,6 +105,43 @@ fn explain_names_an_attitude_reference_mounting_and_no_sensor_term() {
     }
 }
 
+/// The attitude rows restamped 0.2 s late (a second INS's output latency): the time offset
+/// dt_att is named, -200 ms within 10 %, beside the mounting, and nothing else (before it was a
+/// candidate, an accelerometer white noise 21.5× the stated was named in its place).
+#[test]
+fn explain_names_a_late_attitude_reference() {
+    let dir = tmp("late");
+    let sim = simulated(&dir, |t| t);
+    let good = std::fs::read_to_string(sim.join("attitude.txt")).unwrap();
+    let late = dir.join("late.txt");
+    std::fs::write(
+        &late,
+        rewritten(&good, |mut v| {
+            v[0] += 0.2;
+            v
+        }),
+    )
+    .unwrap();
+    let j = explained(&sim, &late, &dir.join("explain"), &[]);
+    let mut named = causes(&j);
+    named.sort();
+    assert_eq!(
+        named,
+        ["att_mount_x", "att_mount_z", "dt_att"],
+        "{:#?}",
+        j["summary"]
+    );
+    let f = j["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["term"] == "dt_att")
+        .unwrap();
+    let est = f["estimate"].as_f64().unwrap();
+    assert!((est + 200.0).abs() < 20.0, "dt_att = {est} ms for -200");
+    assert_eq!(f["unit"], "ms");
+}
+
 /// A reference mounted true (no mounting in the scenario) names nothing; with the mounting but
 /// its terms withheld from the candidates, no sensor term or noise level is named in its place.
 #[test]
@@ -288,6 +325,14 @@ fn bad_attitude_input_is_refused_with_the_likely_slip() {
                 v
             }),
             "another clock",
+        ),
+        (
+            "other_run.txt",
+            rewritten(&good, |mut v| {
+                v[0] += 5.0;
+                v
+            }),
+            "when shifted by -4.95 s",
         ),
     ];
     for (name, text, want) in &cases {

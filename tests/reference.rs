@@ -433,6 +433,15 @@ fn bad_reference_input_is_refused_with_the_likely_slip() {
             "{e}"
         );
     }
+    // UTC stamps against GPST (18 s): inside the fixes' times, but its speeds line up with the
+    // GNSS's only shifted back
+    let f = dir.join("utc.txt");
+    std::fs::write(&f, rows(&|t: f64| t + 18.0)).unwrap();
+    let e = run("P13+vertical", Some(f.to_str().unwrap()));
+    assert!(
+        e.contains("when shifted by -18") && e.contains("its clock is not the IMU's"),
+        "{e}"
+    );
     // the position aiding file given as the reference
     let e = run("P13+vertical", Some(&p("gnss.txt")));
     assert!(e.contains("position aiding file"), "{e}");

@@ -99,6 +99,11 @@ class MisprintsAreCaught(unittest.TestCase):
         self.assertEqual(code, 1, f"transposed attitude mounting not caught:\n{out}")
         self.assertIn("][att_mount_x]:", out, f"wrong entry named:\n{out}")
 
+    def test_attitude_time_offset_without_frame_rate_is_named(self):
+        code, out = run("--corrupt", "16", "--models", "P13+dt_att")
+        self.assertEqual(code, 1, f"missing frame rate not caught:\n{out}")
+        self.assertIn("][dt_att]:", out, f"wrong entry named:\n{out}")
+
     def test_every_spec_term_is_checked_by_default(self):
         models = vj.default_models()
         named = {s for m in models for s in m.split("+")} | {s for m in models for s in vj.PRESETS.get(m.split("+")[0], [])}

@@ -191,9 +191,11 @@ REFERENCE_PHYSICS = {"mount_x": ("mount", 0), "mount_y": ("mount", 1), "mount_z"
 
 # Attitude-reference terms, written independently of the spec: the reference (a second INS, an
 # AHRS) gives the attitude of its own frame r, turned against the IMU body frame by roll, pitch,
-# yaw (att_mount_x, att_mount_y, att_mount_z): C_r^b = dcm_from_euler(mount), C_r^n = C_b^n C_r^b.
+# yaw (att_mount_x, att_mount_y, att_mount_z): C_r^b = dcm_from_euler(mount), C_r^n = C_b^n C_r^b;
+# ("time_offset",): the row stamped t is that attitude at t + theta [s] (C's rate from the true
+# navigation equations).
 ATTITUDE_PHYSICS = {"att_mount_x": ("mount", 0), "att_mount_y": ("mount", 1),
-                    "att_mount_z": ("mount", 2)}
+                    "att_mount_z": ("mount", 2), "dt_att": ("time_offset",)}
 
 
 # The tables of the terms that enter the measurements, by the spec's `sensor`.
@@ -363,11 +365,15 @@ def build_jacobian_function():
     # the attitude reference: the rotation from its attitude to the computed one, as the small
     # rotation vector e of C~ (C_r^n)^T = exp(-[e x]) (computed minus reference)
     att_mount = [0, 0, 0]
+    dt_att = 0
     for k, name in enumerate(TERM_NAMES):
         if TERMS[name][0] == "attitude":
-            axis = ATTITUDE_PHYSICS[name][1]
-            att_mount[axis] = att_mount[axis] + theta[k]
-    c_rn = c @ dcm_from_euler(att_mount[0], att_mount[1], att_mount[2])
+            kind = ATTITUDE_PHYSICS[name]
+            if kind[0] == "mount":
+                att_mount[kind[1]] = att_mount[kind[1]] + theta[k]
+            else:
+                dt_att = dt_att + theta[k]
+    c_rn = (c + dt_att * cd_t) @ dcm_from_euler(att_mount[0], att_mount[1], att_mount[2])
     rot = c_tilde @ c_rn.T
     z_att = -0.5 * ca.vertcat(rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1])
     z = ca.vertcat(dv[0] - dt * vd_t[0] - v_arm[0],
@@ -447,6 +453,12 @@ def corrupt(kind, out, pt):
         col = idx["att_mount_x"]
         for r in range(3):
             out["h"]["att_ref"][r][col] = float(cm[0, r])
+    elif kind == 16 and "att_ref" in out["h"] and "dt_att" in idx:
+        # an attitude reference's time offset without the navigation frame's rate
+        w_in = np.array([OMEGA * c + ve / rn, -pt["v_ned"][0] / (rm0 + pt["h_m"]),
+                         -OMEGA * s - ve * math.tan(lat) / rn])
+        for r in range(3):
+            out["h"]["att_ref"][r][idx["dt_att"]] += float(w_in[r])
     elif kind == 11 and "tau_y" in idx:
         # an accelerometer delay with its sign reversed (a lead taken for a lag)
         for k, row in enumerate(["dv_n", "dv_e", "dv_d"]):
@@ -619,7 +631,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20131)
     ap.add_argument("--tol", type=float, default=1e-9, help="relative tolerance")
     ap.add_argument("--models", nargs="*", default=None)
-    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed, 12: a reference mounting's yaw reversed in H[vel_body], 13: the attitude error's sign reversed in H[vel_body], 14: a reference time offset's H without the navigation frame's rate, 15: an attitude reference's mounting through C's row, not its column; the check must fail")
+    ap.add_argument("--corrupt", type=int, default=0, help="apply paper misprint K (1-6) to the generated A, or 7: R_N for R_M in H[pos_ne], 8: a time offset's velocity H without Coriolis, 9: a lever arm's velocity H reversed, 10: an off-axis inner lever arm's tangential part reversed, 11: an accelerometer delay's sign reversed, 12: a reference mounting's yaw reversed in H[vel_body], 13: the attitude error's sign reversed in H[vel_body], 14: a reference time offset's H without the navigation frame's rate, 15: an attitude reference's mounting through C's row, not its column, 16: an attitude reference's time offset without the navigation frame's rate; the check must fail")
     args = ap.parse_args()
 
     models = args.models or default_models()

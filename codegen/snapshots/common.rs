@@ -135,7 +135,7 @@ pub const NAV_STATES: [NavStateInfo; NAV_COUNT] = [
 ];
 
 /// Number of instrument error terms in the spec.
-pub const TERM_COUNT: usize = 72;
+pub const TERM_COUNT: usize = 73;
 
 /// Instrument error terms in spec order.
 pub const TERMS: [TermInfo; TERM_COUNT] = [
@@ -1219,6 +1219,21 @@ pub const TERMS: [TermInfo; TERM_COUNT] = [
         doc: "attitude reference mounting yaw against the IMU body frame (small angle)",
         library: true,
     },
+    TermInfo {
+        name: "dt_att",
+        sensor: Sensor::Attitude,
+        axis: 0,
+        regressor: 0,
+        unit: "s",
+        display: "ms",
+        display_to_si: 0.001,
+        sigma: 0.1,
+        noise: 0.0,
+        limit: 1.0,
+        group: "attitude reference time offset",
+        doc: "attitude reference time offset: the row stamped t is the attitude at t + dt_att",
+        library: true,
+    },
 ];
 
 /// Structural non-zeros of the full navigation block.
@@ -1327,6 +1342,7 @@ pub const TERM_ROWS: [&[usize]; TERM_COUNT] = [
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
     &[DV_N, DV_E, DV_D],
+    &[],
     &[],
     &[],
     &[],
@@ -1523,6 +1539,7 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.017453292519943295,
             0.017453292519943295,
             0.017453292519943295,
+            0.1,
         ],
     },
     GradeInfo {
@@ -1616,6 +1633,7 @@ pub const GRADES: [GradeInfo; GRADE_COUNT] = [
             0.017453292519943295,
             0.017453292519943295,
             0.017453292519943295,
+            0.1,
         ],
     },
 ];
@@ -2553,6 +2571,9 @@ pub fn term_column(term: usize, nav: &NavPoint, r: f64, col: &mut [f64; NAV_COUN
         71 => {
             // att_mount_z: Attitude x axis, regressor 1
         }
+        72 => {
+            // dt_att: Attitude x axis, regressor 1
+        }
         _ => panic!("term index {term} out of range"),
     }
 }
@@ -2805,6 +2826,12 @@ pub fn measurement_entries(
             );
         }
         4 => {
+            let lat = nav.lat;
+            let vn = nav.v_ned[0];
+            let ve = nav.v_ned[1];
+            let rm = nav.rm;
+            let rn = nav.rn;
+            let omega = nav.omega;
             let c11 = nav.c[0][0];
             let c12 = nav.c[0][1];
             let c13 = nav.c[0][2];
@@ -2814,18 +2841,33 @@ pub fn measurement_entries(
             let c31 = nav.c[2][0];
             let c32 = nav.c[2][1];
             let c33 = nav.c[2][2];
+            let w_x = nav.w_b[0];
+            let w_y = nav.w_b[1];
+            let w_z = nav.w_b[2];
             emit(0, "phi_n", 1.0);
             emit(0, "att_mount_x", c11);
             emit(0, "att_mount_y", c12);
             emit(0, "att_mount_z", c13);
+            emit(
+                0,
+                "dt_att",
+                c11 * w_x + c12 * w_y + c13 * w_z - (omega * lat.cos() + ve / rn),
+            );
             emit(1, "phi_e", 1.0);
             emit(1, "att_mount_x", c21);
             emit(1, "att_mount_y", c22);
             emit(1, "att_mount_z", c23);
+            emit(1, "dt_att", c21 * w_x + c22 * w_y + c23 * w_z + vn / rm);
             emit(2, "phi_d", 1.0);
             emit(2, "att_mount_x", c31);
             emit(2, "att_mount_y", c32);
             emit(2, "att_mount_z", c33);
+            emit(
+                2,
+                "dt_att",
+                c31 * w_x + c32 * w_y + c33 * w_z
+                    - (-omega * lat.sin() - ve * lat.tan() / rn),
+            );
         }
         _ => panic!("measurement index {m} out of range"),
     }

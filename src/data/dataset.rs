@@ -710,9 +710,106 @@ impl DataOptions {
                     after.len()
                 )),
             }
+            if let Some(lag) = reference_clock_lag(fixes, &after) {
+                bail!(
+                    "--body-velocity {}: its speeds follow the GNSS fixes' {} when shifted by {:+.2} s (mean square difference {:.3} (m/s)² there, {:.3} as stamped): its clock is not the IMU's (UTC against GPST: 18 s; another time base; ms for s?); a latency under 1 s is estimated by explain as dt_ref",
+                    path.display(),
+                    self.aid.as_deref().map_or("--aid".into(), |p| p.display().to_string()),
+                    lag.shift_s,
+                    lag.msd_best,
+                    lag.msd_zero
+                );
+            }
         }
         Ok(after)
     }
+}
+
+/// A reference's speeds matching the GNSS's far better shifted in time than as stamped.
+struct ClockLag {
+    /// The shift that fits best [s] (a row stamped t is the speed at t + shift_s).
+    shift_s: f64,
+    /// Mean square difference (about its mean) at that shift [(m/s)², deg²].
+    msd_best: f64,
+    /// ... and as stamped.
+    msd_zero: f64,
+}
+
+/// Largest shift searched between a reference's clock and the GNSS's [s].
+const MAX_CLOCK_SHIFT_S: f64 = 60.0;
+
+/// The shift of the velocity reference's clock against the GNSS fixes' when it is one the data
+/// show ([`best_shift`] of the GNSS speed from consecutive fixes at most 2 s apart against the
+/// reference's speed interpolated there).
+fn reference_clock_lag(
+    fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
+    body: &[BodyVelocityFix],
+) -> Option<ClockLag> {
+    let gnss: Vec<(f64, f64)> = fixes
+        .windows(2)
+        .filter_map(|w| {
+            let (a, b) = (&w[0].0, &w[1].0);
+            let dt = b.t - a.t;
+            (dt > 0.0 && dt <= 2.0).then(|| {
+                let d = horizontal_distance_m(a.lat, a.lon, a.h, b.lat, b.lon).hypot(b.h - a.h);
+                (0.5 * (a.t + b.t), d / dt)
+            })
+        })
+        .collect();
+    let speed = |t: f64| -> Option<f64> {
+        let k = body.partition_point(|r| r.t < t);
+        if k == 0 || k >= body.len() {
+            return None;
+        }
+        let (a, b) = (&body[k - 1], &body[k]);
+        if b.t - a.t > 2.0 {
+            return None;
+        }
+        let w = (t - a.t) / (b.t - a.t);
+        let n = |r: &BodyVelocityFix| nalgebra::Vector3::from(r.v_frd).norm();
+        Some(n(a) + w * (n(b) - n(a)))
+    };
+    best_shift(&gnss, &speed, &|r, v| r - v)
+}
+
+/// The shift of a reference's clock against the GNSS's that the data show ([`ClockLag`]): the
+/// shift s (−60…60 s in 0.05 s steps) minimising the mean square of `diff(reference at t − s,
+/// GNSS value at t)` over the GNSS series `gnss` ((t, value)) about its mean, kept when beyond
+/// 1 s (a latency within it is the reference's time-offset term's) and when the spread as
+/// stamped exceeds that at the shift by more than half of it and beyond chance (n (m₀ − m)/m
+/// above 100 over the n values compared, an F-like ratio; a steady motion shows no shift: flat).
+fn best_shift(
+    gnss: &[(f64, f64)],
+    value_at: &dyn Fn(f64) -> Option<f64>,
+    diff: &dyn Fn(f64, f64) -> f64,
+) -> Option<ClockLag> {
+    let msd = |shift: f64| -> Option<f64> {
+        let d: Vec<f64> = gnss
+            .iter()
+            .filter_map(|&(t, v)| value_at(t - shift).map(|r| diff(r, v)))
+            .collect();
+        // at least half the pairs compared, and 10
+        if d.len() < 10 || 2 * d.len() < gnss.len() {
+            return None;
+        }
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        Some(d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / d.len() as f64)
+    };
+    let msd_zero = msd(0.0)?;
+    let steps = (MAX_CLOCK_SHIFT_S / 0.05).round() as i64;
+    let (shift_s, msd_best) = (-steps..=steps)
+        .filter_map(|k| {
+            let s = k as f64 * 0.05;
+            msd(s).map(|m| (s, m))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let n = gnss.len() as f64;
+    let gain = n * (msd_zero - msd_best) / msd_best.max(f64::MIN_POSITIVE);
+    (shift_s.abs() > 1.0 && msd_zero > 1.5 * msd_best && gain > 100.0).then_some(ClockLag {
+        shift_s,
+        msd_best,
+        msd_zero,
+    })
 }
 
 impl DataOptions {
@@ -771,9 +868,60 @@ impl DataOptions {
                     after.len()
                 )),
             }
+            if let Some(lag) = attitude_clock_lag(fixes, &after) {
+                bail!(
+                    "--attitude {}: its yaw follows the GNSS course of {} when shifted by {:+.2} s (mean square difference about its mean {:.3} deg² there, {:.3} as stamped): its clock is not the IMU's (UTC against GPST: 18 s; another run's file; another time base?)",
+                    path.display(),
+                    self.aid.as_deref().map_or("--aid".into(), |p| p.display().to_string()),
+                    lag.shift_s,
+                    lag.msd_best,
+                    lag.msd_zero
+                );
+            }
         }
         Ok(after)
     }
+}
+
+/// An angle difference wrapped to ±180 [deg].
+fn wrap_deg(d: f64) -> f64 {
+    (d + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// The shift of the attitude reference's clock against the GNSS fixes' when it is one the data
+/// show ([`best_shift`] of the GNSS course from consecutive fixes at most 2 s apart moving
+/// faster than 3 m/s against the reference's yaw interpolated there, both deg).
+fn attitude_clock_lag(
+    fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
+    rows: &[AttitudeFix],
+) -> Option<ClockLag> {
+    let course: Vec<(f64, f64)> = fixes
+        .windows(2)
+        .filter_map(|w| {
+            let (a, b) = (&w[0].0, &w[1].0);
+            let dt = b.t - a.t;
+            let dn = (b.lat - a.lat) * (earth::radius_meridian(a.lat) + a.h);
+            let de = earth::lon_difference(b.lon, a.lon)
+                * (earth::radius_transverse(a.lat) + a.h)
+                * a.lat.cos();
+            (dt > 0.0 && dt <= 2.0 && dn.hypot(de) / dt >= 3.0)
+                .then(|| (0.5 * (a.t + b.t), de.atan2(dn).to_degrees()))
+        })
+        .collect();
+    let yaw = |t: f64| -> Option<f64> {
+        let k = rows.partition_point(|r| r.t < t);
+        if k == 0 || k >= rows.len() {
+            return None;
+        }
+        let (a, b) = (&rows[k - 1], &rows[k]);
+        if b.t - a.t > 2.0 {
+            return None;
+        }
+        let w = (t - a.t) / (b.t - a.t);
+        let (ya, yb) = (a.rpy[2].to_degrees(), b.rpy[2].to_degrees());
+        Some(ya + w * wrap_deg(yb - ya))
+    };
+    best_shift(&course, &yaw, &|r, v| wrap_deg(r - v))
 }
 
 /// A reading of an attitude row's yaw [rad] under a hypothesis about its file.

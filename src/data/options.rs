@@ -145,7 +145,8 @@ pub struct DataOptions {
     #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub init_speed: Option<f64>,
     /// open (errors estimated only) or closed (fed back) [default: open; closed with
-    /// --body-velocity, whose rows open loop would linearise about the free-inertial solution].
+    /// --body-velocity or --attitude, whose rows open loop would linearise about the
+    /// free-inertial solution].
     #[cfg_attr(feature = "cli", arg(long))]
     pub mode: Option<String>,
     /// Filter step [s] [default: 0.01, or the IMU's median interval when that is longer].
@@ -193,8 +194,8 @@ pub struct DataOptions {
     )]
     pub mounting: Option<Vec<String>>,
     /// Attitude reference (a second INS, an AHRS): a file of `t roll pitch yaw sigma_tilt
-    /// sigma_yaw` (s on the IMU's clock; the reference frame's FRD axes against NED, deg; deg),
-    /// used as the `att_ref` measurement.
+    /// sigma_yaw` (s on the IMU's clock; z-y-x Euler angles of the reference frame's FRD axes
+    /// against NED, deg, yaw -180..360; deg), used as the `att_ref` measurement.
     #[cfg_attr(feature = "cli", arg(long))]
     pub attitude: Option<PathBuf>,
 }

@@ -275,6 +275,9 @@ pub struct Explanation {
     /// Fraction of the baseline's excess mean NIS the extended model leaves; absent when the
     /// baseline's mean NIS is within its 95 % band.
     pub misfit_unexplained: Option<f64>,
+    /// The extended model holds only the causes: the stand-ins found last (a small share beside
+    /// a misfit the causes leave) were taken out of it and its pass run again.
+    pub stand_ins_left_out: bool,
     /// Baseline terms whose prior looks too tight for these data: in the extended model (the
     /// findings added) their estimate still lies beyond 3 prior σ and 3 own σ. Explain then
     /// ran again from the baseline with each prior widened to `suggested`.

@@ -453,32 +453,19 @@ pub fn explain(
     // the share of the baseline's excess the extended model leaves
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
-    // (complete_findings gives one finding per named term, in order)
-    for (((f, j), n), rival) in findings.iter_mut().zip(judged).zip(&r.named).zip(rivals) {
-        if !j.is_cause() {
-            // a stand-in keeps the value it was fitted with; its words say what is left now
-            *f = j;
-            // (a stand-in for a withheld GNSS term is no value to hold with a prior)
-            f.suggested_prior = rival
-                .is_none()
-                .then(|| suggested_prior(f, ctx.opts))
-                .flatten();
-            f.stand_in = f.stand_in.as_ref().and(joined(
-                stand_in_reason(f, misfit_unexplained, ctx.opts),
-                rival,
-            ));
-            let t = n.term;
-            let info = &common::TERMS[t];
-            (f.headline, f.words) =
-                finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
-        }
-    }
+    keep_stand_ins(ctx, &r, &mut findings, judged, rivals, misfit_unexplained);
     mark_passed_over(&mut findings, &stand_ins, &passed_over);
     companions_move(ctx, &r, &tests, &mut findings, progress)?;
     aiding_and_sensor_confounded(ctx, &r, &mut findings, progress)?;
     value_not_fixed(&mut findings);
     findings.extend(noise_findings);
-    small_beside_the_unexplained(&mut findings, opts);
+    // a term this rule unnames leaves the extended model: its pass is run again without it
+    let (model_name, rerun) = if small_beside_the_unexplained(&mut findings, opts) {
+        causes_only_pass(ctx, &r, &findings, progress)?
+    } else {
+        (r.model.name.clone(), None)
+    };
+    let last_pass = rerun.as_ref().unwrap_or(last_pass);
     let mut implausible = r.implausible;
     implausible.retain(|i| !findings.iter().any(|f| f.term == i.term));
     let extended_stats = last_pass.stats.clone();
@@ -495,13 +482,17 @@ pub fn explain(
         implausible,
         unconfirmed: r.unconfirmed,
         not_separable,
-        extended_model: r.model.name.clone(),
+        extended_model: model_name,
         extended: extended_stats,
         gain,
         rounds: r.rounds,
         alpha: opts.alpha,
         summary: Vec::new(),
-        misfit_unexplained: misfit_unexplained.map(|u| u.max(0.0)),
+        misfit_unexplained: match &rerun {
+            Some(p) => excess.map(|e| ((p.stats.nis_mean - 1.0) / e).max(0.0)),
+            None => misfit_unexplained.map(|u| u.max(0.0)),
+        },
+        stand_ins_left_out: rerun.is_some(),
         baseline_priors_tight: tight,
         baseline_priors_widened: widened_kept,
         baseline_priors_gain: prior_gain,
@@ -692,6 +683,62 @@ fn value_not_fixed(findings: &mut [Finding]) {
     }
 }
 
+/// Each finding that was judged no cause (`judged`, one per named term of `r`, in order) keeps
+/// the value it was fitted with; its words say what is left now (`unexplained`), with the
+/// withheld GNSS term it may stand in for (`rivals`).
+fn keep_stand_ins(
+    ctx: &Context,
+    r: &Rounds,
+    findings: &mut [Finding],
+    judged: Vec<Finding>,
+    rivals: Vec<Option<String>>,
+    unexplained: Option<f64>,
+) {
+    for (((f, j), n), rival) in findings.iter_mut().zip(judged).zip(&r.named).zip(rivals) {
+        if j.is_cause() {
+            continue;
+        }
+        *f = j;
+        // (a stand-in for a withheld GNSS term is no value to hold with a prior)
+        f.suggested_prior = rival
+            .is_none()
+            .then(|| suggested_prior(f, ctx.opts))
+            .flatten();
+        f.stand_in = f
+            .stand_in
+            .as_ref()
+            .and(joined(stand_in_reason(f, unexplained, ctx.opts), rival));
+        let info = &common::TERMS[n.term];
+        (f.headline, f.words) =
+            finding_words(f, info, prior_sigma(n.term, ctx.opts) / info.display_to_si);
+    }
+}
+
+/// The name of the model of the causes among `findings` (the baseline and the named terms of `r`
+/// that are causes) and its pass.
+fn causes_only_pass(
+    ctx: &Context,
+    r: &Rounds,
+    findings: &[Finding],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<(String, Option<Pass>)> {
+    let causes = r
+        .named
+        .iter()
+        .map(|n| n.term)
+        .filter(|&t| {
+            findings
+                .iter()
+                .any(|f| f.term == common::TERMS[t].name && f.is_cause())
+        })
+        .collect::<Vec<_>>();
+    let model = model_with(&ctx.baseline.name, causes)?;
+    let cfg = ctx.extended_config(&model, &r.widened)?;
+    let round = r.rounds + 1;
+    let pass = run_pass(&model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
+    Ok((model.name.clone(), Some(pass)))
+}
+
 /// Prior σ beyond which a term cause that removes a small share of the misfit, while the causes
 /// together leave most of it, is a stand-in (the prior itself objects to it at 3 σ).
 const UNEXPLAINED_PRIOR_SIGMAS: f64 = 3.0;
@@ -703,21 +750,24 @@ const UNEXPLAINED_PRIOR_SIGMAS: f64 = 3.0;
 /// others are not causes (measured: an attitude reference's mounting withheld from the
 /// candidates gave "Found: lever_y = -5.32 ± 0.19 m", 7 % of the misfit, the rest fitted only
 /// by noise levels that hold nowhere).
-fn small_beside_the_unexplained(findings: &mut [Finding], opts: &ExplainOptions) {
+/// Returns whether it unnamed a term.
+fn small_beside_the_unexplained(findings: &mut [Finding], opts: &ExplainOptions) -> bool {
     let explained: f64 = findings
         .iter()
         .filter(|f| f.is_cause())
         .filter_map(|f| f.misfit_share)
         .sum();
     if explained >= 0.5 {
-        return;
+        return false;
     }
+    let mut unnamed = false;
     for f in findings.iter_mut().filter(|f| {
         f.is_cause()
             && f.kind != "noise"
             && f.prior_sigmas.abs() > UNEXPLAINED_PRIOR_SIGMAS
             && f.misfit_share.is_some_and(|s| s < opts.stand_in_share)
     }) {
+        unnamed = true;
         let Some(t) = common::TERMS.iter().position(|t| t.name == f.term) else {
             continue;
         };
@@ -730,6 +780,7 @@ fn small_beside_the_unexplained(findings: &mut [Finding], opts: &ExplainOptions)
         let info = &common::TERMS[t];
         (f.headline, f.words) = finding_words(f, info, prior_sigma(t, opts) / info.display_to_si);
     }
+    unnamed
 }
 
 /// Largest |correlation| of two causes' estimates in the extended filter at which both stay

@@ -650,7 +650,9 @@ fn noise_finding(
     };
     // a body-frame reference's rows are no fixes
     let states = match f.level {
-        Level::Sigma(m) if m.ends_with("_body") => "the σ the reference's rows state",
+        Level::Sigma(m) if m.ends_with("_body") || m == "att_ref" => {
+            "the σ the reference's rows state"
+        }
         _ => "the σ the fixes state",
     };
     let words = match (bound, f.level) {

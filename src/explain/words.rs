@@ -324,9 +324,9 @@ fn gnss_finding_words(f: &Finding, info: &crate::model::catalog::TermInfo) -> (S
             }
         ));
     }
-    if info.sensor == Sensor::Attitude {
+    if info.sensor == Sensor::Attitude && info.unit == "rad" {
         s.push_str(
-            "; the reference's frame is turned by this angle against the IMU's: it reports the IMU's attitude turned by it (roll, pitch, yaw of the reference's FRD axes in the IMU's)",
+            "; the reference's axes are turned by this angle against the IMU's (on a level vehicle it reads its roll, pitch or yaw larger by it): rotate the reference's output back by it, or keep the term in the model",
         );
     }
     if !f.equivalent.is_empty() {
@@ -624,12 +624,8 @@ fn findings_words(e: &Explanation, out: &mut Vec<String>) {
     for f in &e.findings {
         out.push(finding_line(f));
     }
-    // every finding a term that is no cause (no noise level either): nothing is added
-    if !e.findings.is_empty()
-        && e.findings
-            .iter()
-            .all(|f| f.kind != "noise" && !f.is_cause())
-    {
+    // no finding a cause (a term or a noise level): nothing is added
+    if !e.findings.is_empty() && e.findings.iter().all(|f| !f.is_cause()) {
         out.push(format!(
             "No term is added: every term fitted is a stand-in or not attributed, so the model stays {}.",
             e.baseline_model
@@ -686,13 +682,22 @@ fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
             e.misfit_unexplained_by_causes(),
             out.last_mut(),
         ) {
-            *last = format!(
-                "Left unexplained by the causes found: {} % of the baseline's excess misfit. Fits that are not causes (\"Fitted, but not a cause\" above) take up {} % of it; with them the extended model leaves {} % (mean NIS {} against 1 for a consistent filter), which is no explanation.",
-                sig3(100.0 * by_causes),
-                sig3(100.0 * taken),
-                sig3(100.0 * left.max(0.0)),
-                nis_text(e.extended.nis_mean),
-            );
+            *last = if e.stand_ins_left_out {
+                format!(
+                    "Left unexplained by the causes found: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter). Fits that are not causes (\"Fitted, but not a cause\" above) take up {} % of it; they are left out of the extended model.",
+                    sig3(100.0 * left.max(0.0)),
+                    nis_text(e.extended.nis_mean),
+                    sig3(100.0 * taken),
+                )
+            } else {
+                format!(
+                    "Left unexplained by the causes found: {} % of the baseline's excess misfit. Fits that are not causes (\"Fitted, but not a cause\" above) take up {} % of it; with them the extended model leaves {} % (mean NIS {} against 1 for a consistent filter), which is no explanation.",
+                    sig3(100.0 * by_causes),
+                    sig3(100.0 * taken),
+                    sig3(100.0 * left.max(0.0)),
+                    nis_text(e.extended.nis_mean),
+                )
+            };
         }
     }
     // what the extended model leaves in the innovations (the baseline's was said above)

@@ -252,12 +252,17 @@ pub fn write_body_velocity(path: &Path, rows: &[BodyVelocityFix], header: &str) 
 const MAX_REFERENCE_SPEED: f64 = 300.0;
 
 /// Reads a body-velocity reference file (`t vx vy vz sigma`: s, FRD m/s, m/s): time strictly
-/// increasing, speeds within ±300 m/s, σ in [1e-4, 2] m/s; each error names the line and the
+/// increasing, speeds within ±300 m/s, σ in [0.001, 2] m/s; each error names the line and the
 /// likely slip.
 pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
     let rows = read_table(path, 5, "body-velocity reference file").map_err(|e| {
         // a GNSS aiding file given here is the likeliest slip
-        if e.to_string().contains("found 7") || e.to_string().contains("found 11") {
+        if e.to_string().contains("found 6") {
+            e.context(format!(
+                "{}: 6 columns is the layout of an attitude reference (--attitude: t roll pitch yaw sigma_tilt sigma_yaw); --body-velocity takes `t vx vy vz sigma` in the body frame",
+                path.display()
+            ))
+        } else if e.to_string().contains("found 7") || e.to_string().contains("found 11") {
             e.context(format!(
                 "{}: 7 or 11 columns is the layout of a position aiding file (--aid); --body-velocity takes `t vx vy vz sigma` in the body frame",
                 path.display()
@@ -292,9 +297,9 @@ pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
                 v[3]
             );
         }
-        if !(1e-4..=2.0).contains(&v[4]) {
+        if !(1e-3..=2.0).contains(&v[4]) {
             bail!(
-                "{at}: sigma {} must be in [1e-4, 2] m/s (a reference worse than 2 m/s carries nothing; cm/s or mm/s written as m/s?)",
+                "{at}: sigma {} must be in [0.001, 2] m/s (an odometer or DVL is not better than 1 mm/s, and one worse than 2 m/s carries nothing; cm/s or mm/s written as m/s?)",
                 v[4]
             );
         }

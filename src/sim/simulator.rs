@@ -158,20 +158,20 @@ fn reference_reading(
     v_b
 }
 
-/// The true attitude at `t` [s] as a reference mounted with the terms `terms` ((term, value
-/// rad)) reads it: C_r^n = C_b^n exp([m×]), as roll, pitch, yaw [rad].
+/// The true attitude at `t` [s] as a reference with the terms `terms` ((term, value SI)) reads
+/// it: C_r^n = C_b^n(t + dt_att) exp([m×]), as roll, pitch, yaw [rad].
 fn attitude_reading(traj: &Trajectory, t: f64, terms: &[(usize, f64)]) -> Vector3<f64> {
-    let mut m = Vector3::zeros();
+    let (mut m, mut dt) = (Vector3::zeros(), 0.0);
     for &(k, v) in terms {
-        let axis = match common::TERMS[k].name {
-            "att_mount_x" => 0,
-            "att_mount_y" => 1,
-            "att_mount_z" => 2,
-            other => unreachable!("{other} is no attitude reference mounting"),
-        };
-        m[axis] = v;
+        match common::TERMS[k].name {
+            "att_mount_x" => m[0] = v,
+            "att_mount_y" => m[1] = v,
+            "att_mount_z" => m[2] = v,
+            "dt_att" => dt = v,
+            other => unreachable!("{other} is no attitude reference term the simulator knows"),
+        }
     }
-    let c_r = traj.at(t).c * *nalgebra::Rotation3::from_scaled_axis(m).matrix();
+    let c_r = traj.at(t + dt).c * *nalgebra::Rotation3::from_scaled_axis(m).matrix();
     crate::nav::attitude::euler_from_dcm(&c_r)
 }
 
