@@ -102,6 +102,108 @@ fn horizontal_distance_m(lat: f64, lon: f64, h: f64, lat2: f64, lon2: f64) -> f6
     dn.hypot(de)
 }
 
+/// The GNSS motion between two consecutive fixes at most 2 s apart: the interval [s] and the
+/// displacement north, east (flat, at the first fix) and up [m].
+struct FixStep {
+    /// First fix's time [s].
+    t0: f64,
+    /// Second fix's time [s].
+    t1: f64,
+    /// North displacement [m].
+    dn: f64,
+    /// East displacement [m].
+    de: f64,
+    /// Up displacement [m].
+    du: f64,
+}
+
+impl FixStep {
+    /// Mid time [s].
+    fn t_mid(&self) -> f64 {
+        0.5 * (self.t0 + self.t1)
+    }
+    /// Horizontal speed [m/s].
+    fn horizontal_speed(&self) -> f64 {
+        self.dn.hypot(self.de) / (self.t1 - self.t0)
+    }
+    /// Speed, with the vertical [m/s].
+    fn speed(&self) -> f64 {
+        self.dn.hypot(self.de).hypot(self.du) / (self.t1 - self.t0)
+    }
+    /// Course over ground, clockwise from north [rad].
+    fn course(&self) -> f64 {
+        self.de.atan2(self.dn)
+    }
+}
+
+/// Each pair of consecutive fixes at most 2 s apart as a [`FixStep`].
+fn fix_steps(fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)]) -> Vec<FixStep> {
+    fixes
+        .windows(2)
+        .filter_map(|w| {
+            let (a, b) = (&w[0].0, &w[1].0);
+            let dt = b.t - a.t;
+            (dt > 0.0 && dt <= 2.0).then(|| FixStep {
+                t0: a.t,
+                t1: b.t,
+                dn: (b.lat - a.lat) * (earth::radius_meridian(a.lat) + a.h),
+                de: earth::lon_difference(b.lon, a.lon)
+                    * (earth::radius_transverse(a.lat) + a.h)
+                    * a.lat.cos(),
+                du: b.h - a.h,
+            })
+        })
+        .collect()
+}
+
+/// The rows of a reference file (`option` `path`, `first`..`last` its time span [s]) after the
+/// run's start `t0` [s]: at least 10 must be.
+fn rows_after<R: super::aid::ReferenceRow>(
+    option: &str,
+    path: &std::path::Path,
+    rows: Vec<R>,
+    t0: f64,
+) -> Result<Vec<R>> {
+    let (first, last) = (rows[0].t(), rows[rows.len() - 1].t());
+    let after: Vec<R> = rows.into_iter().filter(|r| r.t() > t0).collect();
+    if after.len() < 10 {
+        bail!(
+            "{option} {}: {} of its rows (t = {first:.3} to {last:.3} s) fall after the run's start at t = {t0:.3} s; at least 10 are needed (its times must be on the IMU's clock: UTC for GPST, or ms for s?)",
+            path.display(),
+            after.len()
+        );
+    }
+    Ok(after)
+}
+
+/// Most of a reference's rows (`option` `path`, times `times` [s], in order) must fall within
+/// the GNSS fixes' times (±1 s), else another clock.
+fn check_within_fixes(
+    option: &str,
+    path: &std::path::Path,
+    times: &[f64],
+    fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
+) -> Result<()> {
+    let (Some((p0, _)), Some((p1, _)), Some(&first), Some(&last)) =
+        (fixes.first(), fixes.last(), times.first(), times.last())
+    else {
+        return Ok(());
+    };
+    let (f0, f1) = (p0.t, p1.t);
+    let inside = times
+        .iter()
+        .filter(|&&t| t >= f0 - 1.0 && t <= f1 + 1.0)
+        .count();
+    if 2 * inside < times.len() {
+        bail!(
+            "{option} {}: {inside} of its {} rows after the start fall within the GNSS fixes' times (t = {f0:.3} to {f1:.3} s); its rows run t = {first:.3} to {last:.3} s: another clock (GPS seconds against the IMU's, UTC against GPST: 18 s) or ms written as s?",
+            path.display(),
+            times.len()
+        );
+    }
+    Ok(())
+}
+
 impl DataOptions {
     /// Opens the IMU, aiding and truth files for one streamed pass and builds the initial
     /// state; everything that can be checked before the run is (the aiding epochs that fall
@@ -680,15 +782,7 @@ impl DataOptions {
             return Ok(Vec::new());
         };
         let rows = crate::io::aiding::read_body_velocity(path)?;
-        let (first, last) = (rows[0].t, rows[rows.len() - 1].t);
-        let after: Vec<BodyVelocityFix> = rows.into_iter().filter(|r| r.t > t0).collect();
-        if after.len() < 10 {
-            bail!(
-                "--body-velocity {}: {} of its rows (t = {first:.3} to {last:.3} s) fall after the run's start at t = {t0:.3} s; at least 10 are needed (its times must be on the IMU's clock: UTC for GPST, or ms for s?)",
-                path.display(),
-                after.len()
-            );
-        }
+        let after = rows_after("--body-velocity", path, rows, t0)?;
         check_reference_times(path, &after, aid)?;
         if let Some(w) = sideways_reference(&after) {
             note(&format!("warning: --body-velocity {}: {w}", path.display()));
@@ -745,16 +839,9 @@ fn reference_clock_lag(
     fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
     body: &[BodyVelocityFix],
 ) -> Option<ClockLag> {
-    let gnss: Vec<(f64, f64)> = fixes
-        .windows(2)
-        .filter_map(|w| {
-            let (a, b) = (&w[0].0, &w[1].0);
-            let dt = b.t - a.t;
-            (dt > 0.0 && dt <= 2.0).then(|| {
-                let d = horizontal_distance_m(a.lat, a.lon, a.h, b.lat, b.lon).hypot(b.h - a.h);
-                (0.5 * (a.t + b.t), d / dt)
-            })
-        })
+    let gnss: Vec<(f64, f64)> = fix_steps(fixes)
+        .iter()
+        .map(|s| (s.t_mid(), s.speed()))
         .collect();
     let speed = |t: f64| -> Option<f64> {
         let k = body.partition_point(|r| r.t < t);
@@ -784,16 +871,21 @@ fn best_shift(
     diff: &dyn Fn(f64, f64) -> f64,
 ) -> Option<ClockLag> {
     let msd = |shift: f64| -> Option<f64> {
-        let d: Vec<f64> = gnss
+        let (mut n, mut sum, mut sum2) = (0usize, 0.0, 0.0);
+        for d in gnss
             .iter()
             .filter_map(|&(t, v)| value_at(t - shift).map(|r| diff(r, v)))
-            .collect();
+        {
+            n += 1;
+            sum += d;
+            sum2 += d * d;
+        }
         // at least half the pairs compared, and 10
-        if d.len() < 10 || 2 * d.len() < gnss.len() {
+        if n < 10 || 2 * n < gnss.len() {
             return None;
         }
-        let mean = d.iter().sum::<f64>() / d.len() as f64;
-        Some(d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / d.len() as f64)
+        let mean = sum / n as f64;
+        Some((sum2 / n as f64 - mean * mean).max(0.0))
     };
     let msd_zero = msd(0.0)?;
     let steps = (MAX_CLOCK_SHIFT_S / 0.05).round() as i64;
@@ -826,30 +918,10 @@ impl DataOptions {
             return Ok(Vec::new());
         };
         let rows = crate::io::aiding::read_attitude(path)?;
-        let (first, last) = (rows[0].t, rows[rows.len() - 1].t);
-        let after: Vec<AttitudeFix> = rows.into_iter().filter(|r| r.t > t0).collect();
-        if after.len() < 10 {
-            bail!(
-                "--attitude {}: {} of its rows (t = {first:.3} to {last:.3} s) fall after the run's start at t = {t0:.3} s; at least 10 are needed (its times must be on the IMU's clock: UTC for GPST, or ms for s?)",
-                path.display(),
-                after.len()
-            );
-        }
+        let after = rows_after("--attitude", path, rows, t0)?;
         if let AidPlan::Fixes(fixes, _, _) = aid {
-            if !fixes.is_empty() {
-                let (f0, f1) = (fixes[0].0.t, fixes[fixes.len() - 1].0.t);
-                let inside = after
-                    .iter()
-                    .filter(|r| r.t >= f0 - 1.0 && r.t <= f1 + 1.0)
-                    .count();
-                if 2 * inside < after.len() {
-                    bail!(
-                        "--attitude {}: {inside} of its {} rows after the start fall within the GNSS fixes' times (t = {f0:.3} to {f1:.3} s); its rows run t = {first:.3} to {last:.3} s: another clock (GPS seconds against the IMU's, UTC against GPST: 18 s) or ms written as s?",
-                        path.display(),
-                        after.len()
-                    );
-                }
-            }
+            let times: Vec<f64> = after.iter().map(|r| r.t).collect();
+            check_within_fixes("--attitude", path, &times, fixes)?;
             let yaw = |r: &AttitudeFix| r.rpy[2];
             match heading_offset(fixes, &after, &yaw) {
                 Some((d, spread)) if !follows_course(d, spread) => {
@@ -895,18 +967,10 @@ fn attitude_clock_lag(
     fixes: &[(PositionFix, Option<crate::io::aiding::VelocityFix>)],
     rows: &[AttitudeFix],
 ) -> Option<ClockLag> {
-    let course: Vec<(f64, f64)> = fixes
-        .windows(2)
-        .filter_map(|w| {
-            let (a, b) = (&w[0].0, &w[1].0);
-            let dt = b.t - a.t;
-            let dn = (b.lat - a.lat) * (earth::radius_meridian(a.lat) + a.h);
-            let de = earth::lon_difference(b.lon, a.lon)
-                * (earth::radius_transverse(a.lat) + a.h)
-                * a.lat.cos();
-            (dt > 0.0 && dt <= 2.0 && dn.hypot(de) / dt >= 3.0)
-                .then(|| (0.5 * (a.t + b.t), de.atan2(dn).to_degrees()))
-        })
+    let course: Vec<(f64, f64)> = fix_steps(fixes)
+        .iter()
+        .filter(|s| s.horizontal_speed() >= 3.0)
+        .map(|s| (s.t_mid(), s.course().to_degrees()))
         .collect();
     let yaw = |t: f64| -> Option<f64> {
         let k = rows.partition_point(|r| r.t < t);
@@ -975,31 +1039,16 @@ fn heading_offset(
 ) -> Option<(f64, f64)> {
     let mut diffs = Vec::new();
     let mut j = 0;
-    for w in fixes.windows(2) {
-        let (a, b) = (&w[0].0, &w[1].0);
-        let dt = b.t - a.t;
-        if !(dt > 0.0 && dt <= 2.0) {
+    for step in fix_steps(fixes) {
+        if step.horizontal_speed() < 3.0 {
             continue;
         }
-        let dn = (b.lat - a.lat) * (earth::radius_meridian(a.lat) + a.h);
-        let de = earth::lon_difference(b.lon, a.lon)
-            * (earth::radius_transverse(a.lat) + a.h)
-            * a.lat.cos();
-        if dn.hypot(de) / dt < 3.0 {
-            continue;
-        }
-        let course = de.atan2(dn);
-        while j < rows.len() && rows[j].t < a.t {
+        let course = step.course();
+        while j < rows.len() && rows[j].t < step.t0 {
             j += 1;
         }
-        for r in rows[j..].iter().take_while(|r| r.t <= b.t) {
-            let d = (yaw(r) - course).rem_euclid(std::f64::consts::TAU);
-            let d = if d > std::f64::consts::PI {
-                d - std::f64::consts::TAU
-            } else {
-                d
-            };
-            diffs.push(d.to_degrees());
+        for r in rows[j..].iter().take_while(|r| r.t <= step.t1) {
+            diffs.push(wrap_deg((yaw(r) - course).to_degrees()));
         }
     }
     if diffs.len() < 10 {
@@ -1019,20 +1068,14 @@ fn reference_speed_ratio(
 ) -> Option<f64> {
     let mut ratios = Vec::new();
     let mut j = 0;
-    for w in fixes.windows(2) {
-        let (a, b) = (&w[0].0, &w[1].0);
-        let dt = b.t - a.t;
-        if !(dt > 0.0 && dt <= 2.0) {
-            continue;
-        }
-        let gnss_speed =
-            horizontal_distance_m(a.lat, a.lon, a.h, b.lat, b.lon).hypot(b.h - a.h) / dt;
-        while j < body.len() && body[j].t < a.t {
+    for step in fix_steps(fixes) {
+        let gnss_speed = step.speed();
+        while j < body.len() && body[j].t < step.t0 {
             j += 1;
         }
         let inside: Vec<f64> = body[j..]
             .iter()
-            .take_while(|r| r.t <= b.t)
+            .take_while(|r| r.t <= step.t1)
             .map(|r| nalgebra::Vector3::from(r.v_frd).norm())
             .collect();
         if inside.is_empty() || gnss_speed < 1.0 {
@@ -1072,21 +1115,10 @@ fn check_reference_times(
     rows: &[BodyVelocityFix],
     aid: &AidPlan,
 ) -> Result<()> {
-    let (first, last) = (rows[0].t, rows[rows.len() - 1].t);
     match aid {
-        AidPlan::Fixes(fixes, _, _) if !fixes.is_empty() => {
-            let (f0, f1) = (fixes[0].0.t, fixes[fixes.len() - 1].0.t);
-            let inside = rows
-                .iter()
-                .filter(|r| r.t >= f0 - 1.0 && r.t <= f1 + 1.0)
-                .count();
-            if 2 * inside < rows.len() {
-                bail!(
-                    "--body-velocity {}: {inside} of its {} rows after the start fall within the GNSS fixes' times (t = {f0:.3} to {f1:.3} s); its rows run t = {first:.3} to {last:.3} s: another clock (GPS seconds against the IMU's, UTC against GPST: 18 s) or ms written as s?",
-                    path.display(),
-                    rows.len()
-                );
-            }
+        AidPlan::Fixes(fixes, _, _) => {
+            let times: Vec<f64> = rows.iter().map(|r| r.t).collect();
+            check_within_fixes("--body-velocity", path, &times, fixes)?;
         }
         AidPlan::Static { .. } => {
             let mut speeds: Vec<f64> = rows
@@ -1102,7 +1134,6 @@ fn check_reference_times(
                 );
             }
         }
-        _ => {}
     }
     Ok(())
 }

@@ -648,11 +648,9 @@ fn noise_finding(
         1 => Some(("≥", "larger", "at least")),
         _ => None,
     };
-    // a body-frame reference's rows are no fixes
+    // a reference's rows (body velocity, attitude) are no fixes
     let states = match f.level {
-        Level::Sigma(m) if m.ends_with("_body") || m == "att_ref" => {
-            "the σ the reference's rows state"
-        }
+        Level::Sigma(m) if from_reference(m) => "the σ the reference's rows state",
         _ => "the σ the fixes state",
     };
     let words = match (bound, f.level) {
@@ -736,6 +734,15 @@ fn noise_finding(
         speed_halves: None,
         consistency: vec![],
     }
+}
+
+/// Measurement `m` is formed from a reference's rows (its spec `aiding` is a body velocity or an
+/// attitude), not from GNSS fixes.
+fn from_reference(m: &str) -> bool {
+    use crate::model::catalog::Aiding;
+    crate::model::generated::common::MEASUREMENTS
+        .iter()
+        .any(|x| x.name == m && matches!(x.aiding, Aiding::BodyVelocity | Aiding::Attitude))
 }
 
 #[cfg(test)]

@@ -280,15 +280,7 @@ pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
     let mut out: Vec<BodyVelocityFix> = Vec::with_capacity(rows.len());
     for (line, v) in rows {
         let at = format!("{}:{line}", path.display());
-        if let Some(prev) = out.last() {
-            if v[0] <= prev.t {
-                bail!(
-                    "{at}: time {} s is not after the previous row's {} s (rows must be in time order, each time once)",
-                    v[0],
-                    prev.t
-                );
-            }
-        }
+        check_after(&at, v[0], out.last().map(|r| r.t))?;
         if v[1..4].iter().any(|x| x.abs() > MAX_REFERENCE_SPEED) {
             bail!(
                 "{at}: a velocity component beyond ±{MAX_REFERENCE_SPEED} m/s ({}, {}, {}): km/h or mm/s written as m/s?",
@@ -310,6 +302,16 @@ pub fn read_body_velocity(path: &Path) -> Result<Vec<BodyVelocityFix>> {
         });
     }
     Ok(out)
+}
+
+/// A reference row's time `t` [s] must follow the previous row's `prev` (`at`: file and line).
+fn check_after(at: &str, t: f64, prev: Option<f64>) -> Result<()> {
+    match prev {
+        Some(p) if t <= p => bail!(
+            "{at}: time {t} s is not after the previous row's {p} s (rows must be in time order, each time once)"
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// An attitude from a reference (a second INS, an AHRS): the roll, pitch and yaw of its own
@@ -378,15 +380,7 @@ pub fn read_attitude(path: &Path) -> Result<Vec<AttitudeFix>> {
     let mut out: Vec<AttitudeFix> = Vec::with_capacity(rows.len());
     for (line, v) in rows {
         let at = format!("{}:{line}", path.display());
-        if let Some(prev) = out.last() {
-            if v[0] <= prev.t {
-                bail!(
-                    "{at}: time {} s is not after the previous row's {} s (rows must be in time order, each time once)",
-                    v[0],
-                    prev.t
-                );
-            }
-        }
+        check_after(&at, v[0], out.last().map(|r| r.t))?;
         let (roll, pitch, yaw) = (v[1], v[2], v[3]);
         if roll.abs() > 180.0 || pitch.abs() > 90.0 || !(-180.0..=360.0).contains(&yaw) {
             bail!(
