@@ -512,7 +512,7 @@ pub fn noise(data: &[u8]) {
 
 /// One stored case of an `explain-eval` campaign (a `cases.json` entry, JSON), checked as
 /// `explain-eval --merge` checks it against the published campaign's settings
-/// (`docs/explain-eval/cases.json`: seed 7, seven groups, 600 s). Property: an accepted case has
+/// (`docs/explain-eval/sensor-600/cases.json`: seed 7, seven groups, 600 s). Property: an accepted case has
 /// finite numbers (λ > 0, σ > 0, a truth ≠ 0) and flags that agree with what it named.
 pub fn eval_case(data: &[u8]) {
     use crate::experiment::explain_eval::{CaseResult, EvalSpec};

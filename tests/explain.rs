@@ -604,13 +604,9 @@ fn probe() {
         "null" => CaseKind::Null,
         "two" => CaseKind::Two,
         g => CaseKind::One(
-            sinsmodel::sim::hidden::GROUPS
-                .iter()
-                .chain(sinsmodel::sim::hidden::GNSS_GROUPS.iter())
-                .chain(sinsmodel::sim::hidden::TURNTABLE_GROUPS.iter())
-                .chain(sinsmodel::sim::hidden::NOISE_GROUPS.iter())
-                .chain(sinsmodel::sim::hidden::REFERENCE_GROUPS.iter())
-                .find(|x| **x == g)
+            sinsmodel::sim::hidden::all_groups()
+                .into_iter()
+                .find(|x| *x == g)
                 .expect("a group, null or two"),
         ),
     };
@@ -618,7 +614,12 @@ fn probe() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
-    let mut case = generate(seed, kind, SECONDS, clear_effect(kind));
+    // CASE_SECONDS=300: a shorter case (explain-eval's --seconds)
+    let seconds = std::env::var("CASE_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(SECONDS);
+    let mut case = generate(seed, kind, seconds, clear_effect(kind));
     if let Ok(w) = std::env::var("WITHHOLD") {
         case = case.withholding(&w.split(',').collect::<Vec<_>>());
     }

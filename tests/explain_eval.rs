@@ -171,6 +171,67 @@ fn small_campaign_structure_behaviour_broken_selector_and_merge() {
     }
 }
 
+/// Every kind of cause in one small campaign: a two-term case (d and kas on one axis), a
+/// misstated noise (a null case for terms, which explain must call noise), a GNSS lever arm, a
+/// turntable's inner lever arm and accelerometer delay; the report states the test, gives the
+/// rates' confidence intervals and a power curve per group.
+#[test]
+fn every_kind_of_cause_in_a_small_campaign() {
+    let groups = "two_axis,noise_gyro,gnss_lever,inner_lever,accel_delay";
+    let (dir, v) = eval("kinds", &["--cases", "10", "--groups", groups]);
+    let cases = json(&dir.join("cases.json"));
+    let cases = cases["cases"].as_array().unwrap();
+    let of = |g: &'static str| cases.iter().filter(move |c| c["group"] == g);
+    assert!(of("two_axis").count() >= 1, "seed 3 draws a two-term case");
+    for c in of("two_axis") {
+        let kas = c["term"].as_str().unwrap().replace("d_", "kas_");
+        assert_eq!(c["also_hidden"], serde_json::json!([kas]), "{c}");
+    }
+    for c in of("noise_gyro") {
+        assert_eq!(c["noise_misstated"], serde_json::json!(["gyro_arw"]));
+        assert!(c["term"].is_null(), "a noise case hides no term: {c}");
+    }
+    for c in of("accel_delay") {
+        assert_eq!(c["also_hidden"], serde_json::json!(["tau_y", "tau_z"]));
+    }
+    behaves(&v).unwrap();
+    for k in [
+        "false_alarm_ci",
+        "wrong_term_ci",
+        "detection_lambda_50_ci",
+        "calibration_ci",
+        "noise_cases",
+    ] {
+        assert!(v.get(k).is_some(), "eval.json lacks {k}");
+    }
+    if let Some([lo, hi]) = v["false_alarm_ci"]
+        .as_array()
+        .map(|a| [a[0].as_f64().unwrap(), a[1].as_f64().unwrap()])
+    {
+        assert!(lo <= v["false_alarm_rate"].as_f64().unwrap() && hi > 0.0);
+    }
+    for g in groups.split(',') {
+        let bins = v["by_group"][g]["power_curve"].as_array().unwrap();
+        assert_eq!(bins.len(), 6, "{g}: six λ bins");
+    }
+    let md = std::fs::read_to_string(dir.join("eval.md")).unwrap();
+    for says in ["Holm's first threshold", "95 % interval", "per λ bin"] {
+        assert!(md.contains(says), "eval.md does not say {says}:\n{md}");
+    }
+    assert!(dir.join("power_by_group.png").exists());
+    // an unknown group is refused naming the known ones
+    let (ok, err) = sinsmodel(&[
+        "explain-eval",
+        "--cases",
+        "1",
+        "--groups",
+        "d,nosuch",
+        "--out",
+        tmp("nosuch").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("unknown group `nosuch`") && err.contains("two_axis"));
+}
+
 /// `--merge` checks every stored case like any input: an edited field is refused naming the
 /// shard's file, the case's index and the field (never an `inf %` from a truth of 0), and a
 /// range of indices missing between shards is refused naming it.
@@ -201,7 +262,17 @@ fn merged_cases_are_checked_like_any_input() {
         .expect("seed 3 finds a hidden term in its first three cases");
     let index = stored["cases"][k]["index"].as_u64().unwrap();
     let edited = tmp("chk_edit");
-    let edits: [(&str, serde_json::Value, &str); 11] = [
+    let edits: [(&str, serde_json::Value, &str); 13] = [
+        (
+            "also_hidden",
+            serde_json::json!(["kas_x"]),
+            "also_hidden [kas_x]",
+        ),
+        (
+            "noise_misstated",
+            serde_json::json!(["gyro_arw"]),
+            "noise_misstated [gyro_arw]",
+        ),
         ("lambda", serde_json::json!(-5.0), "lambda -5"),
         (
             "lambda",

@@ -7,11 +7,12 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
 use sinsmodel::experiment::eval_check::{check_case, missing_ranges};
-use sinsmodel::experiment::explain_eval::{self, CaseResult, EvalSpec, Summary};
+use sinsmodel::experiment::eval_report::{headline, markdown};
+use sinsmodel::experiment::explain_eval::{self, CaseResult, EvalSpec};
 use sinsmodel::io::atomic_file::{self, OutputDir};
 use sinsmodel::report::plot::{self, Scale, Series};
 use sinsmodel::report::progress;
-use sinsmodel::sim::hidden::GROUPS;
+use sinsmodel::sim::hidden::{all_groups, GROUPS};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -27,7 +28,8 @@ pub struct EvalArgs {
     /// Index of the first case (shards of one campaign: `--first 0 --cases 100`, `--first 100 …`).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000))]
     first: u64,
-    /// Library groups to draw from (default all: d,kaq,kas,kao,kgf,kgq,size).
+    /// Groups to draw from (default the sensor groups d,kaq,kas,kao,kgf,kgq,size; `all` for
+    /// every group: also GNSS, reference, turntable, two-term and misstated-noise groups).
     #[arg(long, value_delimiter = ',')]
     groups: Option<Vec<String>>,
     /// Threads (default: all cores, or as many as an address-space limit `ulimit -v` leaves room
@@ -44,7 +46,7 @@ pub struct EvalArgs {
     #[arg(long, num_args = 1..)]
     merge: Vec<PathBuf>,
     /// Output DIRECTORY (not a file; navigate's --out is a file): eval.json, eval.md,
-    /// cases.json, power_curve.png.
+    /// cases.json, power_curve.png, power_by_group.png.
     #[arg(long)]
     out: PathBuf,
     /// Test only: a deliberately broken selector (names a pseudo-random candidate).
@@ -82,13 +84,20 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         bail!("--alpha {}: expected a level in (0, 0.5]", args.alpha);
     }
     let groups: Vec<String> = match &args.groups {
+        Some(g) if g.len() == 1 && g[0] == "all" => {
+            all_groups().iter().map(|s| s.to_string()).collect()
+        }
         Some(g) => {
+            let known = all_groups();
             for x in g {
-                if !GROUPS.contains(&x.as_str()) {
+                if !known.contains(&x.as_str()) {
                     bail!(
-                        "--groups: unknown group `{x}` (groups: {})",
-                        GROUPS.join(", ")
+                        "--groups: unknown group `{x}` (groups: {}; or `all`)",
+                        known.join(", ")
                     );
+                }
+                if g.iter().filter(|y| *y == x).count() > 1 {
+                    bail!("--groups: `{x}` is given twice");
                 }
             }
             if g.is_empty() {
@@ -250,36 +259,6 @@ fn merge(args: &EvalArgs) -> Result<()> {
     Ok(())
 }
 
-fn pct(v: Option<f64>) -> String {
-    // (never `inf %`: merged cases are checked, and what slips past is said as such)
-    match v {
-        Some(x) if x.is_finite() => format!("{:.1} %", 100.0 * x),
-        Some(x) => format!("not finite ({x})"),
-        None => "—".into(),
-    }
-}
-
-fn headline(s: &Summary) -> Vec<String> {
-    vec![
-        format!(
-            "detection {} (λ ≥ 50: {}), false alarms {} of {} null cases, wrong term {}, a noise level named in {} of the cases",
-            pct(s.detection_rate),
-            pct(s.detection_rate_lambda_50),
-            pct(s.false_alarm_rate),
-            s.null_cases,
-            pct(s.wrong_term_rate),
-            pct(s.noise_finding_rate)
-        ),
-        format!(
-            "coefficient error median {} (90 %: {}), calibration (truth within ±2σ) {}, gain recovery median {}",
-            pct(s.coef_error_median),
-            pct(s.coef_error_p90),
-            pct(s.calibration),
-            pct(s.gain_recovery_median)
-        ),
-    ]
-}
-
 fn write(out: &OutputDir, spec: &EvalSpec, cases: &[CaseResult], wall: Option<f64>) -> Result<()> {
     let s = explain_eval::summarize(spec, cases);
     let mut v = serde_json::to_value(&s)?;
@@ -305,7 +284,7 @@ fn write(out: &OutputDir, spec: &EvalSpec, cases: &[CaseResult], wall: Option<f6
         .iter()
         .filter_map(|b| Some(((b.lambda_lo * b.lambda_hi).sqrt(), b.detection_rate?)))
         .collect();
-    let c_thr = sinsmodel::estimate::stats::chi2_isf(s.alpha / s.candidates_tested_median, 1.0);
+    let c_thr = explain_eval::first_threshold(s.alpha, s.candidates_tested_median as usize);
     let theory: Vec<(f64, f64)> = (0..=60)
         .map(|k| {
             let l = 10f64.powf(1.0 + 2.0 * k as f64 / 60.0);
@@ -324,43 +303,43 @@ fn write(out: &OutputDir, spec: &EvalSpec, cases: &[CaseResult], wall: Option<f6
             },
             Series {
                 label: format!(
-                    "theory: χ²₁(λ) at Holm's first threshold (α {}, {} candidates)",
+                    "theory: the first test, χ²₁(λ) at Holm's first threshold (α {}, {} candidates)",
                     s.alpha, s.candidates_tested_median
                 ),
-                points: theory,
+                points: theory.clone(),
             },
         ],
         Scale::LogX,
     )?;
-    atomic_file::write_text(&out.file("eval.md"), &markdown(&s, cases.len()))?;
+    // per group: measured detection per λ bin, one line each, beside the stated test's curve
+    let mut groups: Vec<Series> = s
+        .by_group
+        .iter()
+        .filter(|(_, g)| g.cases > 0)
+        .map(|(name, g)| Series {
+            label: name.clone(),
+            points: g
+                .power_curve
+                .iter()
+                .filter_map(|b| Some(((b.lambda_lo * b.lambda_hi).sqrt(), b.detection_rate?)))
+                .collect(),
+        })
+        .collect();
+    groups.push(Series {
+        label: "theory (the first test)".into(),
+        points: theory,
+    });
+    plot::line_plot(
+        &out.file("power_by_group.png"),
+        "explain: detection against λ, per group",
+        "λ",
+        "detection rate",
+        &groups,
+        Scale::LogX,
+    )?;
+    atomic_file::write_text(
+        &out.file("eval.md"),
+        &markdown(&s, cases.len(), spec.seconds),
+    )?;
     Ok(())
-}
-
-fn markdown(s: &Summary, n: usize) -> String {
-    let mut m = format!("# explain-eval: {n} cases, seed {}\n\n", s.seed);
-    for l in headline(s) {
-        m.push_str(&format!("- {l}\n"));
-    }
-    m.push_str("\n| λ bin | cases | detected | theory |\n|---|---|---|---|\n");
-    for b in &s.power_curve {
-        m.push_str(&format!(
-            "| {:.0}–{:.0} | {} | {} | {:.1} % |\n",
-            b.lambda_lo,
-            b.lambda_hi,
-            b.cases,
-            pct(b.detection_rate),
-            100.0 * b.theory
-        ));
-    }
-    m.push_str("\n| group | cases | detected | detected, λ ≥ 50 |\n|---|---|---|---|\n");
-    for (g, st) in &s.by_group {
-        m.push_str(&format!(
-            "| {g} | {} | {} | {} |\n",
-            st.cases,
-            pct(st.detection_rate),
-            pct(st.detection_rate_lambda_50)
-        ));
-    }
-    m.push_str("\n![power curve](power_curve.png)\n");
-    m
 }

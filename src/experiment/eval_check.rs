@@ -57,6 +57,22 @@ fn check_draw(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
             shown(want)
         ));
     }
+    let also: Vec<&str> = d.case.hidden.iter().skip(1).map(|h| h.0.as_str()).collect();
+    if c.also_hidden != also {
+        return Err(format!(
+            "also_hidden [{}]: case {i} of seed {seed} hides [{}] beside its first term",
+            c.also_hidden.join(", "),
+            also.join(", ")
+        ));
+    }
+    let misstated: Vec<&str> = d.case.noise_ratio.iter().map(|n| n.0.as_str()).collect();
+    if c.noise_misstated != misstated {
+        return Err(format!(
+            "noise_misstated [{}]: case {i} of seed {seed} states [{}] wrongly",
+            c.noise_misstated.join(", "),
+            misstated.join(", ")
+        ));
+    }
     // the truth's size comes from the simulation (λ over the signature's information), its
     // sign from the draw
     if let (Some(v), Some((_, reference))) = (c.truth, d.case.hidden.first()) {
@@ -137,6 +153,15 @@ fn check_outcome(c: &CaseResult) -> Result<(), String> {
             c.named.join(", ")
         ));
     }
+    if let Some(n) = c
+        .stand_ins
+        .iter()
+        .find(|n| !is_term(n) || c.named.contains(n))
+    {
+        return Err(format!(
+            "stand_ins: `{n}` is not a library term or is also among named (a finding is a claim or a stand-in)"
+        ));
+    }
     if let Some(n) = c.named.iter().find(|n| !is_term(n)) {
         return Err(format!(
             "named: `{n}` is not a term of the model spec's library"
@@ -163,6 +188,12 @@ fn check_outcome(c: &CaseResult) -> Result<(), String> {
 fn check_flags(c: &CaseResult) -> Result<(), String> {
     let (d, w, nothing) = (c.detected, c.wrong_term, c.named.is_empty());
     let named = c.named.join(", ");
+    let hidden: Vec<&str> = c
+        .term
+        .iter()
+        .chain(&c.also_hidden)
+        .map(String::as_str)
+        .collect();
     let why = match c.term.as_deref() {
         None if d => "detected = true in a null case (nothing is hidden)".to_string(),
         None if w == nothing => format!(
@@ -173,13 +204,13 @@ fn check_flags(c: &CaseResult) -> Result<(), String> {
         _ if w && nothing => format!(
             "wrong_term = true with detected = {d}, yet named is empty: a wrong term is a named one"
         ),
-        Some(t) if !d && c.named.iter().any(|n| n == t) => {
-            format!("detected = false, yet named holds the hidden term `{t}`")
+        Some(t) if !d && hidden.iter().all(|h| c.named.iter().any(|n| n == h)) => {
+            format!("detected = false, yet named holds the hidden term `{t}` and any beside it")
         }
-        Some(t) if w && c.named.iter().all(|n| n == t) => format!(
-            "wrong_term = true, yet named holds only the hidden term `{t}`: a wrong term is another one"
+        Some(t) if w && c.named.iter().all(|n| hidden.contains(&n.as_str())) => format!(
+            "wrong_term = true, yet named holds only the hidden term `{t}` or those beside it: a wrong term is another one"
         ),
-        Some(_) if !d && !w && !nothing => format!(
+        Some(_) if !d && !w && !nothing && hidden.len() == 1 => format!(
             "detected = false and wrong_term = false, yet named holds {named}: a named term is the hidden one (detected) or not (a wrong term)"
         ),
         _ => return Ok(()),

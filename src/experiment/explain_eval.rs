@@ -6,11 +6,11 @@
 
 use crate::estimate::filter::FilterConfig;
 use crate::estimate::stats;
-use crate::experiment::hidden::{inject, run_hidden_on, simulate_case};
+use crate::experiment::hidden::{inject, run_hidden_on, simulate_case, stated_config};
 use crate::explain::{self, signature_information, ExplainData, ExplainOptions};
 use crate::model::generated::common;
 use crate::model::Model;
-use crate::sim::hidden::{clear_effect, generate, CaseKind, GROUPS};
+use crate::sim::hidden::{all_groups, clear_effect, generate, CaseKind, GROUPS};
 use crate::sim::rng::Rng;
 use serde::{Deserialize, Serialize};
 
@@ -53,13 +53,23 @@ pub struct CaseResult {
     pub index: usize,
     /// `null` or the library group.
     pub group: String,
-    /// Hidden term (None for a null case).
+    /// Hidden term (None for a null case; the first of a two-term case).
     pub term: Option<String>,
+    /// The other hidden terms of a case that hides more than one (a two-term case, a mounting's
+    /// two axes, a turntable's three delays).
+    #[serde(default)]
+    pub also_hidden: Vec<String>,
+    /// Noise levels the case states wrongly to the filter (a noise case); explain should name
+    /// them as noise, not a term.
+    #[serde(default)]
+    pub noise_misstated: Vec<String>,
     /// True value (display unit of the term).
     pub truth: Option<f64>,
-    /// Noncentrality λ = θ² I of the hidden term's test through the baseline filter.
+    /// Noncentrality λ = θ² I of the hidden term's test through the baseline filter (of the
+    /// weakest hidden term, when there are more than one).
     pub lambda: Option<f64>,
-    /// Terms explain named (sensor and measurement findings).
+    /// Terms explain named (sensor and measurement findings that are no stand-ins: causes, and
+    /// classes the data cannot attribute to one member).
     pub named: Vec<String>,
     /// Noise levels explain named (noise findings: a claim about the data's noise, not a term).
     #[serde(default)]
@@ -67,9 +77,13 @@ pub struct CaseResult {
     /// Of those, the ones it labelled "not one level across the data" (stand-ins).
     #[serde(default)]
     pub noise_stand_ins: Vec<String>,
-    /// The hidden term was named or is in a named class.
+    /// Terms explain fitted but labelled stand-ins ("Fitted, but not a cause"): no claim, so
+    /// neither a detection nor a wrong term.
+    #[serde(default)]
+    pub stand_ins: Vec<String>,
+    /// Every hidden term was named or is in a named class.
     pub detected: bool,
-    /// A named term is neither the hidden one nor in a class with it (or anything in a null case).
+    /// A named term is neither a hidden one nor in a class with one (or anything in a null case).
     pub wrong_term: bool,
     /// Estimate of the hidden term (display unit) and its σ, when detected.
     pub estimate: Option<f64>,
@@ -110,11 +124,15 @@ pub fn draw(spec: &EvalSpec, index: usize) -> anyhow::Result<Drawn> {
         CaseKind::Null
     } else {
         let k = ((rng.uniform() * spec.groups.len() as f64) as usize).min(spec.groups.len() - 1);
-        let g = GROUPS
-            .iter()
-            .find(|g| **g == spec.groups[k])
+        let g = all_groups()
+            .into_iter()
+            .find(|g| *g == spec.groups[k])
             .ok_or_else(|| anyhow::anyhow!("unknown group `{}`", spec.groups[k]))?;
-        CaseKind::One(g)
+        if g == "two" {
+            CaseKind::Two
+        } else {
+            CaseKind::One(g)
+        }
     };
     let case_seed = spec
         .seed
@@ -139,17 +157,128 @@ pub fn run_case(
         case: drawn,
         lambda: drawn_lambda,
     } = draw(spec, index)?;
-    // simulate without the hidden term, then put it in at the drawn λ
-    let mut case = drawn.scaled(0.0);
-    let (mut sim, aid) = simulate_case(&case)?;
     let mut opts = opts.clone();
     opts.alpha = spec.alpha;
-    let (mut lambda, mut truth_si, mut term) = (None, None, None);
-    if let Some((name, reference)) = drawn.hidden.first() {
-        let t = common::TERMS
+    let put = if GROUPS.contains(&drawn.group.as_str()) {
+        put_in_increments(&drawn, drawn_lambda, index)?
+    } else {
+        put_in_simulation(&drawn, drawn_lambda, index)?
+    };
+    let Put {
+        case,
+        sim,
+        aid,
+        lambda,
+        truth_si,
+    } = put;
+    let term = case
+        .hidden
+        .first()
+        .and_then(|h| common::TERMS.iter().position(|x| x.name == h.0));
+    let out = run_hidden_on(&case, &sim, &aid, &opts)?;
+    let e = &out.explanation;
+    // a claim: a term finding that is no stand-in (a cause, or a class the data cannot
+    // attribute to one member); a stand-in ("Fitted, but not a cause: it probably stands in for
+    // …") claims nothing about the sensor and is neither a detection nor a wrong term
+    let claims: Vec<&crate::explain::Finding> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind != "noise" && f.stand_in.is_none())
+        .collect();
+    let named: Vec<String> = claims.iter().map(|f| f.term.clone()).collect();
+    let stand_ins: Vec<String> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind != "noise" && f.stand_in.is_some())
+        .map(|f| f.term.clone())
+        .collect();
+    let noise_named: Vec<String> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind == "noise")
+        .map(|f| f.term.clone())
+        .collect();
+    let noise_stand_ins: Vec<String> = e
+        .findings
+        .iter()
+        .filter(|f| f.kind == "noise" && f.stand_in.is_some())
+        .map(|f| f.term.clone())
+        .collect();
+    let hidden: Vec<&str> = case.hidden.iter().map(|h| h.0.as_str()).collect();
+    let (mut detected, mut estimate, mut sigma) = (false, None, None);
+    if let Some(t) = term {
+        let name = common::TERMS[t].name;
+        detected = hidden.iter().all(|h| {
+            claims
+                .iter()
+                .any(|f| f.term == *h || f.equivalent.iter().any(|q| q == h))
+        });
+        for f in &claims {
+            if f.term == name {
+                estimate = Some(f.estimate);
+                sigma = Some(f.sigma);
+            } else if let Some(q) = f.equivalent_estimates.iter().find(|q| q.term == name) {
+                estimate = Some(q.estimate);
+                sigma = Some(q.sigma);
+            }
+        }
+    }
+    let hidden_name = term.map(|t| common::TERMS[t].name);
+    let wrong_term = claims.iter().any(|f| {
+        !hidden
             .iter()
-            .position(|x| x.name == name)
-            .ok_or_else(|| anyhow::anyhow!("hidden term `{name}` is not a spec term"))?;
+            .any(|h| f.term == *h || f.equivalent.iter().any(|q| q == h))
+    });
+    Ok(CaseResult {
+        index,
+        group: drawn.group.clone(),
+        term: hidden_name.map(str::to_string),
+        also_hidden: hidden.iter().skip(1).map(|h| h.to_string()).collect(),
+        noise_misstated: case.noise_ratio.iter().map(|n| n.0.clone()).collect(),
+        truth: term
+            .zip(truth_si)
+            .map(|(t, v)| v / common::TERMS[t].display_to_si),
+        lambda,
+        named,
+        noise_named,
+        noise_stand_ins,
+        stand_ins,
+        detected,
+        wrong_term,
+        estimate,
+        sigma,
+        gain_recovery: out.gain_recovery().map(|g| g.0),
+        candidates_tested: e
+            .candidates
+            .iter()
+            .filter(|c| c.testable && c.confounded_with.is_none())
+            .count(),
+        seconds_taken: t_start.elapsed().as_secs_f64(),
+    })
+}
+
+/// A case with its hidden terms put in at the drawn λ: the case (its hidden values the ones
+/// put in), its simulated data, and the λ and first term's true value (SI) put in.
+struct Put {
+    case: crate::sim::hidden::HiddenCase,
+    sim: crate::sim::simulator::SimOutput,
+    aid: Vec<crate::estimate::filter::AidingEpoch>,
+    lambda: Option<f64>,
+    truth_si: Option<f64>,
+}
+
+/// A sensor group's term: simulated without it, then put into the IMU's increments at the drawn
+/// λ (θ · regressor · Δt along the sensor axis; I from a pilot pass on the same data).
+fn put_in_increments(
+    drawn: &crate::sim::hidden::HiddenCase,
+    drawn_lambda: Option<f64>,
+    index: usize,
+) -> anyhow::Result<Put> {
+    let mut case = drawn.scaled(0.0);
+    let (mut sim, aid) = simulate_case(&case)?;
+    let (mut lambda, mut truth_si) = (None, None);
+    if let Some((name, reference)) = drawn.hidden.first() {
+        let t = term_index(name)?;
         let baseline = Model::parse(&case.baseline)?;
         let data = ExplainData {
             imu: crate::explain::ImuInput::Memory(&sim.imu),
@@ -165,74 +294,77 @@ pub fn run_case(
         case.hidden = vec![(name.clone(), theta)];
         lambda = Some(lam);
         truth_si = Some(theta);
-        term = Some(t);
     }
-    let out = run_hidden_on(&case, &sim, &aid, &opts)?;
-    let e = &out.explanation;
-    let named: Vec<String> = e
-        .findings
-        .iter()
-        .filter(|f| f.kind != "noise")
-        .map(|f| f.term.clone())
-        .collect();
-    let noise_named: Vec<String> = e
-        .findings
-        .iter()
-        .filter(|f| f.kind == "noise")
-        .map(|f| f.term.clone())
-        .collect();
-    let noise_stand_ins: Vec<String> = e
-        .findings
-        .iter()
-        .filter(|f| f.kind == "noise" && f.stand_in.is_some())
-        .map(|f| f.term.clone())
-        .collect();
-    let (mut detected, mut estimate, mut sigma) = (false, None, None);
-    if let Some(t) = term {
-        let name = common::TERMS[t].name;
-        detected = out.found(name);
-        for f in &e.findings {
-            if f.term == name {
-                estimate = Some(f.estimate);
-                sigma = Some(f.sigma);
-            } else if let Some(q) = f.equivalent_estimates.iter().find(|q| q.term == name) {
-                estimate = Some(q.estimate);
-                sigma = Some(q.sigma);
-            }
-        }
-    }
-    let hidden_name = term.map(|t| common::TERMS[t].name);
-    let wrong_term = e
-        .findings
-        .iter()
-        .filter(|f| f.kind != "noise")
-        .any(|f| match hidden_name {
-            Some(h) => f.term != h && !f.equivalent.iter().any(|q| q == h),
-            None => true,
-        });
-    Ok(CaseResult {
-        index,
-        group: drawn.group.clone(),
-        term: hidden_name.map(str::to_string),
-        truth: term
-            .zip(truth_si)
-            .map(|(t, v)| v / common::TERMS[t].display_to_si),
+    Ok(Put {
+        case,
+        sim,
+        aid,
         lambda,
-        named,
-        noise_named,
-        noise_stand_ins,
-        detected,
-        wrong_term,
-        estimate,
-        sigma,
-        gain_recovery: out.gain_recovery().map(|g| g.0),
-        candidates_tested: e
-            .candidates
-            .iter()
-            .filter(|c| c.testable && c.confounded_with.is_none())
-            .count(),
-        seconds_taken: t_start.elapsed().as_secs_f64(),
+        truth_si,
     })
+}
+
+/// Any other group (GNSS, reference, turntable, two-term, noise): the hidden terms go in
+/// through the simulator (a GNSS or reference term lives in the aiding, not in the increments).
+/// A pilot simulation without them gives each term's information I_i through the case's
+/// baseline filter; every hidden value is then scaled by one factor k so that the weakest term's
+/// λ_i = (k θ_i)² I_i is the drawn λ, and the case is simulated again (the same noise).
+fn put_in_simulation(
+    drawn: &crate::sim::hidden::HiddenCase,
+    drawn_lambda: Option<f64>,
+    index: usize,
+) -> anyhow::Result<Put> {
+    if drawn.hidden.is_empty() {
+        let (sim, aid) = simulate_case(drawn)?;
+        return Ok(Put {
+            case: drawn.clone(),
+            sim,
+            aid,
+            lambda: None,
+            truth_si: None,
+        });
+    }
+    let lam = drawn_lambda
+        .ok_or_else(|| anyhow::anyhow!("case {index}: a hidden term drawn without its λ"))?;
+    let pilot = drawn.scaled(0.0);
+    let (sim0, aid0) = simulate_case(&pilot)?;
+    let baseline = Model::parse(&pilot.baseline)?;
+    let cfg = stated_config(&pilot, &sim0, &baseline);
+    let data = ExplainData {
+        imu: crate::explain::ImuInput::Memory(&sim0.imu),
+        aid: &aid0,
+        truth: Some(&sim0.truth),
+        start: sim0.start,
+    };
+    let mut weakest = f64::INFINITY;
+    for (name, v) in &drawn.hidden {
+        let info = signature_information(&baseline, term_index(name)?, &data, &cfg)?;
+        weakest = weakest.min(v * v * info);
+    }
+    if !(weakest.is_finite() && weakest > 0.0) {
+        anyhow::bail!(
+            "case {index}: the baseline filter holds no information on {} (λ per unit {weakest})",
+            drawn.oracle_model()
+        );
+    }
+    drop((sim0, aid0));
+    let case = drawn.scaled((lam / weakest).sqrt());
+    let (sim, aid) = simulate_case(&case)?;
+    let truth_si = case.hidden.first().map(|h| h.1);
+    Ok(Put {
+        case,
+        sim,
+        aid,
+        lambda: Some(lam),
+        truth_si,
+    })
+}
+
+fn term_index(name: &str) -> anyhow::Result<usize> {
+    common::TERMS
+        .iter()
+        .position(|x| x.name == name)
+        .ok_or_else(|| anyhow::anyhow!("hidden term `{name}` is not a spec term"))
 }
 
 /// Detection in one λ bin, measured and in theory.
@@ -246,9 +378,14 @@ pub struct PowerBin {
     pub cases: usize,
     /// Fraction detected (null when the bin is empty).
     pub detection_rate: Option<f64>,
-    /// Theoretical detection at the bin's geometric centre: a χ²₁(λ) test at Holm's first
-    /// threshold over the median number of candidates tested.
+    /// Theoretical detection of the test explain's selection starts with, averaged over the
+    /// bin's cases: a χ²₁(λ_i) test at Holm's first threshold χ²₁ quantile 1 − α/m_i over the
+    /// case's own m_i candidates tested (at the bin's geometric centre and the median m when the
+    /// bin is empty).
     pub theory: f64,
+    /// 95 % confidence interval of the detection rate (Wilson score).
+    #[serde(default)]
+    pub detection_ci: Option<[f64; 2]>,
 }
 
 /// Per-group detection.
@@ -260,6 +397,9 @@ pub struct GroupStats {
     pub detection_rate: Option<f64>,
     /// Fraction detected among the cases with λ ≥ 50.
     pub detection_rate_lambda_50: Option<f64>,
+    /// The group's detection against λ, with theory.
+    #[serde(default)]
+    pub power_curve: Vec<PowerBin>,
 }
 
 /// The evaluation's numbers (DESIGN-style field names of the issue; rates are fractions 0–1,
@@ -296,8 +436,30 @@ pub struct Summary {
     pub by_group: std::collections::BTreeMap<String, GroupStats>,
     /// Detection against λ, with theory.
     pub power_curve: Vec<PowerBin>,
-    /// Median candidates tested per case (the Holm count the theory uses).
+    /// Median candidates tested per case (the Holm count of the theory of an empty bin).
     pub candidates_tested_median: f64,
+    /// 95 % confidence interval (Wilson score) of the detection rate at λ ≥ 50.
+    #[serde(default)]
+    pub detection_lambda_50_ci: Option<[f64; 2]>,
+    /// 95 % confidence interval of the false-alarm rate.
+    #[serde(default)]
+    pub false_alarm_ci: Option<[f64; 2]>,
+    /// 95 % confidence interval of the wrong-term rate.
+    #[serde(default)]
+    pub wrong_term_ci: Option<[f64; 2]>,
+    /// 95 % confidence interval of the calibration.
+    #[serde(default)]
+    pub calibration_ci: Option<[f64; 2]>,
+    /// Cases that state a noise level wrongly to the filter (with or without a term beside it).
+    #[serde(default)]
+    pub noise_cases: usize,
+    /// Of those, the fraction in which explain named every misstated level as noise.
+    #[serde(default)]
+    pub noise_called_rate: Option<f64>,
+    /// Cases that state a noise level wrongly and hide no term: the fraction in which explain
+    /// named a term (a false alarm; these cases are among the null cases).
+    #[serde(default)]
+    pub noise_only_term_named_rate: Option<f64>,
     /// α used.
     pub alpha: f64,
 }
@@ -313,6 +475,61 @@ fn quantile(v: &mut [f64], q: f64) -> Option<f64> {
     v.sort_by(f64::total_cmp);
     let k = ((v.len() - 1) as f64 * q).round() as usize;
     Some(v[k])
+}
+
+/// 95 % confidence interval of a rate `hits`/`n` (Wilson score; None for n = 0).
+pub fn wilson(hits: usize, n: usize) -> Option<[f64; 2]> {
+    if n == 0 {
+        return None;
+    }
+    let z = 1.959_963_984_540_054_f64;
+    let (nf, p) = (n as f64, hits as f64 / n as f64);
+    let den = 1.0 + z * z / nf;
+    let centre = (p + z * z / (2.0 * nf)) / den;
+    let half = z * (p * (1.0 - p) / nf + z * z / (4.0 * nf * nf)).sqrt() / den;
+    Some([(centre - half).max(0.0), (centre + half).min(1.0)])
+}
+
+/// Holm's first threshold over `m` candidates at family-wise `alpha`: the χ²₁ quantile 1 − α/m.
+pub fn first_threshold(alpha: f64, m: usize) -> f64 {
+    stats::chi2_isf(alpha / m.max(1) as f64, 1.0)
+}
+
+/// λ bin edges of the power curve.
+const EDGES: [f64; 7] = [10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0];
+
+/// Detection per λ bin of `non_null` cases against the stated test's theory.
+fn power_bins(non_null: &[&CaseResult], alpha: f64, m_med: f64) -> Vec<PowerBin> {
+    EDGES
+        .windows(2)
+        .map(|w| {
+            let in_bin: Vec<&&CaseResult> = non_null
+                .iter()
+                .filter(|c| c.lambda.is_some_and(|l| l >= w[0] && l < w[1]))
+                .collect();
+            let hits = in_bin.iter().filter(|c| c.detected).count();
+            let theory = if in_bin.is_empty() {
+                power((w[0] * w[1]).sqrt(), first_threshold(alpha, m_med as usize))
+            } else {
+                in_bin
+                    .iter()
+                    .map(|c| {
+                        let l = c.lambda.unwrap_or(w[0]);
+                        power(l, first_threshold(alpha, c.candidates_tested))
+                    })
+                    .sum::<f64>()
+                    / in_bin.len() as f64
+            };
+            PowerBin {
+                lambda_lo: w[0],
+                lambda_hi: w[1],
+                cases: in_bin.len(),
+                detection_rate: rate(hits, in_bin.len()),
+                theory,
+                detection_ci: wilson(hits, in_bin.len()),
+            }
+        })
+        .collect()
 }
 
 /// Theoretical detection probability of a single χ²₁ test with noncentrality λ at threshold c.
@@ -345,28 +562,11 @@ pub fn summarize(spec: &EvalSpec, cases: &[CaseResult]) -> Summary {
         .collect();
     let mut m: Vec<f64> = cases.iter().map(|c| c.candidates_tested as f64).collect();
     let m_med = quantile(&mut m, 0.5).unwrap_or(27.0).max(1.0);
-    let c_thr = stats::chi2_isf(spec.alpha / m_med, 1.0);
-    let edges = [10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0];
-    let power_curve = edges
-        .windows(2)
-        .map(|w| {
-            let in_bin: Vec<&&CaseResult> = non_null
-                .iter()
-                .filter(|c| c.lambda.is_some_and(|l| l >= w[0] && l < w[1]))
-                .collect();
-            PowerBin {
-                lambda_lo: w[0],
-                lambda_hi: w[1],
-                cases: in_bin.len(),
-                detection_rate: rate(in_bin.iter().filter(|c| c.detected).count(), in_bin.len()),
-                theory: power((w[0] * w[1]).sqrt(), c_thr),
-            }
-        })
-        .collect();
+    let power_curve = power_bins(&non_null, spec.alpha, m_med);
     let mut by_group = std::collections::BTreeMap::new();
     for g in &spec.groups {
-        let of: Vec<&&CaseResult> = non_null.iter().filter(|c| &c.group == g).collect();
-        let of_hi: Vec<&&&CaseResult> = of
+        let of: Vec<&CaseResult> = non_null.iter().filter(|c| &c.group == g).copied().collect();
+        let of_hi: Vec<&&CaseResult> = of
             .iter()
             .filter(|c| c.lambda.is_some_and(|l| l >= 50.0))
             .collect();
@@ -379,38 +579,56 @@ pub fn summarize(spec: &EvalSpec, cases: &[CaseResult]) -> Summary {
                     of_hi.iter().filter(|c| c.detected).count(),
                     of_hi.len(),
                 ),
+                power_curve: power_bins(&of, spec.alpha, m_med),
             },
         );
     }
+    let hi_hits = hi.iter().filter(|c| c.detected).count();
+    let false_alarms = cases
+        .iter()
+        .filter(|c| c.term.is_none() && !c.named.is_empty())
+        .count();
+    let wrong = non_null.iter().filter(|c| c.wrong_term).count();
+    let calibrated = calib.iter().filter(|&&b| b).count();
+    let noise: Vec<&CaseResult> = cases
+        .iter()
+        .filter(|c| !c.noise_misstated.is_empty())
+        .collect();
+    let called = noise
+        .iter()
+        .filter(|c| c.noise_misstated.iter().all(|l| c.noise_named.contains(l)))
+        .count();
+    let noise_only: Vec<&&CaseResult> = noise.iter().filter(|c| c.term.is_none()).collect();
     Summary {
         cases: cases.len(),
         seed: spec.seed,
         null_cases: nulls,
         detection_rate: rate(det, non_null.len()),
-        detection_rate_lambda_50: rate(hi.iter().filter(|c| c.detected).count(), hi.len()),
-        false_alarm_rate: rate(
-            cases
-                .iter()
-                .filter(|c| c.term.is_none() && !c.named.is_empty())
-                .count(),
-            nulls,
-        ),
-        wrong_term_rate: rate(
-            non_null.iter().filter(|c| c.wrong_term).count(),
-            non_null.len(),
-        ),
+        detection_rate_lambda_50: rate(hi_hits, hi.len()),
+        false_alarm_rate: rate(false_alarms, nulls),
+        wrong_term_rate: rate(wrong, non_null.len()),
         noise_finding_rate: rate(
             cases.iter().filter(|c| !c.noise_named.is_empty()).count(),
             cases.len(),
         ),
         coef_error_median: quantile(&mut errs, 0.5),
         coef_error_p90: quantile(&mut errs, 0.9),
-        calibration: rate(calib.iter().filter(|&&b| b).count(), calib.len()),
+        calibration: rate(calibrated, calib.len()),
         gain_recovery_median: quantile(&mut gains, 0.5),
         by_group,
         power_curve,
         candidates_tested_median: m_med,
         alpha: spec.alpha,
+        detection_lambda_50_ci: wilson(hi_hits, hi.len()),
+        false_alarm_ci: wilson(false_alarms, nulls),
+        wrong_term_ci: wilson(wrong, non_null.len()),
+        calibration_ci: wilson(calibrated, calib.len()),
+        noise_cases: noise.len(),
+        noise_called_rate: rate(called, noise.len()),
+        noise_only_term_named_rate: rate(
+            noise_only.iter().filter(|c| !c.named.is_empty()).count(),
+            noise_only.len(),
+        ),
     }
 }
 
@@ -422,6 +640,17 @@ pub fn default_options() -> ExplainOptions {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wilson_interval_holds_the_rate_and_stays_in_0_1() {
+        let [lo, hi] = wilson(0, 32).expect("n > 0");
+        assert_eq!(lo, 0.0);
+        // the rule of three's neighbourhood: 0 of 32 leaves up to ~11 %
+        assert!(hi > 0.09 && hi < 0.12, "{hi}");
+        let [lo, hi] = wilson(18, 32).expect("n > 0");
+        assert!(lo < 18.0 / 32.0 && hi > 18.0 / 32.0 && hi - lo > 0.3 && hi - lo < 0.35);
+        assert!(wilson(5, 0).is_none());
+    }
 
     #[test]
     fn power_is_alpha_at_zero_and_grows() {

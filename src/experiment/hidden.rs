@@ -62,20 +62,7 @@ pub fn run_hidden_on(
         truth: Some(&sim.truth),
         start: sim.start,
     };
-    // the filter is told the case's stated noise (a noise case states one level wrongly)
-    // (closed loop with a velocity reference, as the command line runs it)
-    let stated = |m: &Model| {
-        let mut c = match case.stated_noise {
-            Some([arw, vrw, grw, arw_bias]) => FilterConfig::new(m)
-                .with_sensor_noise(m, arw, vrw)
-                .with_bias_random_walk(m, grw, arw_bias),
-            None => FilterConfig::new(m),
-        };
-        if sim.body_velocity.is_some() {
-            c.mode = crate::estimate::filter::Mode::ClosedLoop;
-        }
-        c
-    };
+    let stated = |m: &Model| stated_config(case, sim, m);
     let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(stated(m)) };
     let mut opts = opts.clone();
     opts.noise_levels &= !case.static_aid;
@@ -128,6 +115,26 @@ pub fn run_hidden_on(
         oracle_model_error_rms: oracle_rms,
         oracle_estimates,
     })
+}
+
+/// The filter configuration of `model` on a case's data: the case's stated noise (a noise case
+/// states one level wrongly), closed loop with a velocity reference, as the command line runs
+/// it.
+pub fn stated_config(
+    case: &crate::sim::hidden::HiddenCase,
+    sim: &crate::sim::simulator::SimOutput,
+    m: &Model,
+) -> FilterConfig {
+    let mut c = match case.stated_noise {
+        Some([arw, vrw, grw, arw_bias]) => FilterConfig::new(m)
+            .with_sensor_noise(m, arw, vrw)
+            .with_bias_random_walk(m, grw, arw_bias),
+        None => FilterConfig::new(m),
+    };
+    if sim.body_velocity.is_some() {
+        c.mode = crate::estimate::filter::Mode::ClosedLoop;
+    }
+    c
 }
 
 /// Adds term `term` with value `theta` (SI) to IMU increments: the sensor's output along its

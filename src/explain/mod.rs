@@ -447,9 +447,10 @@ pub fn explain(
     let r = without_stand_ins(ctx, r, &judged, progress)?;
     let passed_over = passed_over(ctx, &r, &judged, &cands, progress)?;
     let stand_ins = judged_stand_ins(&r, &judged);
-    let (noise_findings, noise_pass) = noise::stage(ctx, &r, &base_stats, progress)?;
+    let (noise_findings, noise_stage) = noise::stage(ctx, &r, &base_stats, progress)?;
+    let noise_pass = noise_stage.as_ref().map(|x| &x.0);
     // the extended pass is the last one run (the baseline itself when nothing was found)
-    let last_pass = noise_pass.as_ref().unwrap_or(&r.pass);
+    let last_pass = noise_pass.unwrap_or(&r.pass);
     // the share of the baseline's excess the extended model leaves
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
@@ -459,9 +460,16 @@ pub fn explain(
     aiding_and_sensor_confounded(ctx, &r, &mut findings, progress)?;
     value_not_fixed(&mut findings);
     findings.extend(noise_findings);
-    // a term this rule unnames leaves the extended model: its pass is run again without it
-    let (model_name, rerun) = if small_beside_the_unexplained(&mut findings, opts) {
-        causes_only_pass(ctx, &r, &findings, progress)?
+    let held_by_noise = match &noise_stage {
+        Some((_, applied)) => {
+            held_only_by_the_stated_noise(ctx, &r, applied, &mut findings, progress)?
+        }
+        None => false,
+    };
+    // a term these rules unname leaves the extended model: its pass is run again without it
+    let (model_name, rerun) = if small_beside_the_unexplained(&mut findings, opts) | held_by_noise {
+        let applied = noise_stage.as_ref().map_or(&[][..], |x| &x.1[..]);
+        causes_only_pass(ctx, &r, &findings, applied, progress)?
     } else {
         (r.model.name.clone(), None)
     };
@@ -715,11 +723,12 @@ fn keep_stand_ins(
 }
 
 /// The name of the model of the causes among `findings` (the baseline and the named terms of `r`
-/// that are causes) and its pass.
+/// that are causes) and its pass, with the noise levels found (`applied`) applied.
 fn causes_only_pass(
     ctx: &Context,
     r: &Rounds,
     findings: &[Finding],
+    applied: &[(noise::Level, f64)],
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<(String, Option<Pass>)> {
     let causes = r
@@ -733,10 +742,87 @@ fn causes_only_pass(
         })
         .collect::<Vec<_>>();
     let model = model_with(&ctx.baseline.name, causes)?;
-    let cfg = ctx.extended_config(&model, &r.widened)?;
+    let mut cfg = ctx.extended_config(&model, &r.widened)?;
+    // with the noise levels found, as the extended pass it replaces
+    for (level, scale) in applied {
+        level.apply(&model, &mut cfg, *scale);
+    }
     let round = r.rounds + 1;
     let pass = run_pass(&model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
     Ok((model.name.clone(), Some(pass)))
+}
+
+/// A term cause whose gain does not survive the noise levels found as causes (each one level
+/// across the data): with them applied, the model without the term loses less than the BIC's
+/// ln N (and the α-level χ²₁ quantile) of 2Δℓ. Its significance came from the stated noise
+/// being wrong (measured: a gyro white noise stated 8× too small on a drive gave "Found:
+/// lever_y = −0.34 ± 0.03 m" beside the noise level). Noise fits that are not causes are not
+/// applied: a level that does not hold across the data is no sensor's noise, and inflating it
+/// can take up a real cause (on the MEMS drive, with every noise fit applied, the model
+/// without dt_gnss fitted better). One pass, then one per term cause.
+/// Returns whether it unnamed a term.
+fn held_only_by_the_stated_noise(
+    ctx: &Context,
+    r: &Rounds,
+    applied: &[(noise::Level, f64)],
+    findings: &mut [Finding],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<bool> {
+    let causes: Vec<(noise::Level, f64)> = applied
+        .iter()
+        .filter(|(level, _)| {
+            let name = level.name();
+            findings
+                .iter()
+                .any(|f| f.kind == "noise" && f.term == name && f.is_cause())
+        })
+        .copied()
+        .collect();
+    let terms: Vec<usize> = findings
+        .iter()
+        .filter(|f| f.is_cause() && f.kind != "noise")
+        .filter_map(|f| term_index(&f.term))
+        .filter(|t| r.named.iter().any(|x| x.term == *t))
+        .collect();
+    if causes.is_empty() || terms.is_empty() {
+        return Ok(false);
+    }
+    let round = r.rounds + 2;
+    let mut pass_of = |model: &Model| -> anyhow::Result<Pass> {
+        let mut cfg = ctx.extended_config(model, &r.widened)?;
+        for (level, scale) in &causes {
+            level.apply(model, &mut cfg, *scale);
+        }
+        run_pass(model, &[], ctx.data, &cfg, &mut |x| progress(round, x))
+    };
+    let with = pass_of(&r.model)?;
+    let n = with.run.innovations.len().max(2) as f64;
+    let threshold = n.ln().max(stats::chi2_isf(ctx.opts.alpha, 1.0));
+    let mut unnamed = false;
+    for t in terms {
+        let others = r.named.iter().map(|x| x.term).filter(|&x| x != t);
+        let pass = pass_of(&model_with(&ctx.baseline.name, others)?)?;
+        let gain = 2.0 * (with.stats.loglik - pass.stats.loglik);
+        if gain >= threshold {
+            continue;
+        }
+        unnamed = true;
+        let Some(f) = findings
+            .iter_mut()
+            .find(|f| f.term == common::TERMS[t].name)
+        else {
+            continue;
+        };
+        f.stand_in = Some(format!(
+            "with the noise levels found applied it no longer improves the fit beyond chance (2Δℓ {} against {}): it is significant only while the noise is stated wrongly, and stands in for the noise",
+            sig3(gain),
+            sig3(threshold)
+        ));
+        let info = &common::TERMS[t];
+        (f.headline, f.words) =
+            finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+    }
+    Ok(unnamed)
 }
 
 /// Prior σ beyond which a term cause that removes a small share of the misfit, while the causes

@@ -272,15 +272,19 @@ fn search(
 /// Most filter passes per noise level (the start point's pass not counted).
 const MAX_EVALS: usize = 5;
 
+/// The extended pass with the significant noise levels and the scales it applies to them.
+pub(super) type NoisePass = (Pass, Vec<(Level, f64)>);
+
 /// Noise levels as findings (after the terms): when the extended model's mean NIS lies outside
 /// its 95 % band, the ML scale of each noise level is tested against 1; the significant ones
-/// become findings of kind `noise` and a last pass with them is the extended one.
+/// become findings of kind `noise` and a last pass with them is the extended one, returned with
+/// the scales it applies.
 pub(super) fn stage(
     ctx: &Context,
     r: &Rounds,
     base: &PassStats,
     progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<(Vec<Finding>, Option<Pass>)> {
+) -> anyhow::Result<(Vec<Finding>, Option<NoisePass>)> {
     let st = &r.pass.stats;
     let n: usize = st.channels.iter().map(|c| c.count).sum();
     let band = stats::mean_chi2_band(1.0, n.max(1), 1.959_964);
@@ -375,7 +379,12 @@ pub(super) fn stage(
         }
         findings.push(nf);
     }
-    Ok((findings, Some(pass)))
+    let applied = fits
+        .iter()
+        .filter(|f| f.significant)
+        .map(|f| (f.level, f.scale))
+        .collect();
+    Ok((findings, Some((pass, applied))))
 }
 
 /// Most a sensor's noise level can be mis-stated by and still be read as that level: grades

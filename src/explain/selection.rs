@@ -135,9 +135,10 @@ pub(super) const UNATTRIBUTED_RATIO: f64 = 10.0;
 ///
 /// Each step takes the candidate with the largest conditional llr; it must pass Holm's test at
 /// α over the candidates left *and* lower the BIC (llr > ln N). Candidates join its equivalence
-/// class when their conditional signatures correlate at |ρ| > `rho_equivalent` *and* the data
-/// do not prefer the best one by more than the α-level χ²₁ quantile (with much information,
-/// |ρ| = 0.97 can still separate two terms). Within a class the data cannot choose, so the
+/// class when their conditional signatures correlate at |ρ| > `rho_equivalent`, the data do not
+/// prefer the best one by more than the α-level χ²₁ quantile, *and* beside the best one they
+/// are no longer significant at that quantile (with much information, |ρ| = 0.97 can still
+/// separate two terms, and two terms present together are then both kept in the pool). Within a class the data cannot choose, so the
 /// member the spec's priors find most plausible (fewest prior σ) is named and the rest listed
 /// with the value each would need.
 pub(super) fn forward_select(
@@ -194,10 +195,15 @@ fn select(
             (c, llr)
         };
         let mut members: Vec<(usize, f64, f64)> = vec![]; // (cand, θ' prior-scaled, info)
+        let with_c: Vec<usize> = chosen.iter().copied().chain([c]).collect();
         for &a in &pool {
+            // a term still significant beside c is not c's equivalent: the data separate them
+            // and hold both (d and kas hidden on one axis correlate at |ρ| > 0.97)
+            let separable = || cond(a, &with_c).is_some_and(|(l, _, _)| l >= margin);
             let equivalent = a == c
                 || (conditional_rho(j, &chosen, a, c).abs() > opts.rho_equivalent
-                    && cond(a, &chosen).is_some_and(|(la, _, _)| llr - la < margin));
+                    && cond(a, &chosen).is_some_and(|(la, _, _)| llr - la < margin)
+                    && !separable());
             if equivalent {
                 if let Some((_, ia, ba)) = cond(a, &chosen) {
                     members.push((a, ba / ia, ia));

@@ -31,6 +31,25 @@ pub const REFERENCE_GROUPS: [&str; 4] = [
     "attitude_mount",
 ];
 
+/// Groups hiding two terms (besides `gnss_time_kgf`, `reference_mount_kgf` and
+/// `noise_accel_kgf`, which put a gyro g-sensitivity beside a GNSS, reference or noise cause):
+/// d_x and d_y on different windows (`two`), and d and kas on one axis (`two_axis`).
+pub const TWO_GROUPS: [&str; 2] = ["two", "two_axis"];
+
+/// Every group a case can be drawn from: the sensor terms, the GNSS, reference and turntable
+/// groups, the two-term groups and the misstated noise.
+pub fn all_groups() -> Vec<&'static str> {
+    GROUPS
+        .iter()
+        .chain(&GNSS_GROUPS)
+        .chain(&REFERENCE_GROUPS)
+        .chain(&TURNTABLE_GROUPS)
+        .chain(&TWO_GROUPS)
+        .chain(&NOISE_GROUPS)
+        .copied()
+        .collect()
+}
+
 /// Groups hidden on a turntable (a multi-position rotation sequence at rest, static aiding): an
 /// accelerometer's off-axis inner lever arm (`size_i_j`, 20–60 mm times `effect`), seen in
 /// the tangential kicks as a rotation starts and stops and in the centripetal terms.
@@ -367,6 +386,7 @@ pub fn generate(seed: u64, kind: CaseKind, seconds: f64, effect: f64) -> HiddenC
     let (group, description): (String, String) = match kind {
         CaseKind::Null => ("null".into(), draw_null(&mut rng, &d, &mut p)),
         CaseKind::Two => ("two".into(), draw_two(&d, &mut p)),
+        CaseKind::One("two_axis") => ("two_axis".into(), draw_two_axis(&mut rng, &d, &mut p)),
         CaseKind::One(g) => {
             draw_one(g, &mut rng, &d, &mut p);
             let text = if NOISE_GROUPS.contains(&g) {
@@ -413,6 +433,27 @@ fn draw_two(d: &Draw, p: &mut Parts) -> String {
     format!(
         "d_x and d_y hidden; {amp} g vibration on x, then y, then both at {} g",
         amp / 2.0
+    )
+}
+
+/// A case hiding two sensor terms on one axis (x or y): the quadratic term d and the
+/// asymmetric scale factor kas, under a sine vibration on that axis at two amplitudes (the
+/// mean of f² goes with the amplitude squared, the mean of |f| with the amplitude, so the two
+/// amplitudes separate them); kas at 0.7 of the effect, either sign. Returns the description.
+fn draw_two_axis(rng: &mut Rng, d: &Draw, p: &mut Parts) -> String {
+    p.baseline = "P28".into();
+    p.with_d = false;
+    let ax = *pick(rng, &["x", "y"]);
+    p.vib = sine(ax, d.amp, d.freq, &d.steps);
+    let dv = d.effect_si_acc / (d.a_si * d.a_si / 2.0);
+    let sgn = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+    let kv = sgn * 0.7 * d.effect_si_acc / (d.a_si * 2.0 / std::f64::consts::PI);
+    p.hidden.push((format!("d_{ax}"), dv));
+    p.hidden.push((format!("kas_{ax}"), kv));
+    format!(
+        "d_{ax} and kas_{ax} hidden on one axis; {} g / {} g vibration on {ax}, baseline P28",
+        d.amp,
+        d.amp / 2.0
     )
 }
 
