@@ -126,7 +126,12 @@ fn small_campaign_structure_behaviour_broken_selector_and_merge() {
     ]);
     assert!(ok, "{stderr}");
     let strip = |mut x: serde_json::Value| {
-        for k in ["seconds_wall", "seconds_per_case"] {
+        for k in [
+            "seconds_wall",
+            "seconds_per_case",
+            "seconds_per_case_setup",
+            "seconds_per_case_explain",
+        ] {
             x.as_object_mut().unwrap().remove(k);
         }
         x
@@ -135,7 +140,13 @@ fn small_campaign_structure_behaviour_broken_selector_and_merge() {
     let cases = |p: &Path| {
         let mut c = json(&p.join("cases.json"));
         for x in c["cases"].as_array_mut().unwrap() {
-            x.as_object_mut().unwrap().remove("seconds_taken");
+            for k in [
+                "seconds_taken",
+                "seconds_taken_setup",
+                "seconds_taken_explain",
+            ] {
+                x.as_object_mut().unwrap().remove(k);
+            }
         }
         c
     };
@@ -425,4 +436,37 @@ fn jobs_under_an_address_space_limit_fit_or_are_refused() {
     left.sort();
     assert_eq!(left, ["j2"], "left beside --out");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Developer probe: `EVAL_SEED=7 EVAL_INDEX=10 [EVAL_SECONDS=600] [EVAL_GROUPS=all] cargo test
+/// --release --test explain_eval -- --ignored probe_case --nocapture` prints one campaign
+/// case's result and explain's summary.
+#[test]
+#[ignore]
+fn probe_case() {
+    use sinsmodel::experiment::explain_eval::{default_options, run_case_explained, EvalSpec};
+    let var = |k: &str| std::env::var(k).ok();
+    let mut spec = EvalSpec {
+        seed: var("EVAL_SEED").and_then(|s| s.parse().ok()).unwrap_or(7),
+        seconds: var("EVAL_SECONDS")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(600.0),
+        ..EvalSpec::default()
+    };
+    if let Some(g) = var("EVAL_GROUPS") {
+        spec.groups = if g == "all" {
+            sinsmodel::sim::hidden::all_groups()
+                .iter()
+                .map(|s| s.to_string())
+                .collect()
+        } else {
+            g.split(',').map(str::to_string).collect()
+        };
+    }
+    let index = var("EVAL_INDEX").and_then(|s| s.parse().ok()).unwrap_or(0);
+    let (c, e) = run_case_explained(&spec, index, &default_options()).expect("the case runs");
+    eprintln!("{}", serde_json::to_string_pretty(&c).unwrap());
+    for s in &e.summary {
+        eprintln!("  {s}");
+    }
 }

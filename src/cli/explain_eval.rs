@@ -269,6 +269,11 @@ fn write(out: &OutputDir, spec: &EvalSpec, cases: &[CaseResult], wall: Option<f6
         cases.iter().map(|c| c.seconds_taken).sum::<f64>() / cases.len().max(1) as f64
     );
     v["case_seconds"] = serde_json::json!(spec.seconds);
+    // where a case's time goes: simulation and sizing, explain, the rest (oracle, scoring)
+    let mean =
+        |f: fn(&CaseResult) -> f64| cases.iter().map(f).sum::<f64>() / cases.len().max(1) as f64;
+    v["seconds_per_case_setup"] = serde_json::json!(mean(|c| c.seconds_taken_setup));
+    v["seconds_per_case_explain"] = serde_json::json!(mean(|c| c.seconds_taken_explain));
     atomic_file::write_text(&out.file("eval.json"), &serde_json::to_string_pretty(&v)?)?;
     let stored = Stored {
         spec: spec.clone(),

@@ -232,10 +232,19 @@ fn check_numbers(c: &CaseResult) -> Result<(), String> {
             common::TERM_COUNT
         ));
     }
-    if !(c.seconds_taken.is_finite() && c.seconds_taken >= 0.0) {
+    for (field, v) in [
+        ("seconds_taken", c.seconds_taken),
+        ("seconds_taken_setup", c.seconds_taken_setup),
+        ("seconds_taken_explain", c.seconds_taken_explain),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(format!("{field} {v}: a time is finite and ≥ 0"));
+        }
+    }
+    if c.seconds_taken_setup + c.seconds_taken_explain > c.seconds_taken * (1.0 + 1e-9) + 1e-6 {
         return Err(format!(
-            "seconds_taken {}: a time is finite and ≥ 0",
-            c.seconds_taken
+            "seconds_taken_setup {} and seconds_taken_explain {} add up to more than seconds_taken {}",
+            c.seconds_taken_setup, c.seconds_taken_explain, c.seconds_taken
         ));
     }
     Ok(())

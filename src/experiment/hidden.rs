@@ -72,7 +72,9 @@ pub fn run_hidden_on(
             opts.candidate_sigma.push((t, *sigma));
         }
     }
+    let t_explain = std::time::Instant::now();
     let expl = explain(&baseline, &cands, &data, &config_for, &opts, &mut |_, _| {})?;
+    let explain_seconds = t_explain.elapsed().as_secs_f64();
     let oracle = Model::parse(&case.oracle_model())?;
     // the oracle knows the terms and their size: a prior that holds the true value
     let mut oracle_cfg = stated(&oracle);
@@ -111,6 +113,7 @@ pub fn run_hidden_on(
         .collect();
     Ok(HiddenOutcome {
         explanation: expl,
+        explain_seconds,
         oracle_loglik: innovation_loglik(&run),
         oracle_model_error_rms: oracle_rms,
         oracle_estimates,
@@ -167,6 +170,8 @@ pub fn inject(imu: &mut ImuData, start_t: f64, term: usize, theta: f64) {
 pub struct HiddenOutcome {
     /// Explain's result.
     pub explanation: Explanation,
+    /// Wall time explain took [s].
+    pub explain_seconds: f64,
     /// Model error RMS of the filter with the true model [arcsec] (second half).
     pub oracle_model_error_rms: Option<f64>,
     /// Innovation log-likelihood of the filter with the true model.

@@ -534,6 +534,23 @@ mod tests {
     }
 
     #[test]
+    fn two_correlated_terms_both_present_are_not_one_class() {
+        // signatures at ρ = 0.98 with much information (d and kas on one axis): the data hold
+        // both (θ' = 0.5 and 0.4 prior σ), so each is significant beside the other
+        let rho: f64 = 0.98;
+        let (i0, i1): (f64, f64) = (4e4, 4e4);
+        let c = rho * (i0 * i1).sqrt();
+        let j = DMatrix::from_row_slice(2, 2, &[i0, c, c, i1]);
+        let theta = [0.45, 0.45];
+        let b = [i0 * theta[0] + c * theta[1], c * theta[0] + i1 * theta[1]];
+        // what made them one class before: ρ above the bar and llrs within the α-quantile
+        assert!(rho > opts().rho_equivalent && (b[0] * b[0] / i0 - b[1] * b[1] / i1).abs() < 6.6);
+        let (sel, _) = select(&sc(j, &b), &[0, 1], &[true; 2], 1000, &opts());
+        assert_eq!(sel.len(), 2, "both selected, not one class");
+        assert!(sel.iter().all(|x| x.class.is_empty()));
+    }
+
+    #[test]
     fn a_value_beyond_the_plausible_prior_sigmas_is_not_named() {
         let j = DMatrix::identity(1, 1) * 1e-2;
         let b = [10.0]; // θ' = 1000 prior σ, llr 10⁴

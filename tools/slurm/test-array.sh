@@ -45,7 +45,8 @@ done
 "$bin" explain-eval --seed 7 --cases 8 --seconds 300 --out "$run/whole"
 python3 - "$run/merged" "$run/whole" <<'PY'
 import json, sys
-timing = {"seconds_taken", "seconds_per_case", "seconds_wall", "command"}
+timing = {"seconds_taken", "seconds_taken_setup", "seconds_taken_explain", "seconds_per_case",
+          "seconds_per_case_setup", "seconds_per_case_explain", "seconds_wall", "command"}
 def strip(x):
     if isinstance(x, dict):
         return {k: strip(v) for k, v in x.items() if k not in timing}
