@@ -160,7 +160,7 @@ fn small_campaign_structure_behaviour_broken_selector_and_merge() {
         "--out",
         tmp("twice").to_str().unwrap(),
     ]);
-    assert!(!ok && stderr.contains("appears twice"), "{stderr}");
+    assert!(!ok && stderr.contains("merge each shard once"), "{stderr}");
     // a stored campaign with settings explain-eval never writes is refused
     let edited = tmp("edited");
     std::fs::create_dir_all(&edited).unwrap();
@@ -230,6 +230,31 @@ fn every_kind_of_cause_in_a_small_campaign() {
         assert!(md.contains(says), "eval.md does not say {says}:\n{md}");
     }
     assert!(dir.join("power_by_group.png").exists());
+    // `all` stands alone; empty entries and settings beside --merge are refused, named
+    for (args, says) in [
+        (
+            vec!["--cases", "1", "--groups", "all,d"],
+            "`all` stands alone",
+        ),
+        (
+            vec!["--cases", "1", "--groups", "d,,kas"],
+            "entry 2 of 3 is empty",
+        ),
+        (vec!["--cases", "1", "--groups", "d, kas"], "no spaces"),
+        (vec!["--cases", "1", "--seconds", "-1"], "--seconds -1"),
+        (
+            vec!["--merge", dir.to_str().unwrap(), "--seed", "9"],
+            "not --seed",
+        ),
+    ] {
+        let mut a = vec!["explain-eval"];
+        a.extend(args.iter().copied());
+        let out = tmp("refused");
+        a.extend(["--out", out.to_str().unwrap()]);
+        let (ok, err) = sinsmodel(&a);
+        assert!(!ok && err.contains(says), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
     // an unknown group is refused naming the known ones
     let (ok, err) = sinsmodel(&[
         "explain-eval",
@@ -273,7 +298,13 @@ fn merged_cases_are_checked_like_any_input() {
         .expect("seed 3 finds a hidden term in its first three cases");
     let index = stored["cases"][k]["index"].as_u64().unwrap();
     let edited = tmp("chk_edit");
-    let edits: [(&str, serde_json::Value, &str); 13] = [
+    let edits: [(&str, serde_json::Value, &str); 15] = [
+        (
+            "stand_ins",
+            serde_json::json!(["size_z", "size_z"]),
+            "`size_z` is there twice",
+        ),
+        ("seconds_taken", serde_json::json!(1e300), "at most a day"),
         (
             "also_hidden",
             serde_json::json!(["kas_x"]),
@@ -326,6 +357,27 @@ fn merged_cases_are_checked_like_any_input() {
             );
         }
         assert!(!err.contains("inf %"), "{err}");
+    }
+    // a field left out is refused, not read as empty or 0; so are settings no run writes
+    let mut v = stored.clone();
+    v["cases"][k].as_object_mut().unwrap().remove("stand_ins");
+    std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+    let (ok, err) = merge(&[edited.as_path()]);
+    assert!(!ok && err.contains("missing field `stand_ins`"), "{err}");
+    for (field, value, says) in [
+        (
+            "groups",
+            serde_json::json!(["d", "nosuch"]),
+            "unknown group `nosuch`",
+        ),
+        ("seconds", serde_json::json!(10.0), "seconds 10"),
+        ("null_fraction", serde_json::json!(0.5), "null_fraction 0.5"),
+    ] {
+        let mut v = stored.clone();
+        v["spec"][field] = value;
+        std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+        let (ok, err) = merge(&[edited.as_path()]);
+        assert!(!ok && err.contains(says), "spec.{field}: {err}");
     }
     // contradictory flags: not detected, a wrong term, nothing named
     let mut v = stored.clone();

@@ -6,13 +6,15 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
-use sinsmodel::experiment::eval_check::{check_case, missing_ranges};
+use sinsmodel::experiment::eval_check::{
+    check_case, check_spec, missing_ranges, parse_groups, spec_differs,
+};
 use sinsmodel::experiment::eval_report::{headline, markdown};
 use sinsmodel::experiment::explain_eval::{self, CaseResult, EvalSpec};
 use sinsmodel::io::atomic_file::{self, OutputDir};
 use sinsmodel::report::plot::{self, Scale, Series};
 use sinsmodel::report::progress;
-use sinsmodel::sim::hidden::{all_groups, GROUPS};
+use sinsmodel::sim::hidden::GROUPS;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -22,9 +24,9 @@ pub struct EvalArgs {
     /// Number of cases (1 to 100000).
     #[arg(long)]
     cases: Option<usize>,
-    /// Campaign seed (0 to 1e12).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
-    seed: u64,
+    /// Campaign seed (0 to 1000000000000; default 1).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000_000))]
+    seed: Option<u64>,
     /// Index of the first case (shards of one campaign: `--first 0 --cases 100`, `--first 100 …`).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1_000_000_000))]
     first: u64,
@@ -36,12 +38,12 @@ pub struct EvalArgs {
     /// for: about 4 MB + 0.125 MB per simulated second each).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     jobs: Option<u64>,
-    /// Simulated seconds per case (300 to 7200).
-    #[arg(long, default_value_t = 600.0)]
-    seconds: f64,
-    /// Family-wise α of explain, in (0, 0.5].
-    #[arg(long, default_value_t = 0.01)]
-    alpha: f64,
+    /// Simulated seconds per case (300 to 7200; default 600).
+    #[arg(long, allow_negative_numbers = true)]
+    seconds: Option<f64>,
+    /// Family-wise α of explain, in (0, 0.5] (default 0.01).
+    #[arg(long, allow_negative_numbers = true)]
+    alpha: Option<f64>,
     /// Merge the `cases.json` of these evaluation directories instead of running cases.
     #[arg(long, num_args = 1..)]
     merge: Vec<PathBuf>,
@@ -65,9 +67,18 @@ struct Stored {
 /// Runs the command.
 pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
-        if args.cases.is_some() || args.first != 0 || args.groups.is_some() || args.broken_selector
-        {
-            bail!("--merge combines finished runs: give only the directories and --out");
+        let given = [
+            ("--cases", args.cases.is_some()),
+            ("--first", args.first != 0),
+            ("--groups", args.groups.is_some()),
+            ("--seed", args.seed.is_some()),
+            ("--seconds", args.seconds.is_some()),
+            ("--alpha", args.alpha.is_some()),
+            ("--jobs", args.jobs.is_some()),
+            ("--broken-selector", args.broken_selector),
+        ];
+        if let Some((opt, _)) = given.iter().find(|g| g.1) {
+            bail!("--merge combines finished runs, whose settings are in their cases.json: give only the directories and --out, not {opt}");
         }
         return merge(args);
     }
@@ -77,44 +88,26 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     if !(1..=100_000).contains(&n) {
         bail!("--cases {n}: expected 1 to 100000");
     }
-    if !(args.seconds.is_finite() && (300.0..=7200.0).contains(&args.seconds)) {
-        bail!("--seconds {}: expected 300 to 7200 s", args.seconds);
+    let seconds = args.seconds.unwrap_or(600.0);
+    if !(seconds.is_finite() && (300.0..=7200.0).contains(&seconds)) {
+        bail!("--seconds {seconds}: expected 300 to 7200 s");
     }
-    if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha <= 0.5) {
-        bail!("--alpha {}: expected a level in (0, 0.5]", args.alpha);
+    let alpha = args.alpha.unwrap_or(0.01);
+    if !(alpha.is_finite() && (1e-12..=0.5).contains(&alpha)) {
+        bail!("--alpha {alpha}: expected a level in [1e-12, 0.5]");
     }
     let groups: Vec<String> = match &args.groups {
-        Some(g) if g.len() == 1 && g[0] == "all" => {
-            all_groups().iter().map(|s| s.to_string()).collect()
-        }
-        Some(g) => {
-            let known = all_groups();
-            for x in g {
-                if !known.contains(&x.as_str()) {
-                    bail!(
-                        "--groups: unknown group `{x}` (groups: {}; or `all`)",
-                        known.join(", ")
-                    );
-                }
-                if g.iter().filter(|y| *y == x).count() > 1 {
-                    bail!("--groups: `{x}` is given twice");
-                }
-            }
-            if g.is_empty() {
-                bail!("--groups: the list is empty");
-            }
-            g.clone()
-        }
+        Some(g) => parse_groups(g).map_err(|e| anyhow::anyhow!("--groups: {e}"))?,
         None => GROUPS.iter().map(|s| s.to_string()).collect(),
     };
     if args.jobs == Some(0) {
         bail!("--jobs 0: at least one thread");
     }
     let spec = EvalSpec {
-        seed: args.seed,
+        seed: args.seed.unwrap_or(1),
         groups,
-        seconds: args.seconds,
-        alpha: args.alpha,
+        seconds,
+        alpha,
         ..EvalSpec::default()
     };
     // --out checked now (its staging made and removed); the staging that holds the result is
@@ -123,7 +116,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let mut opts = explain_eval::default_options();
     opts.broken_selector = args.broken_selector;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let jobs = super::address_space::fit_jobs(args.jobs, cores, args.seconds)?;
+    let jobs = super::address_space::fit_jobs(args.jobs, cores, seconds)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
@@ -158,7 +151,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         eprintln!("{line}");
     }
     eprintln!(
-        "{n} cases in {wall:.1} s ({:.2} s per case on one thread); wrote {}",
+        "{n} case(s) in {wall:.1} s ({:.2} s per case on one thread); wrote {}",
         cases.iter().map(|c| c.seconds_taken).sum::<f64>() / n as f64,
         args.out.display()
     );
@@ -166,58 +159,61 @@ pub fn run(args: &EvalArgs) -> Result<()> {
 }
 
 fn merge(args: &EvalArgs) -> Result<()> {
-    let mut spec: Option<EvalSpec> = None;
-    let mut cases: Vec<CaseResult> = Vec::new();
+    let mut spec: Option<(EvalSpec, &Path)> = None;
+    let mut cases: Vec<(CaseResult, &Path)> = Vec::new();
     for d in &args.merge {
+        if d.is_file() {
+            bail!(
+                "--merge {}: a file; give the directory an explain-eval run wrote (it holds cases.json)",
+                d.display()
+            );
+        }
         let path = d.join("cases.json");
         let text = sinsmodel::io::lines::read_small_text(&path, "explain-eval result")
             .with_context(|| format!("--merge: cannot read {}", path.display()))?;
-        let stored: Stored = serde_json::from_str(&text).with_context(|| {
-            format!(
-                "--merge: {} is not an explain-eval cases file",
+        let stored: Stored = serde_json::from_str(&text).map_err(|e| {
+            let hint = if ["NaN", "Infinity"].iter().any(|w| text.contains(w)) {
+                " (it holds NaN or Infinity, which JSON has no words for: edited by hand?)"
+            } else {
+                ""
+            };
+            anyhow::anyhow!(
+                "--merge: {} is not an explain-eval cases file of this version: {e}{hint}",
                 path.display()
             )
         })?;
-        // a stored campaign is input like any other: its numbers checked before they are used
-        let sp = &stored.spec;
-        let plausible = sp.seconds.is_finite()
-            && sp.seconds > 0.0
-            && sp.seconds <= 86_400.0
-            && (0.0..=1.0).contains(&sp.null_fraction)
-            && sp.lambda.iter().all(|l| l.is_finite() && *l > 0.0)
-            && sp.lambda[0] <= sp.lambda[1]
-            && sp.alpha > 0.0
-            && sp.alpha <= 0.5;
-        if !plausible {
-            bail!(
-                "--merge: {}: its campaign settings are not ones explain-eval writes (seconds in (0, 86400], null fraction in [0, 1], 0 < lambda_lo <= lambda_hi, alpha in (0, 0.5])",
+        // a stored campaign is input like any other: its settings checked before they are used
+        check_spec(&stored.spec).map_err(|e| {
+            anyhow::anyhow!(
+                "--merge: {}: its campaign settings are not ones explain-eval writes: {e}",
                 path.display()
-            );
-        }
+            )
+        })?;
         match &spec {
-            None => spec = Some(stored.spec),
-            Some(s) => {
-                let same = s.seed == stored.spec.seed
-                    && s.groups == stored.spec.groups
-                    && s.seconds == stored.spec.seconds
-                    && s.alpha == stored.spec.alpha
-                    && s.null_fraction == stored.spec.null_fraction
-                    && s.lambda == stored.spec.lambda;
-                if !same {
+            None => spec = Some((stored.spec, d.as_path())),
+            Some((s, first)) => {
+                if let Some(why) = spec_differs(s, &stored.spec) {
                     bail!(
-                        "--merge: {} belongs to another campaign (seed, groups, seconds, alpha or λ range differ)",
-                        d.display()
+                        "--merge: {} belongs to another campaign than {}: {why}",
+                        d.display(),
+                        first.display()
                     );
                 }
             }
         }
         let n = stored.cases.len();
-        let sp = spec
+        let sp = &spec
             .as_ref()
-            .context("--merge: no campaign settings read")?;
+            .context("--merge: no campaign settings read")?
+            .0;
         for (k, c) in stored.cases.into_iter().enumerate() {
-            if cases.iter().any(|x| x.index == c.index) {
-                bail!("--merge: case {} appears twice ({})", c.index, d.display());
+            if let Some((_, other)) = cases.iter().find(|x| x.0.index == c.index) {
+                bail!(
+                    "--merge: case {} is in {} and in {}: merge each shard once",
+                    c.index,
+                    other.display(),
+                    d.display()
+                );
             }
             // a stored case is input like any other: checked against what its index draws
             check_case(sp, &c).map_err(|e| {
@@ -228,15 +224,27 @@ fn merge(args: &EvalArgs) -> Result<()> {
                     k + 1
                 )
             })?;
-            cases.push(c);
+            cases.push((c, d.as_path()));
         }
     }
-    let spec = spec.context("--merge needs at least one directory")?;
+    let spec = spec.context("--merge needs at least one directory")?.0;
+    if cases.is_empty() {
+        bail!("--merge: the given runs hold no case (a run holds at least one)");
+    }
+    let mut cases: Vec<CaseResult> = cases.into_iter().map(|x| x.0).collect();
     cases.sort_by_key(|c| c.index);
     let indices: Vec<usize> = cases.iter().map(|c| c.index).collect();
     if let Some(&(a, b)) = missing_ranges(&indices).first() {
+        let d = EvalSpec::default();
+        let mut opts = String::new();
+        if spec.groups != d.groups {
+            opts.push_str(&format!(" --groups {}", spec.groups.join(",")));
+        }
+        if spec.alpha != d.alpha {
+            opts.push_str(&format!(" --alpha {}", spec.alpha));
+        }
         bail!(
-            "--merge: {} missing between the shards (the given ones hold {} to {}, each run a contiguous range): merge the shard that holds them too, or run it: explain-eval --seed {} --first {a} --cases {} --seconds {} --out DIR",
+            "--merge: {} missing between the shards (the given ones hold {} to {}, each run a contiguous range): merge the shard that holds them too, or run it: explain-eval --seed {} --first {a} --cases {} --seconds {}{opts} --out DIR",
             if a == b {
                 format!("case {a} is")
             } else {
@@ -256,6 +264,12 @@ fn merge(args: &EvalArgs) -> Result<()> {
     for line in headline(&explain_eval::summarize(&spec, &cases)) {
         eprintln!("{line}");
     }
+    eprintln!(
+        "merged {} case(s) of {} run(s); wrote {}",
+        cases.len(),
+        args.merge.len(),
+        args.out.display()
+    );
     Ok(())
 }
 

@@ -6,6 +6,7 @@
 
 use crate::experiment::explain_eval::{draw, CaseResult, EvalSpec};
 use crate::model::generated::common;
+use crate::sim::hidden::all_groups;
 
 /// Noise levels explain names, besides `sigma_<measurement>`.
 const NOISE_LEVELS: [&str; 4] = ["gyro_arw", "accel_vrw", "gyro_bias_rw", "accel_bias_rw"];
@@ -16,6 +17,97 @@ pub fn check_case(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
     check_draw(spec, c)?;
     check_outcome(c)?;
     check_numbers(c)
+}
+
+/// Most wall time one case may take [s] (a day): beyond it a stored time is no measurement.
+const MAX_CASE_SECONDS: f64 = 86_400.0;
+
+/// The groups of `--groups`: `all`, or a list of known group names, each once. Err says which
+/// entry is wrong and why.
+pub fn parse_groups(given: &[String]) -> Result<Vec<String>, String> {
+    let known = all_groups();
+    if given.is_empty() {
+        return Err("the list is empty".into());
+    }
+    if given.iter().any(|g| g == "all") {
+        if given.len() > 1 {
+            return Err(
+                "`all` stands alone: it is every group; give it or a list of groups".into(),
+            );
+        }
+        return Ok(known.iter().map(|s| s.to_string()).collect());
+    }
+    for (k, x) in given.iter().enumerate() {
+        if x.is_empty() {
+            return Err(format!(
+                "entry {} of {} is empty (a doubled or trailing comma?)",
+                k + 1,
+                given.len()
+            ));
+        }
+        if !known.contains(&x.as_str()) {
+            let hint = if x.trim() != x {
+                " (no spaces around the commas)"
+            } else if known.contains(&x.to_ascii_lowercase().as_str()) {
+                " (names are lower-case)"
+            } else {
+                ""
+            };
+            return Err(format!(
+                "unknown group `{x}`{hint} (groups: {}; or `all`)",
+                known.join(", ")
+            ));
+        }
+        if given[..k].contains(x) {
+            return Err(format!("`{x}` is given twice"));
+        }
+    }
+    Ok(given.to_vec())
+}
+
+/// Why stored campaign settings `sp` cannot be ones explain-eval writes, or Ok.
+pub fn check_spec(sp: &EvalSpec) -> Result<(), String> {
+    let d = EvalSpec::default();
+    if !(sp.seconds.is_finite() && (300.0..=7200.0).contains(&sp.seconds)) {
+        return Err(format!("seconds {}: a run takes 300 to 7200 s", sp.seconds));
+    }
+    if sp.null_fraction != d.null_fraction || sp.lambda != d.lambda {
+        return Err(format!(
+            "null_fraction {} and lambda {:?}: every run draws a fraction {} of null cases and λ over {:?}",
+            sp.null_fraction, sp.lambda, d.null_fraction, d.lambda
+        ));
+    }
+    if !(sp.alpha.is_finite() && (1e-12..=0.5).contains(&sp.alpha)) {
+        return Err(format!("alpha {}: a run's α is in [1e-12, 0.5]", sp.alpha));
+    }
+    parse_groups(&sp.groups)
+        .map(|_| ())
+        .map_err(|e| format!("groups: {e}"))
+}
+
+/// Which settings of campaign `b` differ from `a`'s, with both values; None when none does.
+pub fn spec_differs(a: &EvalSpec, b: &EvalSpec) -> Option<String> {
+    let mut d = Vec::new();
+    if a.seed != b.seed {
+        d.push(format!("seed {} against {}", b.seed, a.seed));
+    }
+    if a.groups != b.groups {
+        d.push(format!(
+            "groups {} against {}",
+            b.groups.join(","),
+            a.groups.join(",")
+        ));
+    }
+    if a.seconds != b.seconds {
+        d.push(format!("seconds {} against {}", b.seconds, a.seconds));
+    }
+    if a.alpha != b.alpha {
+        d.push(format!("alpha {} against {}", b.alpha, a.alpha));
+    }
+    if a.null_fraction != b.null_fraction || a.lambda != b.lambda {
+        d.push("null fraction or λ range".into());
+    }
+    (!d.is_empty()).then(|| d.join(", "))
 }
 
 fn is_term(name: &str) -> bool {
@@ -153,14 +245,32 @@ fn check_outcome(c: &CaseResult) -> Result<(), String> {
             c.named.join(", ")
         ));
     }
-    if let Some(n) = c
-        .stand_ins
-        .iter()
-        .find(|n| !is_term(n) || c.named.contains(n))
-    {
+    if let Some(n) = c.stand_ins.iter().find(|n| !is_term(n)) {
         return Err(format!(
-            "stand_ins: `{n}` is not a library term or is also among named (a finding is a claim or a stand-in)"
+            "stand_ins: `{n}` is not a term of the model spec's library"
         ));
+    }
+    if let Some(n) = c.stand_ins.iter().find(|n| c.named.contains(n)) {
+        return Err(format!(
+            "stand_ins: `{n}` is also among named (a finding is a claim or a stand-in, not both)"
+        ));
+    }
+    for (field, list) in [
+        ("stand_ins", &c.stand_ins),
+        ("noise_named", &c.noise_named),
+        ("noise_stand_ins", &c.noise_stand_ins),
+        ("also_hidden", &c.also_hidden),
+    ] {
+        if let Some((k, n)) = list
+            .iter()
+            .enumerate()
+            .find(|(k, n)| list[..*k].contains(n))
+        {
+            return Err(format!(
+                "{field}: `{n}` is there twice (entry {}): a run lists it once",
+                k + 1
+            ));
+        }
     }
     if let Some(n) = c.named.iter().find(|n| !is_term(n)) {
         return Err(format!(
@@ -237,8 +347,10 @@ fn check_numbers(c: &CaseResult) -> Result<(), String> {
         ("seconds_taken_setup", c.seconds_taken_setup),
         ("seconds_taken_explain", c.seconds_taken_explain),
     ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(format!("{field} {v}: a time is finite and ≥ 0"));
+        if !(v.is_finite() && (0.0..=MAX_CASE_SECONDS).contains(&v)) {
+            return Err(format!(
+                "{field} {v}: a case's time is finite, ≥ 0 and at most a day ({MAX_CASE_SECONDS} s)"
+            ));
         }
     }
     if c.seconds_taken_setup + c.seconds_taken_explain > c.seconds_taken * (1.0 + 1e-9) + 1e-6 {

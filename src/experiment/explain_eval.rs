@@ -57,11 +57,9 @@ pub struct CaseResult {
     pub term: Option<String>,
     /// The other hidden terms of a case that hides more than one (a two-term case, a mounting's
     /// two axes, a turntable's three delays).
-    #[serde(default)]
     pub also_hidden: Vec<String>,
     /// Noise levels the case states wrongly to the filter (a noise case); explain should name
     /// them as noise, not a term.
-    #[serde(default)]
     pub noise_misstated: Vec<String>,
     /// True value (display unit of the term).
     pub truth: Option<f64>,
@@ -72,14 +70,11 @@ pub struct CaseResult {
     /// classes the data cannot attribute to one member).
     pub named: Vec<String>,
     /// Noise levels explain named (noise findings: a claim about the data's noise, not a term).
-    #[serde(default)]
     pub noise_named: Vec<String>,
     /// Of those, the ones it labelled "not one level across the data" (stand-ins).
-    #[serde(default)]
     pub noise_stand_ins: Vec<String>,
     /// Terms explain fitted but labelled stand-ins ("Fitted, but not a cause"): no claim, so
     /// neither a detection nor a wrong term.
-    #[serde(default)]
     pub stand_ins: Vec<String>,
     /// Every hidden term was named or is in a named class.
     pub detected: bool,
@@ -94,13 +89,10 @@ pub struct CaseResult {
     /// Number of candidates tested (testable and separable) in the baseline pass.
     pub candidates_tested: usize,
     /// Wall time of the case [s] (not part of the comparison of runs).
-    #[serde(default)]
     pub seconds_taken: f64,
     /// Of it, simulating the case and the pilot passes that size its hidden terms [s].
-    #[serde(default)]
     pub seconds_taken_setup: f64,
     /// Of it, explain itself [s] (the rest: the oracle filter and the scoring).
-    #[serde(default)]
     pub seconds_taken_explain: f64,
 }
 

@@ -1,0 +1,73 @@
+"""tools/eval-tables refuses what it cannot do and never runs a campaign on --dry-run.
+
+Run: python3 -m unittest tools/test_eval_tables.py (needs the campaigns' results in
+docs/explain-eval/, which the repository holds).
+"""
+import hashlib
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "tools", "eval-tables")
+DOC = os.path.join(ROOT, "docs", "explain.md")
+
+
+def md5(path):
+    with open(path, "rb") as f:
+        return hashlib.md5(f.read()).hexdigest()
+
+
+def run(*args):
+    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+
+
+class EvalTables(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        # a stand-in binary that only leaves a mark when it is called
+        self.mark = os.path.join(self.tmp.name, "called")
+        self.fake = os.path.join(self.tmp.name, "fake-sinsmodel")
+        with open(self.fake, "w") as f:
+            f.write(f"#!/bin/sh\ntouch '{self.mark}'\nexit 3\n")
+        os.chmod(self.fake, 0o755)
+        self.doc = md5(DOC)
+
+    def tearDown(self):
+        self.assertEqual(md5(DOC), self.doc, "docs/explain.md changed")
+        self.tmp.cleanup()
+
+    def test_dry_run_runs_nothing_and_prints_the_tables(self):
+        r = run("--dry-run", "--bin", self.fake)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertFalse(os.path.exists(self.mark), "a dry run called the binary")
+        self.assertIn("eval-tables:begin", r.stdout)
+        for name in ("sensor-600", "sensor-300", "sensor-1200", "all-600"):
+            self.assertIn(name, r.stdout)
+
+    def test_unknown_or_empty_campaign_names_are_refused(self):
+        for only, says in (("nosuch", "unknown campaign 'nosuch'"), ("", "give campaign names"),
+                           ("sensor-600,", "give campaign names")):
+            r = run("--only", only, "--bin", self.fake)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn(says, r.stderr)
+            self.assertNotIn("Traceback", r.stderr)
+        self.assertFalse(os.path.exists(self.mark))
+
+    def test_a_missing_binary_is_named(self):
+        r = run("--only", "sensor-300", "--bin", os.path.join(self.tmp.name, "nope"))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("no executable there", r.stderr)
+        self.assertNotIn("Traceback", r.stderr)
+
+    def test_a_failing_campaign_leaves_the_doc_alone(self):
+        r = run("--only", "sensor-300", "--bin", self.fake)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertTrue(os.path.exists(self.mark))
+        self.assertIn("failed (exit 3", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
