@@ -48,7 +48,7 @@ pub fn headline(s: &Summary) -> Vec<String> {
     ];
     if s.noise_cases > 0 {
         v.push(format!(
-            "misstated noise: {} cases, every misstated level named as noise in {}; a term named in {} of those that hide none",
+            "misstated noise: {} cases; in {} of them every misstated level was named as noise; a term was named in {} of those that hide no term",
             s.noise_cases,
             pct(s.noise_called_rate),
             pct(s.noise_only_term_named_rate)
@@ -69,7 +69,8 @@ pub fn test_statement(s: &Summary) -> String {
          confirms the extended model (2Δℓ > k ln N for k added terms), its estimate holds across \
          the consistency splits and it is not a stand-in; those later gates can only lower \
          detection below this curve. Each bin's theory is the test's power averaged over the \
-         bin's cases (their λ and m).",
+         bin's cases (their λ and m); an empty bin's, and the plotted curve, are the power at \
+         the median m.",
         s.alpha, s.candidates_tested_median
     )
 }
@@ -101,7 +102,7 @@ pub fn markdown(s: &Summary, n: usize, seconds: f64) -> String {
     m.push_str(&format!("\n{}\n\n", test_statement(s)));
     bins_table(&mut m, &s.power_curve);
     m.push_str(
-        "\n| group | cases | detected | detected, λ ≥ 50 | per λ bin (detected/cases: 10–20, 20–50, 50–100, 100–200, 200–500, 500–1000) |\n|---|---|---|---|---|\n",
+        "\nPer group, the cases that hide a term (a misstated-noise case that hides none is a null case, counted above):\n\n| group | cases | detected | detected, λ ≥ 50 | per λ bin (detected/cases: 10–20, 20–50, 50–100, 100–200, 200–500, 500–1000) |\n|---|---|---|---|---|\n",
     );
     for (g, st) in &s.by_group {
         let per_bin: Vec<String> = st
