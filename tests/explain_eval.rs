@@ -359,11 +359,16 @@ fn merged_cases_are_checked_like_any_input() {
         assert!(!err.contains("inf %"), "{err}");
     }
     // a field left out is refused, not read as empty or 0; so are settings no run writes
-    let mut v = stored.clone();
-    v["cases"][k].as_object_mut().unwrap().remove("stand_ins");
-    std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
-    let (ok, err) = merge(&[edited.as_path()]);
-    assert!(!ok && err.contains("missing field `stand_ins`"), "{err}");
+    for field in ["stand_ins", "gain_recovery", "estimate"] {
+        let mut v = stored.clone();
+        v["cases"][k].as_object_mut().unwrap().remove(field);
+        std::fs::write(edited.join("cases.json"), v.to_string()).unwrap();
+        let (ok, err) = merge(&[edited.as_path()]);
+        assert!(
+            !ok && err.contains(&format!("missing field `{field}`")),
+            "{field}: {err}"
+        );
+    }
     for (field, value, says) in [
         (
             "groups",

@@ -62,6 +62,18 @@ class EvalTables(unittest.TestCase):
         self.assertIn("no executable there", r.stderr)
         self.assertNotIn("Traceback", r.stderr)
 
+    def test_a_campaign_that_writes_nothing_leaves_the_doc_alone(self):
+        ok = os.path.join(self.tmp.name, "silent-sinsmodel")
+        with open(ok, "w") as f:
+            f.write("#!/bin/sh\nexit 0\n")
+        os.chmod(ok, 0o755)
+        stamps = os.path.join(ROOT, "docs", "explain-eval", "measured.json")
+        before = md5(stamps)
+        r = run("--only", "sensor-300", "--bin", ok)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("wrote no new", r.stderr)
+        self.assertEqual(md5(stamps), before)
+
     def test_a_failing_campaign_leaves_the_doc_alone(self):
         r = run("--only", "sensor-300", "--bin", self.fake)
         self.assertNotEqual(r.returncode, 0)

@@ -41,7 +41,7 @@ pub struct EvalArgs {
     /// Simulated seconds per case (300 to 7200; default 600).
     #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
-    /// Family-wise α of explain, in (0, 0.5] (default 0.01).
+    /// Family-wise α of explain, in [1e-12, 0.5] (default 0.01).
     #[arg(long, allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Merge the `cases.json` of these evaluation directories instead of running cases.
@@ -244,7 +244,7 @@ fn merge(args: &EvalArgs) -> Result<()> {
             opts.push_str(&format!(" --alpha {}", spec.alpha));
         }
         bail!(
-            "--merge: {} missing between the shards (the given ones hold {} to {}, each run a contiguous range): merge the shard that holds them too, or run it: explain-eval --seed {} --first {a} --cases {} --seconds {}{opts} --out DIR",
+            "--merge: {} missing between the shards (the given ones hold {} to {}, each run a contiguous range): merge the shards that hold them too, or run them (at most 100000 cases per run), the first: explain-eval --seed {} --first {a} --cases {} --seconds {}{opts} --out DIR",
             if a == b {
                 format!("case {a} is")
             } else {
@@ -253,7 +253,7 @@ fn merge(args: &EvalArgs) -> Result<()> {
             indices[0],
             indices[indices.len() - 1],
             spec.seed,
-            b - a + 1,
+            (b - a + 1).min(100_000),
             spec.seconds
         );
     }

@@ -68,6 +68,9 @@ pub fn parse_groups(given: &[String]) -> Result<Vec<String>, String> {
 /// Why stored campaign settings `sp` cannot be ones explain-eval writes, or Ok.
 pub fn check_spec(sp: &EvalSpec) -> Result<(), String> {
     let d = EvalSpec::default();
+    if sp.seed > 1_000_000_000_000 {
+        return Err(format!("seed {}: a run's seed is 0 to 1e12", sp.seed));
+    }
     if !(sp.seconds.is_finite() && (300.0..=7200.0).contains(&sp.seconds)) {
         return Err(format!("seconds {}: a run takes 300 to 7200 s", sp.seconds));
     }
@@ -121,6 +124,13 @@ fn shown(term: Option<&str>) -> String {
 
 /// The group, term and λ against what the campaign draws for the case's index.
 fn check_draw(spec: &EvalSpec, c: &CaseResult) -> Result<(), String> {
+    // a run's cases start at --first ≤ 1e9 and number at most 100000
+    if c.index >= 1_000_100_000 {
+        return Err(format!(
+            "index {}: a run's cases lie below 1000100000 (--first ≤ 1e9, --cases ≤ 100000)",
+            c.index
+        ));
+    }
     if c.group != "null" && !spec.groups.contains(&c.group) {
         return Err(format!(
             "group `{}` is neither `null` nor one of the campaign's groups ({})",

@@ -45,7 +45,8 @@ impl Default for EvalSpec {
     }
 }
 
-/// One case's outcome.
+/// One case's outcome. Every field must be present in a stored case (a null stays `null`):
+/// a field left out of a hand-edited shard is refused, never read as empty.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CaseResult {
@@ -54,6 +55,7 @@ pub struct CaseResult {
     /// `null` or the library group.
     pub group: String,
     /// Hidden term (None for a null case; the first of a two-term case).
+    #[serde(deserialize_with = "Option::deserialize")]
     pub term: Option<String>,
     /// The other hidden terms of a case that hides more than one (a two-term case, a mounting's
     /// two axes, a turntable's three delays).
@@ -62,9 +64,11 @@ pub struct CaseResult {
     /// them as noise, not a term.
     pub noise_misstated: Vec<String>,
     /// True value (display unit of the term).
+    #[serde(deserialize_with = "Option::deserialize")]
     pub truth: Option<f64>,
     /// Noncentrality λ = θ² I of the hidden term's test through the baseline filter (of the
     /// weakest hidden term, when there are more than one).
+    #[serde(deserialize_with = "Option::deserialize")]
     pub lambda: Option<f64>,
     /// Terms explain named (sensor and measurement findings that are no stand-ins: causes, and
     /// classes the data cannot attribute to one member).
@@ -81,10 +85,13 @@ pub struct CaseResult {
     /// A named term is neither a hidden one nor in a class with one (or anything in a null case).
     pub wrong_term: bool,
     /// Estimate of the hidden term (display unit) and its σ, when detected.
+    #[serde(deserialize_with = "Option::deserialize")]
     pub estimate: Option<f64>,
     /// σ of the estimate.
+    #[serde(deserialize_with = "Option::deserialize")]
     pub sigma: Option<f64>,
     /// Fraction of the oracle's gain the extended model recovers, when defined.
+    #[serde(deserialize_with = "Option::deserialize")]
     pub gain_recovery: Option<f64>,
     /// Number of candidates tested (testable and separable) in the baseline pass.
     pub candidates_tested: usize,
