@@ -832,6 +832,20 @@ struct ClockLag {
 /// Largest shift searched between a reference's clock and the GNSS's [s].
 const MAX_CLOCK_SHIFT_S: f64 = 60.0;
 
+/// The rows (time-ordered) either side of `t` at most 2 s apart and the weight of the later one,
+/// for interpolating a reference at `t`; None outside the rows or across a gap.
+fn bracket<R: super::aid::ReferenceRow>(rows: &[R], t: f64) -> Option<(&R, &R, f64)> {
+    let k = rows.partition_point(|r| r.t() < t);
+    if k == 0 || k >= rows.len() {
+        return None;
+    }
+    let (a, b) = (&rows[k - 1], &rows[k]);
+    if b.t() - a.t() > 2.0 {
+        return None;
+    }
+    Some((a, b, (t - a.t()) / (b.t() - a.t())))
+}
+
 /// The shift of the velocity reference's clock against the GNSS fixes' when it is one the data
 /// show ([`best_shift`] of the GNSS speed from consecutive fixes at most 2 s apart against the
 /// reference's speed interpolated there).
@@ -844,15 +858,7 @@ fn reference_clock_lag(
         .map(|s| (s.t_mid(), s.speed()))
         .collect();
     let speed = |t: f64| -> Option<f64> {
-        let k = body.partition_point(|r| r.t < t);
-        if k == 0 || k >= body.len() {
-            return None;
-        }
-        let (a, b) = (&body[k - 1], &body[k]);
-        if b.t - a.t > 2.0 {
-            return None;
-        }
-        let w = (t - a.t) / (b.t - a.t);
+        let (a, b, w) = bracket(body, t)?;
         let n = |r: &BodyVelocityFix| nalgebra::Vector3::from(r.v_frd).norm();
         Some(n(a) + w * (n(b) - n(a)))
     };
@@ -973,15 +979,7 @@ fn attitude_clock_lag(
         .map(|s| (s.t_mid(), s.course().to_degrees()))
         .collect();
     let yaw = |t: f64| -> Option<f64> {
-        let k = rows.partition_point(|r| r.t < t);
-        if k == 0 || k >= rows.len() {
-            return None;
-        }
-        let (a, b) = (&rows[k - 1], &rows[k]);
-        if b.t - a.t > 2.0 {
-            return None;
-        }
-        let w = (t - a.t) / (b.t - a.t);
+        let (a, b, w) = bracket(rows, t)?;
         let (ya, yb) = (a.rpy[2].to_degrees(), b.rpy[2].to_degrees());
         Some(ya + w * wrap_deg(yb - ya))
     };

@@ -4,7 +4,6 @@
 //! against theory. Each case depends only on (seed, index), so any split of the indices over
 //! threads or machines gives the same cases; [`summarize`] of merged case lists equals one run.
 
-use crate::estimate::filter::FilterConfig;
 use crate::estimate::stats;
 use crate::experiment::hidden::{inject, run_hidden_on, simulate_case, stated_config};
 use crate::explain::{self, signature_information, ExplainData, ExplainOptions};
@@ -175,23 +174,19 @@ pub fn run_case_explained(
     let mut opts = opts.clone();
     opts.alpha = spec.alpha;
     let t_setup = std::time::Instant::now();
-    let put = if GROUPS.contains(&drawn.group.as_str()) {
+    let (case, sim, aid) = if GROUPS.contains(&drawn.group.as_str()) {
         put_in_increments(&drawn, drawn_lambda, index)?
     } else {
         put_in_simulation(&drawn, drawn_lambda, index)?
     };
     let seconds_taken_setup = t_setup.elapsed().as_secs_f64();
-    let Put {
-        case,
-        sim,
-        aid,
-        lambda,
-        truth_si,
-    } = put;
-    let term = case
-        .hidden
-        .first()
-        .and_then(|h| common::TERMS.iter().position(|x| x.name == h.0));
+    // (a case hides a term exactly when its draw gave a λ)
+    let lambda = drawn_lambda.filter(|_| !case.hidden.is_empty());
+    let truth_si = case.hidden.first().map(|h| h.1);
+    let term = match case.hidden.first() {
+        Some(h) => Some(term_index(&h.0)?),
+        None => None,
+    };
     let out = run_hidden_on(&case, &sim, &aid, &opts)?;
     let e = &out.explanation;
     // a claim: a term finding that is no stand-in (a cause, or a class the data cannot
@@ -202,34 +197,25 @@ pub fn run_case_explained(
         .iter()
         .filter(|f| f.kind != "noise" && f.stand_in.is_none())
         .collect();
-    let named: Vec<String> = claims.iter().map(|f| f.term.clone()).collect();
-    let stand_ins: Vec<String> = e
-        .findings
-        .iter()
-        .filter(|f| f.kind != "noise" && f.stand_in.is_some())
-        .map(|f| f.term.clone())
-        .collect();
-    let noise_named: Vec<String> = e
-        .findings
-        .iter()
-        .filter(|f| f.kind == "noise")
-        .map(|f| f.term.clone())
-        .collect();
-    let noise_stand_ins: Vec<String> = e
-        .findings
-        .iter()
-        .filter(|f| f.kind == "noise" && f.stand_in.is_some())
-        .map(|f| f.term.clone())
-        .collect();
+    let names = |keep: &dyn Fn(&crate::explain::Finding) -> bool| -> Vec<String> {
+        e.findings
+            .iter()
+            .filter(|f| keep(f))
+            .map(|f| f.term.clone())
+            .collect()
+    };
+    let named = names(&|f| f.kind != "noise" && f.stand_in.is_none());
+    let stand_ins = names(&|f| f.kind != "noise" && f.stand_in.is_some());
+    let noise_named = names(&|f| f.kind == "noise");
+    let noise_stand_ins = names(&|f| f.kind == "noise" && f.stand_in.is_some());
     let hidden: Vec<&str> = case.hidden.iter().map(|h| h.0.as_str()).collect();
+    // a claim covers hidden term h when it names h or h is in its class
+    let covers =
+        |f: &crate::explain::Finding, h: &str| f.term == h || f.equivalent.iter().any(|q| q == h);
     let (mut detected, mut estimate, mut sigma) = (false, None, None);
     if let Some(t) = term {
         let name = common::TERMS[t].name;
-        detected = hidden.iter().all(|h| {
-            claims
-                .iter()
-                .any(|f| f.term == *h || f.equivalent.iter().any(|q| q == h))
-        });
+        detected = hidden.iter().all(|h| claims.iter().any(|f| covers(f, h)));
         for f in &claims {
             if f.term == name {
                 estimate = Some(f.estimate);
@@ -241,11 +227,7 @@ pub fn run_case_explained(
         }
     }
     let hidden_name = term.map(|t| common::TERMS[t].name);
-    let wrong_term = claims.iter().any(|f| {
-        !hidden
-            .iter()
-            .any(|h| f.term == *h || f.equivalent.iter().any(|q| q == h))
-    });
+    let wrong_term = claims.iter().any(|f| !hidden.iter().any(|h| covers(f, h)));
     let result = CaseResult {
         index,
         group: drawn.group.clone(),
@@ -277,14 +259,31 @@ pub fn run_case_explained(
     Ok((result, out.explanation))
 }
 
-/// A case with its hidden terms put in at the drawn λ: the case (its hidden values the ones
-/// put in), its simulated data, and the λ and first term's true value (SI) put in.
-struct Put {
-    case: crate::sim::hidden::HiddenCase,
-    sim: crate::sim::simulator::SimOutput,
-    aid: Vec<crate::estimate::filter::AidingEpoch>,
-    lambda: Option<f64>,
-    truth_si: Option<f64>,
+/// A case with its hidden terms put in at the drawn λ (its hidden values the ones put in), its
+/// simulated IMU and truth, and its aiding.
+type Put = (
+    crate::sim::hidden::HiddenCase,
+    crate::sim::simulator::SimOutput,
+    Vec<crate::estimate::filter::AidingEpoch>,
+);
+
+/// The information I of term `name`'s signature through `case`'s baseline filter (its stated
+/// noise) on simulated data `sim` and `aid`: λ = θ² I.
+fn information(
+    case: &crate::sim::hidden::HiddenCase,
+    sim: &crate::sim::simulator::SimOutput,
+    aid: &[crate::estimate::filter::AidingEpoch],
+    name: &str,
+) -> anyhow::Result<f64> {
+    let baseline = Model::parse(&case.baseline)?;
+    let data = ExplainData {
+        imu: crate::explain::ImuInput::Memory(&sim.imu),
+        aid,
+        truth: Some(&sim.truth),
+        start: sim.start,
+    };
+    let cfg = stated_config(case, sim, &baseline);
+    signature_information(&baseline, term_index(name)?, &data, &cfg)
 }
 
 /// A sensor group's term: simulated without it, then put into the IMU's increments at the drawn
@@ -296,33 +295,18 @@ fn put_in_increments(
 ) -> anyhow::Result<Put> {
     let mut case = drawn.scaled(0.0);
     let (mut sim, aid) = simulate_case(&case)?;
-    let (mut lambda, mut truth_si) = (None, None);
     if let Some((name, reference)) = drawn.hidden.first() {
-        let t = term_index(name)?;
-        let baseline = Model::parse(&case.baseline)?;
-        let data = ExplainData {
-            imu: crate::explain::ImuInput::Memory(&sim.imu),
-            aid: &aid,
-            truth: Some(&sim.truth),
-            start: sim.start,
-        };
-        let info = signature_information(&baseline, t, &data, &FilterConfig::new(&baseline))?;
+        // (a sensor group states no noise and has no velocity reference: its stated
+        // configuration is the spec's)
+        let info = information(&case, &sim, &aid, name)?;
         let lam = drawn_lambda
             .ok_or_else(|| anyhow::anyhow!("case {index}: a hidden term drawn without its λ"))?;
         let theta = reference.signum() * (lam / info.max(f64::MIN_POSITIVE)).sqrt();
-        inject(&mut sim.imu, sim.start.t, t, theta);
+        inject(&mut sim.imu, sim.start.t, term_index(name)?, theta);
         case.hidden = vec![(name.clone(), theta)];
         hold_in_declared_prior(&mut case);
-        lambda = Some(lam);
-        truth_si = Some(theta);
     }
-    Ok(Put {
-        case,
-        sim,
-        aid,
-        lambda,
-        truth_si,
-    })
+    Ok((case, sim, aid))
 }
 
 /// Any other group (GNSS, reference, turntable, two-term, noise): the hidden terms go in
@@ -337,30 +321,15 @@ fn put_in_simulation(
 ) -> anyhow::Result<Put> {
     if drawn.hidden.is_empty() {
         let (sim, aid) = simulate_case(drawn)?;
-        return Ok(Put {
-            case: drawn.clone(),
-            sim,
-            aid,
-            lambda: None,
-            truth_si: None,
-        });
+        return Ok((drawn.clone(), sim, aid));
     }
     let lam = drawn_lambda
         .ok_or_else(|| anyhow::anyhow!("case {index}: a hidden term drawn without its λ"))?;
     let pilot = drawn.scaled(0.0);
     let (sim0, aid0) = simulate_case(&pilot)?;
-    let baseline = Model::parse(&pilot.baseline)?;
-    let cfg = stated_config(&pilot, &sim0, &baseline);
-    let data = ExplainData {
-        imu: crate::explain::ImuInput::Memory(&sim0.imu),
-        aid: &aid0,
-        truth: Some(&sim0.truth),
-        start: sim0.start,
-    };
     let mut weakest = f64::INFINITY;
     for (name, v) in &drawn.hidden {
-        let info = signature_information(&baseline, term_index(name)?, &data, &cfg)?;
-        weakest = weakest.min(v * v * info);
+        weakest = weakest.min(v * v * information(&pilot, &sim0, &aid0, name)?);
     }
     if !(weakest.is_finite() && weakest > 0.0) {
         anyhow::bail!(
@@ -372,14 +341,7 @@ fn put_in_simulation(
     let mut case = drawn.scaled((lam / weakest).sqrt());
     hold_in_declared_prior(&mut case);
     let (sim, aid) = simulate_case(&case)?;
-    let truth_si = case.hidden.first().map(|h| h.1);
-    Ok(Put {
-        case,
-        sim,
-        aid,
-        lambda: Some(lam),
-        truth_si,
-    })
+    Ok((case, sim, aid))
 }
 
 /// Where a case declares a prior for a family of terms (a MEMS-class gyro's kgf_*, as a user

@@ -461,9 +461,7 @@ pub fn explain(
     value_not_fixed(&mut findings);
     findings.extend(noise_findings);
     let held_by_noise = match &noise_stage {
-        Some((_, applied)) => {
-            held_only_by_the_stated_noise(ctx, &r, applied, &mut findings, progress)?
-        }
+        Some(noise) => held_only_by_the_stated_noise(ctx, &r, noise, &mut findings, progress)?,
         None => false,
     };
     // a term these rules unname leaves the extended model: its pass is run again without it
@@ -742,14 +740,32 @@ fn causes_only_pass(
         })
         .collect::<Vec<_>>();
     let model = model_with(&ctx.baseline.name, causes)?;
-    let mut cfg = ctx.extended_config(&model, &r.widened)?;
     // with the noise levels found, as the extended pass it replaces
-    for (level, scale) in applied {
-        level.apply(&model, &mut cfg, *scale);
-    }
+    let cfg = config_with_levels(ctx, r, &model, applied)?;
     let round = r.rounds + 1;
     let pass = run_pass(&model, &[], ctx.data, &cfg, &mut |f| progress(round, f))?;
     Ok((model.name.clone(), Some(pass)))
+}
+
+/// `r`'s extended configuration of `model` with the noise `levels` scaled.
+fn config_with_levels(
+    ctx: &Context,
+    r: &Rounds,
+    model: &Model,
+    levels: &[(noise::Level, f64)],
+) -> anyhow::Result<FilterConfig> {
+    let mut cfg = ctx.extended_config(model, &r.widened)?;
+    for (level, scale) in levels {
+        level.apply(model, &mut cfg, *scale);
+    }
+    Ok(cfg)
+}
+
+/// Finding `f` of term `t` becomes a stand-in for `why`; its headline and words say so.
+fn mark_stand_in(f: &mut Finding, t: usize, why: String, opts: &ExplainOptions) {
+    f.stand_in = Some(why);
+    let info = &common::TERMS[t];
+    (f.headline, f.words) = finding_words(f, info, prior_sigma(t, opts) / info.display_to_si);
 }
 
 /// A term cause whose gain does not survive the noise levels found as causes (each one level
@@ -759,15 +775,17 @@ fn causes_only_pass(
 /// lever_y = −0.34 ± 0.03 m" beside the noise level). Noise fits that are not causes are not
 /// applied: a level that does not hold across the data is no sensor's noise, and inflating it
 /// can take up a real cause (on the MEMS drive, with every noise fit applied, the model
-/// without dt_gnss fitted better). One pass, then one per term cause.
+/// without dt_gnss fitted better). One pass per term cause, and one with them all unless every
+/// level of `noise` (the extended pass and the scales it applies) is a cause.
 /// Returns whether it unnamed a term.
 fn held_only_by_the_stated_noise(
     ctx: &Context,
     r: &Rounds,
-    applied: &[(noise::Level, f64)],
+    noise: &noise::NoisePass,
     findings: &mut [Finding],
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<bool> {
+    let (noise_pass, applied) = noise;
     let causes: Vec<(noise::Level, f64)> = applied
         .iter()
         .filter(|(level, _)| {
@@ -789,13 +807,17 @@ fn held_only_by_the_stated_noise(
     }
     let round = r.rounds + 2;
     let mut pass_of = |model: &Model| -> anyhow::Result<Pass> {
-        let mut cfg = ctx.extended_config(model, &r.widened)?;
-        for (level, scale) in &causes {
-            level.apply(model, &mut cfg, *scale);
-        }
+        let cfg = config_with_levels(ctx, r, model, &causes)?;
         run_pass(model, &[], ctx.data, &cfg, &mut |x| progress(round, x))
     };
-    let with = pass_of(&r.model)?;
+    // every level found is a cause: the extended pass is the one with the term
+    let fresh;
+    let with = if causes.len() == applied.len() {
+        noise_pass
+    } else {
+        fresh = pass_of(&r.model)?;
+        &fresh
+    };
     let n = with.run.innovations.len().max(2) as f64;
     let threshold = n.ln().max(stats::chi2_isf(ctx.opts.alpha, 1.0));
     let mut unnamed = false;
@@ -806,21 +828,17 @@ fn held_only_by_the_stated_noise(
         if gain >= threshold {
             continue;
         }
-        unnamed = true;
-        let Some(f) = findings
+        if let Some(f) = findings
             .iter_mut()
             .find(|f| f.term == common::TERMS[t].name)
-        else {
-            continue;
-        };
-        f.stand_in = Some(format!(
-            "with the noise levels found applied it no longer improves the fit beyond chance (2Δℓ {} against {}): it is significant only while the noise is stated wrongly, and stands in for the noise",
-            sig3(gain),
-            sig3(threshold)
-        ));
-        let info = &common::TERMS[t];
-        (f.headline, f.words) =
-            finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+        {
+            unnamed = true;
+            mark_stand_in(f, t, format!(
+                "with the noise levels found applied it no longer improves the fit beyond chance (2Δℓ {} against {}): it is significant only while the noise is stated wrongly, and stands in for the noise",
+                sig3(gain),
+                sig3(threshold)
+            ), ctx.opts);
+        }
     }
     Ok(unnamed)
 }
@@ -857,14 +875,13 @@ fn small_beside_the_unexplained(findings: &mut [Finding], opts: &ExplainOptions)
         let Some(t) = common::TERMS.iter().position(|t| t.name == f.term) else {
             continue;
         };
-        f.stand_in = Some(format!(
+        let why = format!(
             "it needs {} prior σ and removes {} % of the baseline's excess misfit, while the causes found together remove {} %: most of the misfit is something the candidates do not describe, and a term this far from its prior fitted beside it probably stands in for part of it",
             sig3(f.prior_sigmas.abs()),
             sig3(100.0 * f.misfit_share.unwrap_or(0.0)),
             sig3(100.0 * explained.max(0.0))
-        ));
-        let info = &common::TERMS[t];
-        (f.headline, f.words) = finding_words(f, info, prior_sigma(t, opts) / info.display_to_si);
+        );
+        mark_stand_in(f, t, why, opts);
     }
     unnamed
 }
