@@ -350,6 +350,20 @@ pub trait Observer {
     /// At the start and after every IMU sample: the navigation state, and the error estimate x
     /// and covariance P (n×n row-major) as of the last propagation step or update.
     fn nav_sample(&mut self, _s: &NavState, _x: &[f64], _p: &[f64]) {}
+    /// Every scalar measurement before the update takes it (applied, gated or not finite): its
+    /// row `h`, residual z (computed − aiding, after the known GNSS terms) and 1-σ (after the
+    /// configuration's σ scale), in the measurement's SI units.
+    #[allow(clippy::too_many_arguments)]
+    fn residual(
+        &mut self,
+        _t: f64,
+        _meas: &'static str,
+        _component: usize,
+        _h: &[f64],
+        _z: f64,
+        _sigma: f64,
+    ) {
+    }
     /// Before a scalar update is applied: its row `h`, gain `k` = P⁻hᵀ/S, innovation ν and
     /// variance S, and which measurement component it is.
     #[allow(clippy::too_many_arguments)]
@@ -369,6 +383,40 @@ pub trait Observer {
 /// An observer that watches nothing.
 pub struct NoObserver;
 impl Observer for NoObserver {}
+
+/// Two observers watching one run, the first called first.
+pub struct Tee<'a>(pub &'a mut dyn Observer, pub &'a mut dyn Observer);
+impl Observer for Tee<'_> {
+    fn sample(&mut self, sig: &crate::model::ImuSignals) {
+        self.0.sample(sig);
+        self.1.sample(sig);
+    }
+    fn step(&mut self, t: f64, dt: f64, np: &NavPoint, a: &[f64], pattern: &[(usize, usize)]) {
+        self.0.step(t, dt, np, a, pattern);
+        self.1.step(t, dt, np, a, pattern);
+    }
+    fn nav_sample(&mut self, s: &NavState, x: &[f64], p: &[f64]) {
+        self.0.nav_sample(s, x, p);
+        self.1.nav_sample(s, x, p);
+    }
+    fn residual(&mut self, t: f64, meas: &'static str, comp: usize, h: &[f64], z: f64, sigma: f64) {
+        self.0.residual(t, meas, comp, h, z, sigma);
+        self.1.residual(t, meas, comp, h, z, sigma);
+    }
+    fn scalar_update(
+        &mut self,
+        t: f64,
+        meas: &'static str,
+        comp: usize,
+        h: &[f64],
+        k: &[f64],
+        nu: f64,
+        s: f64,
+    ) {
+        self.0.scalar_update(t, meas, comp, h, k, nu, s);
+        self.1.scalar_update(t, meas, comp, h, k, nu, s);
+    }
+}
 
 enum Kernel {
     Preset(crate::model::catalog::PropagateFn),
@@ -724,6 +772,7 @@ impl<'a> Engine<'a> {
             }
             for (comp, (&zc, &sc)) in z.iter().zip(&sigma).enumerate() {
                 let h_row = &self.h[comp * n..(comp + 1) * n];
+                obs.residual(ep.t, name, comp, h_row, zc, sc);
                 if !(zc.is_finite() && sc.is_finite()) {
                     self.nonfinite += 1;
                     self.first_nonfinite_t.get_or_insert(ep.t);
@@ -1164,7 +1213,11 @@ fn state_at(s: &NavState, t: f64, f_ned: &Vector3<f64>) -> NavState {
 
 /// The index in `runs` (epochs in a row the gate rejected, per measurement and component) of
 /// component `comp` of measurement `name`, added at 0 when new.
-fn gate_run(runs: &mut Vec<(&'static str, usize, u32)>, name: &'static str, comp: usize) -> usize {
+pub(crate) fn gate_run(
+    runs: &mut Vec<(&'static str, usize, u32)>,
+    name: &'static str,
+    comp: usize,
+) -> usize {
     runs.iter()
         .position(|r| r.0 == name && r.1 == comp)
         .unwrap_or_else(|| {
@@ -1174,7 +1227,7 @@ fn gate_run(runs: &mut Vec<(&'static str, usize, u32)>, name: &'static str, comp
 }
 
 /// What became of one scalar update.
-enum Scalar {
+pub(crate) enum Scalar {
     /// Applied, with its innovation ν and its variance S (SI).
     Applied(f64, f64),
     /// Not applied: |ν| beyond the gate's √S (ν, S).
@@ -1185,7 +1238,7 @@ enum Scalar {
 
 /// Scalar update of measurement row h, value z and variance r in Joseph form:
 /// P ← (I − K h) P (I − K h)ᵀ + K r Kᵀ, expanded for a row h, unless |ν| > `gate` √S.
-fn joseph_update(
+pub(crate) fn joseph_update(
     x: &mut [f64],
     p: &mut [f64],
     (h, z, r): (&[f64], f64, f64),

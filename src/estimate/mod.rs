@@ -9,4 +9,5 @@ pub mod filter;
 pub mod imu_check;
 pub mod init;
 pub mod metrics;
+pub mod replay;
 pub mod stats;

@@ -311,6 +311,18 @@ fn run_pass(
     cfg: &FilterConfig,
     progress: &mut dyn FnMut(f64),
 ) -> anyhow::Result<Pass> {
+    run_pass_watched(model, cands, data, cfg, progress, &mut filter::NoObserver)
+}
+
+/// [`run_pass`] with one more observer `watch` of the run (after the signatures).
+fn run_pass_watched(
+    model: &Model,
+    cands: &[usize],
+    data: &ExplainData,
+    cfg: &FilterConfig,
+    progress: &mut dyn FnMut(f64),
+    watch: &mut dyn filter::Observer,
+) -> anyhow::Result<Pass> {
     // the median aiding time splits the updates into halves
     let t_half = data
         .aid
@@ -351,7 +363,7 @@ fn run_pass(
         &mut io,
         progress,
         &mut |_| {},
-        &mut sig,
+        &mut filter::Tee(&mut sig, watch),
         &mut |_| Ok(()),
         // every epoch's record only for the truth's checks; else the last (the estimates)
         data.truth.is_some(),

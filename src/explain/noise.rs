@@ -11,14 +11,92 @@
 //! alone returns to its stated value, the others kept at their fits. The 95 % interval is
 //! where the last parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns
 //! the significant levels into findings.
+//!
+//! In open loop these passes are replays of one recorded pass (`estimate::replay`): the
+//! navigation, A(t), H and z do not depend on the noise there, so each costs well under 1 % of a
+//! pass; in closed loop they are full passes.
 
 use super::{
-    baseline_excess, run_pass, sig3, Context, ExplainData, ExplainOptions, Finding, Pass,
-    PassStats, Rounds, G0,
+    baseline_excess, run_pass, run_pass_watched, sig3, Context, ExplainData, ExplainOptions,
+    Finding, Pass, PassStats, Rounds, G0,
 };
-use crate::estimate::filter::FilterConfig;
+use crate::estimate::filter::{FilterConfig, Innovation};
+use crate::estimate::replay::{Recorder, Tape};
 use crate::estimate::stats;
 use crate::model::Model;
+
+/// Passes of one model under rescaled noise levels: replayed from a tape of one open-loop pass
+/// (`estimate::replay`) where one could be recorded, else run in full.
+struct Passes<'a, 'd> {
+    model: &'a Model,
+    data: &'a ExplainData<'d>,
+    tape: Option<Tape>,
+}
+
+impl<'a, 'd> Passes<'a, 'd> {
+    /// Runs the pass of `model` with `cfg`, recording a tape whose groups are the states each
+    /// of `levels` scales; the tape is kept only when its replay of `cfg` gives the pass's
+    /// innovations back (the same updates, log-likelihood within 1e-6 relative).
+    fn record(
+        model: &'a Model,
+        data: &'a ExplainData<'d>,
+        cfg: &FilterConfig,
+        levels: &[Level],
+        progress: &mut dyn FnMut(f64),
+    ) -> anyhow::Result<Passes<'a, 'd>> {
+        let groups: Vec<Vec<usize>> = levels
+            .iter()
+            .filter_map(|level| {
+                let mut c = cfg.clone();
+                level.apply(model, &mut c, 2.0);
+                let g: Vec<usize> = (0..cfg.q.len()).filter(|&i| c.q[i] != cfg.q[i]).collect();
+                (!g.is_empty()).then_some(g)
+            })
+            .collect();
+        // (a state in two levels' groups cannot be scaled by either alone)
+        let disjoint = groups.iter().enumerate().all(|(a, ga)| {
+            groups[a + 1..]
+                .iter()
+                .all(|gb| ga.iter().all(|i| !gb.contains(i)))
+        });
+        let Some(mut rec) = Recorder::new(model.n(), cfg, &groups).filter(|_| disjoint) else {
+            return Ok(Passes {
+                model,
+                data,
+                tape: None,
+            });
+        };
+        let pass = run_pass_watched(model, &[], data, cfg, progress, &mut rec)?;
+        let tape = rec.finish().filter(|t| {
+            t.innovations(cfg).is_some_and(|inn| {
+                let l: f64 = inn.iter().map(super::diagnostics::loglik_of).sum();
+                let l0 = pass.stats.loglik;
+                inn.len() == pass.run.innovations.len()
+                    && (l - l0).abs() <= 1e-6 * l0.abs().max(1.0)
+            })
+        });
+        Ok(Passes { model, data, tape })
+    }
+
+    /// The applied innovations of the pass with configuration `cfg`.
+    fn innovations(&self, cfg: &FilterConfig) -> anyhow::Result<Vec<Innovation>> {
+        if let Some(inn) = self.tape.as_ref().and_then(|t| t.innovations(cfg)) {
+            return Ok(inn);
+        }
+        Ok(run_pass(self.model, &[], self.data, cfg, &mut |_| {})?
+            .run
+            .innovations)
+    }
+
+    /// The innovation log-likelihood of the pass with configuration `cfg`.
+    fn loglik(&self, cfg: &FilterConfig) -> anyhow::Result<f64> {
+        Ok(self
+            .innovations(cfg)?
+            .iter()
+            .map(super::diagnostics::loglik_of)
+            .sum())
+    }
+}
 
 /// A noise level explain can scale.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,15 +164,15 @@ pub(super) struct LevelFit {
 /// ML scales of every level on `model` with configuration `cfg`, whose pass has log-likelihood
 /// and scalar innovation count `(loglik0, innovations)`; returns the fits and the configuration
 /// with the significant scales applied.
-pub(super) fn fit(
-    model: &Model,
+fn fit(
+    passes: &Passes,
     cfg: &FilterConfig,
     levels: &[Level],
-    data: &ExplainData,
     (loglik0, innovations): (f64, usize),
     opts: &ExplainOptions,
     progress: &mut dyn FnMut(f64),
 ) -> anyhow::Result<(Vec<LevelFit>, FilterConfig)> {
+    let model = passes.model;
     let mut cur = cfg.clone();
     let mut l_cur = loglik0;
     let mut fits = Vec::new();
@@ -112,9 +190,10 @@ pub(super) fn fit(
         let mut eval = |u: f64| -> anyhow::Result<f64> {
             let mut c = cur.clone();
             level.apply(model, &mut c, 2f64.powf(u));
-            let p = run_pass(model, &[], data, &c, &mut |f| progress((done + f) / total))?;
+            let l = passes.loglik(&c)?;
             done += 1.0;
-            Ok(p.stats.loglik)
+            progress(done / total);
+            Ok(l)
         };
         let (u, l, curv, edge) = search(&mut eval, l_cur)?;
         if l > l_cur {
@@ -136,9 +215,10 @@ pub(super) fn fit(
         }
         let mut c = cur.clone();
         level.apply(model, &mut c, 1.0 / scales[li]);
-        let p = run_pass(model, &[], data, &c, &mut |f| progress((done + f) / total))?;
+        let l = passes.loglik(&c)?;
         done += 1.0;
-        gains[li] = (2.0 * (l_cur - p.stats.loglik)).max(0.0);
+        progress(done / total);
+        gains[li] = (2.0 * (l_cur - l)).max(0.0);
     }
     for (li, &level) in levels.iter().enumerate() {
         fits.push(LevelFit {
@@ -163,7 +243,7 @@ pub(super) fn fit(
             f.level.apply(model, &mut out, f.scale);
         }
     }
-    refit_named(model, data, &mut fits, &mut out)?;
+    refit_named(passes, &mut fits, &mut out)?;
     Ok((fits, out))
 }
 
@@ -171,23 +251,23 @@ pub(super) fn fit(
 /// back at their stated values: a level the data do not need must not shift the value of one
 /// they do. Updates the fits' scales and intervals and `out`.
 fn refit_named(
-    model: &Model,
-    data: &ExplainData,
+    passes: &Passes,
     fits: &mut [LevelFit],
     out: &mut FilterConfig,
 ) -> anyhow::Result<()> {
+    let model = passes.model;
     let moved = fits.iter().any(|f| !f.significant && f.scale != 1.0);
     if !moved || !fits.iter().any(|f| f.significant) {
         return Ok(());
     }
-    let mut l_out = run_pass(model, &[], data, out, &mut |_| {})?.stats.loglik;
+    let mut l_out = passes.loglik(out)?;
     for f in fits.iter_mut().filter(|f| f.significant) {
         let level = f.level;
         let base = out.clone();
         let mut eval = |u: f64| -> anyhow::Result<f64> {
             let mut c = base.clone();
             level.apply(model, &mut c, 2f64.powf(u));
-            Ok(run_pass(model, &[], data, &c, &mut |_| {})?.stats.loglik)
+            passes.loglik(&c)
         };
         let (u, l, curv, edge) = search(&mut eval, l_out)?;
         if l > l_out {
@@ -307,14 +387,16 @@ pub(super) fn stage(
         }
     }
     let round = r.rounds + 1;
+    let passes = Passes::record(&r.model, ctx.data, &cfg, &levels, &mut |f| {
+        progress(round, 0.5 * f)
+    })?;
     let (fits, cfg_noise) = fit(
-        &r.model,
+        &passes,
         &cfg,
         &levels,
-        ctx.data,
         (st.loglik, r.pass.run.innovations.len()),
         ctx.opts,
-        &mut |f| progress(round, f),
+        &mut |f| progress(round, 0.5 + 0.5 * f),
     )?;
     if !fits.iter().any(|f| f.significant) {
         return Ok((Vec::new(), None));
@@ -345,7 +427,7 @@ pub(super) fn stage(
             excess.map(|e| removed * w / e),
             f.two_delta_loglik,
         );
-        nf.consistency = split_scales(ctx, &r.model, &cfg_noise, f, &pass, &groups)?;
+        nf.consistency = split_scales(&passes, &cfg_noise, f, &pass, &groups)?;
         let why: Vec<String> = nf
             .consistency
             .iter()
@@ -507,16 +589,15 @@ fn vibrating_spans(windows: &[(f64, f64, f64)]) -> Vec<(f64, f64)> {
 /// fitted scale beside `pass` (which has it), a parabola in log₂ s through each group's
 /// log-likelihood; σ from its curvature. Groups without curvature carry no information.
 fn split_scales(
-    ctx: &Context,
-    model: &Model,
+    passes: &Passes,
     cfg: &FilterConfig,
     f: &LevelFit,
     pass: &Pass,
     groups: &[[usize; 3]],
 ) -> anyhow::Result<Vec<super::Consistency>> {
-    let loglik_by_group = |p: &Pass| -> [[f64; 2]; 3] {
+    let loglik_by_group = |inn: &[Innovation]| -> [[f64; 2]; 3] {
         let mut l = [[0.0; 2]; 3];
-        for (i, g) in p.run.innovations.iter().zip(groups) {
+        for (i, g) in inn.iter().zip(groups) {
             let li = super::diagnostics::loglik_of(i);
             for (split, &k) in g.iter().enumerate() {
                 l[split][k] += li;
@@ -527,14 +608,14 @@ fn split_scales(
     let mut at = Vec::new();
     for u in [-1.0, 1.0] {
         let mut c = cfg.clone();
-        f.level.apply(model, &mut c, 2f64.powf(u));
-        let p = run_pass(model, &[], ctx.data, &c, &mut |_| {})?;
-        if p.run.innovations.len() != groups.len() {
+        f.level.apply(passes.model, &mut c, 2f64.powf(u));
+        let inn = passes.innovations(&c)?;
+        if inn.len() != groups.len() {
             anyhow::bail!("the noise passes differ in their updates");
         }
-        at.push(loglik_by_group(&p));
+        at.push(loglik_by_group(&inn));
     }
-    let mid = loglik_by_group(pass);
+    let mid = loglik_by_group(&pass.run.innovations);
     let mut out = Vec::new();
     for (split, name, labels) in [
         (

@@ -119,8 +119,28 @@ impl SparsePropagator {
         x: Option<&mut [f64]>,
     ) {
         let n = self.n;
+        self.fill_b(a, dt);
+        if let Some(x) = x {
+            let (b, dx) = (&self.b, &mut self.dx);
+            for (r, d) in dx.iter_mut().enumerate() {
+                *d = self.b_cols[r].iter().map(|&k| b[r * n + k] * x[k]).sum();
+            }
+            for (r, &i) in self.dyn_rows.iter().enumerate() {
+                x[i] += dx[r];
+            }
+        }
+        self.sandwich(p);
+        for i in 0..n {
+            p[i * n + i] += q[i] * dt;
+        }
+    }
+
+    /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows, into the scratch `b`.
+    #[inline(always)]
+    fn fill_b(&mut self, a: &[f64], dt: f64) {
+        let n = self.n;
         let half_dt2 = 0.5 * dt * dt;
-        let (b, m, dx) = (&mut self.b, &mut self.m, &mut self.dx);
+        let b = &mut self.b;
         for (r, i, j, direct, ks) in &self.b_entries {
             let (i, j) = (*i, *j);
             let mut second = 0.0;
@@ -130,14 +150,13 @@ impl SparsePropagator {
             let first = if *direct { a[i * n + j] * dt } else { 0.0 };
             b[r * n + j] = first + half_dt2 * second;
         }
-        if let Some(x) = x {
-            for (r, d) in dx.iter_mut().enumerate() {
-                *d = self.b_cols[r].iter().map(|&k| b[r * n + k] * x[k]).sum();
-            }
-            for (r, &i) in self.dyn_rows.iter().enumerate() {
-                x[i] += dx[r];
-            }
-        }
+    }
+
+    /// M = B P into the scratch `m` (P n×n row-major, B from [`Self::fill_b`]).
+    #[inline(always)]
+    fn b_times(&mut self, p: &[f64]) {
+        let n = self.n;
+        let (b, m) = (&self.b, &mut self.m);
         for (r, cols) in self.b_cols.iter().enumerate() {
             let mr = &mut m[r * n..(r + 1) * n];
             mr.iter_mut().for_each(|v| *v = 0.0);
@@ -148,6 +167,14 @@ impl SparsePropagator {
                 }
             }
         }
+    }
+
+    /// P ← Φ P Φᵀ = P + B P + (B P)ᵀ + B P Bᵀ, with B from [`Self::fill_b`].
+    #[inline(always)]
+    fn sandwich(&mut self, p: &mut [f64]) {
+        let n = self.n;
+        self.b_times(p);
+        let (b, m) = (&self.b, &self.m);
         for (r, &i) in self.dyn_rows.iter().enumerate() {
             let mr = &m[r * n..(r + 1) * n];
             for (s, &js) in self.dyn_rows.iter().enumerate() {
@@ -159,8 +186,71 @@ impl SparsePropagator {
                 p[j * n + i] += mj;
             }
         }
-        for i in 0..n {
-            p[i * n + i] += q[i] * dt;
+    }
+
+    /// Rows of A that are not all zero (the rows Φ − I can change).
+    pub fn dyn_rows(&self) -> &[usize] {
+        &self.dyn_rows
+    }
+
+    /// One step of a replay interval (see `estimate::replay`): Ψ ← Φ Ψ and, for each noise
+    /// group k, G_k ← Φ G_k Φᵀ + diag(q_k)·dt, with Φ = I + A·dt + A²·dt²/2 as in
+    /// [`Self::propagate`]; every matrix n×n row-major, `a` [1/s], `dt` [s], `q_k` [SI²/s].
+    pub fn accumulate(
+        &mut self,
+        a: &[f64],
+        dt: f64,
+        q: &[Vec<f64>],
+        g: &mut [Vec<f64>],
+        psi: &mut [f64],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, checked just above.
+                unsafe { self.accumulate_avx2(a, dt, q, g, psi) };
+                return;
+            }
+        }
+        self.accumulate_body(a, dt, q, g, psi)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn accumulate_avx2(
+        &mut self,
+        a: &[f64],
+        dt: f64,
+        q: &[Vec<f64>],
+        g: &mut [Vec<f64>],
+        psi: &mut [f64],
+    ) {
+        self.accumulate_body(a, dt, q, g, psi)
+    }
+
+    #[inline(always)]
+    fn accumulate_body(
+        &mut self,
+        a: &[f64],
+        dt: f64,
+        q: &[Vec<f64>],
+        g: &mut [Vec<f64>],
+        psi: &mut [f64],
+    ) {
+        let n = self.n;
+        self.fill_b(a, dt);
+        for (gk, qk) in g.iter_mut().zip(q) {
+            self.sandwich(gk);
+            for i in 0..n {
+                gk[i * n + i] += qk[i] * dt;
+            }
+        }
+        // Ψ ← Ψ + B Ψ
+        self.b_times(psi);
+        for (r, &i) in self.dyn_rows.iter().enumerate() {
+            for (pj, mj) in psi[i * n..(i + 1) * n].iter_mut().zip(&self.m[r * n..]) {
+                *pj += mj;
+            }
         }
     }
 }
