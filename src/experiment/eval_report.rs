@@ -66,8 +66,9 @@ pub fn test_statement(s: &Summary) -> String {
          NIS) (quasi-likelihood), must exceed Holm's first threshold, the χ²₁ quantile \
          1 − α/m over the m candidates tested (α = {}; m is each case's own count, median {}), \
          and ln N (BIC, N innovations). A candidate that passes is kept only if the filter \
-         confirms the extended model (2Δℓ > k ln N for k added terms), its estimate holds across \
-         the consistency splits and it is not a stand-in; those later gates can only lower \
+         confirms the extended model (its 2Δℓ with the prior's Occam term ln det(I + DJD) added \
+         back above the χ²_k quantile 1 − α, times φ, for k added terms), its estimate holds \
+         across the consistency splits and it is not a stand-in; those later gates can only lower \
          detection below this curve. Each bin's theory is the test's power averaged over the \
          bin's cases (their λ and m); an empty bin's, and the plotted curve, are the power at \
          the median m.",

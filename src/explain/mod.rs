@@ -1357,6 +1357,36 @@ struct Rounds {
     split_passes: Vec<(usize, Vec<usize>, selection::Scaled)>,
 }
 
+/// The Occam term ln det(I + D J D) of terms `added` (J their information through the pass of
+/// `sig`, D their prior σ in the extended configuration `cfg` of `model`): what the filter's
+/// 2Δℓ pays for giving the terms a prior instead of fitting them freely. In a linear Gaussian
+/// model 2Δℓ + ln(1 + J σ²) = GLR · Jσ²/(1 + Jσ²): the GLR where the data outweigh the prior.
+fn occam(sig: &Signatures, added: &[usize], model: &Model, cfg: &FilterConfig) -> f64 {
+    let m = sig.cands.len();
+    let at: Vec<(usize, f64)> = added
+        .iter()
+        .filter_map(|&t| {
+            let c = sig.cands.iter().position(|&x| x == t)?;
+            let i = model.index_of(common::TERMS[t].name)?;
+            Some((c, cfg.prior_sigma[i]))
+        })
+        .collect();
+    if at.is_empty() {
+        return 0.0;
+    }
+    let j = sig.info();
+    let k = at.len();
+    let a = nalgebra::DMatrix::from_fn(k, k, |x, y| {
+        let ((cx, sx), (cy, sy)) = (at[x], at[y]);
+        f64::from(u8::from(x == y)) + sx * sy * j[cx * m + cy]
+    });
+    // (I + D J D is positive definite for a J that is; a J that is not gives no credit)
+    match a.cholesky() {
+        Some(c) => 2.0 * c.l().diagonal().iter().map(|d| d.ln()).sum::<f64>(),
+        None => 0.0,
+    }
+}
+
 /// The rounds with the model that holds only the causes among `findings` (no stand-in, no
 /// unattributed class) and its pass, when that differs from the rounds' model; else as given.
 fn without_stand_ins(
@@ -1384,7 +1414,7 @@ fn without_stand_ins(
 }
 
 /// Selection on the baseline pass, then rounds of adding the selected terms, re-running the
-/// filter (which must confirm them by more than their BIC penalty) and selecting again.
+/// filter (which must confirm them at the selection's α, see [`occam`]) and selecting again.
 fn select_and_retest(
     ctx: &Context,
     cands: Vec<usize>,
@@ -1446,16 +1476,19 @@ fn select_and_retest(
             &mut |f| progress(round, f),
         )?;
         r.rounds = round;
-        // the filter must confirm what the signatures predicted: the added terms must raise the
-        // log-likelihood by more than their BIC penalty (k ln N); else the linearisation did not
-        // hold (or the misfit is something else) and the round is undone
+        // the filter must confirm what the signatures predicted, at the selection's α: its
+        // 2Δℓ, with the prior's Occam term added back, must pass the χ²_k quantile 1 − α
+        // (times φ, as the selection's quasi-likelihood); else the linearisation did not hold
+        // (or the misfit is something else) and the round is undone
         let gain = next_pass.stats.loglik - r.pass.stats.loglik;
-        let penalty = added.len() as f64 * (next_pass.run.innovations.len().max(2) as f64).ln();
-        if 2.0 * gain <= penalty && !opts.broken_selector {
+        let statistic = 2.0 * gain + occam(&r.pass.sig, &added, &next_model, &cfg);
+        let threshold =
+            r.pass.sig.dispersion.max(1.0) * stats::chi2_isf(opts.alpha, added.len() as f64);
+        if statistic <= threshold && !opts.broken_selector {
             r.unconfirmed.extend(
                 added
                     .iter()
-                    .map(|&t| (common::TERMS[t].name.to_string(), 2.0 * gain, penalty)),
+                    .map(|&t| (common::TERMS[t].name.to_string(), statistic, threshold)),
             );
             r.named.truncate(named_before);
             r.widened.truncate(widened_before);

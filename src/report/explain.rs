@@ -526,7 +526,7 @@ fn candidate_note(e: &Explanation, c: &crate::explain::CandidateTest) -> String 
     }
     if let Some((_, gain, penalty)) = e.unconfirmed.iter().find(|u| u.0 == c.term) {
         return format!(
-            "selected, but the extended filter did not confirm it (2Δℓ {} below k ln N {})",
+            "selected, but the extended filter did not confirm it (2Δℓ with the prior's Occam term {} below the χ² quantile at α {})",
             sig3(*gain),
             sig3(*penalty)
         );
