@@ -459,7 +459,16 @@ pub fn explain(
     let r = without_stand_ins(ctx, r, &judged, progress)?;
     let passed_over = passed_over(ctx, &r, &judged, &cands, progress)?;
     let stand_ins = judged_stand_ins(&r, &judged);
-    let (noise_findings, noise_stage) = noise::stage(ctx, &r, &base_stats, progress)?;
+    // the terms fitted but judged stand-ins: a noise level they take up is no finding either
+    let stand_in_terms: Vec<usize> = r
+        .named
+        .iter()
+        .zip(&judged)
+        .filter(|(_, f)| !f.is_cause())
+        .map(|(n, _)| n.term)
+        .collect();
+    let (noise_findings, noise_stage) =
+        noise::stage(ctx, &r, &base_stats, &stand_in_terms, progress)?;
     let noise_pass = noise_stage.as_ref().map(|x| &x.0);
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let last_pass = noise_pass.unwrap_or(&r.pass);

@@ -23,6 +23,7 @@ use super::{
 use crate::estimate::filter::{FilterConfig, Innovation};
 use crate::estimate::replay::{Recorder, Tape};
 use crate::estimate::stats;
+use crate::model::generated::common;
 use crate::model::Model;
 
 /// Passes of one model under rescaled noise levels: replayed from a tape of one open-loop pass
@@ -363,6 +364,7 @@ pub(super) fn stage(
     ctx: &Context,
     r: &Rounds,
     base: &PassStats,
+    stand_ins: &[usize],
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<(Vec<Finding>, Option<NoisePass>)> {
     let st = &r.pass.stats;
@@ -461,12 +463,75 @@ pub(super) fn stage(
         }
         findings.push(nf);
     }
+    taken_up_by_stand_ins(ctx, r, &fits, stand_ins, &mut findings)?;
     let applied = fits
         .iter()
         .filter(|f| f.significant)
         .map(|f| (f.level, f.scale))
         .collect();
     Ok((findings, Some((pass, applied))))
+}
+
+/// A noise finding that is significant only while the terms the rules called stand-ins
+/// (`stand_ins`) are left out of the model is no claim about the noise either: with them fitted
+/// beside it, each significant level of `fits` (not yet a stand-in in `findings`) is fitted
+/// again from its stated value on the model with them, the others kept at their fits;
+/// a level whose 2Δℓ then falls to max(ln N, χ²₁(α)) or below is marked a stand-in. A term the
+/// prior rejects (a value many prior σ out) may still be a real effect of this unit: the noise
+/// scale then only stands in for it.
+fn taken_up_by_stand_ins(
+    ctx: &Context,
+    r: &Rounds,
+    fits: &[LevelFit],
+    stand_ins: &[usize],
+    findings: &mut [Finding],
+) -> anyhow::Result<()> {
+    let open: Vec<(usize, &LevelFit)> = fits
+        .iter()
+        .filter(|f| f.significant)
+        .enumerate()
+        .filter(|(k, _)| findings[*k].stand_in.is_none())
+        .collect();
+    if stand_ins.is_empty() || open.is_empty() {
+        return Ok(());
+    }
+    let model = super::model_with(&r.model.name, stand_ins.iter().copied())?;
+    let mut cfg_plus = ctx.extended_config(&model, &r.widened)?;
+    for f in fits.iter().filter(|f| f.significant) {
+        f.level.apply(&model, &mut cfg_plus, f.scale);
+    }
+    let levels: Vec<Level> = open.iter().map(|(_, f)| f.level).collect();
+    let passes = Passes::record(&model, ctx.data, &cfg_plus, &levels, &mut |_| {})?;
+    let n = r.pass.run.innovations.len().max(2) as f64;
+    let threshold = n.ln().max(stats::chi2_isf(ctx.opts.alpha, 1.0));
+    let names: Vec<&str> = stand_ins.iter().map(|&t| common::TERMS[t].name).collect();
+    for (k, f) in open {
+        let mut stated = cfg_plus.clone();
+        f.level.apply(&model, &mut stated, 1.0 / f.scale);
+        let l1 = passes.loglik(&stated)?;
+        let mut eval = |u: f64| -> anyhow::Result<f64> {
+            let mut c = stated.clone();
+            f.level.apply(&model, &mut c, 2f64.powf(u));
+            passes.loglik(&c)
+        };
+        let (_, l, _, _) = search(&mut eval, l1)?;
+        let gain = (2.0 * (l - l1)).max(0.0);
+        if gain <= threshold {
+            let why = format!(
+                "fitted beside {} (called stand-ins above) it is no longer significant (2Δℓ {} → {}, against {})",
+                names.join(", "),
+                sig3(f.two_delta_loglik),
+                sig3(gain),
+                sig3(threshold)
+            );
+            let nf = &mut findings[k];
+            nf.words.push_str(&format!(
+                ". It is not a finding of its own: {why}; the misfit it takes up may be an effect of this unit the priors or the candidates do not admit, so do not read it as the stated noise being wrong"
+            ));
+            nf.stand_in = Some(why);
+        }
+    }
+    Ok(())
 }
 
 /// Most a sensor's noise level can be mis-stated by and still be read as that level: grades
