@@ -66,10 +66,11 @@ pub fn test_statement(s: &Summary) -> String {
          NIS) (quasi-likelihood), must exceed Holm's first threshold, the χ²₁ quantile \
          1 − α/m over the m candidates tested (α = {}; m is each case's own count, median {}), \
          and ln N (BIC, N innovations). A candidate that passes is kept only if the filter \
-         confirms the extended model (its 2Δℓ with the prior's Occam term ln det(I + DJD) added \
+         confirms the extended model (its 2Δℓ with the prior's Occam term ln det(I + SJS) added \
          back above the χ²_k quantile 1 − α, times φ, for k added terms), its estimate holds \
-         across the consistency splits and it is not a stand-in; those later gates can only lower \
-         detection below this curve. Each bin's theory is the test's power averaged over the \
+         across the consistency splits and it is not a stand-in; those gates lower detection \
+         below this curve, while the forward selection's later steps (conditional tests, Holm \
+         over the candidates left) can pass a candidate the first test missed. Each bin's theory is the test's power averaged over the \
          bin's cases (their λ and m); an empty bin's, and the plotted curve, are the power at \
          the median m.",
         s.alpha, s.candidates_tested_median

@@ -255,7 +255,7 @@ pub struct Explanation {
     /// Significant candidates not named because their value would be implausible.
     pub implausible: Vec<Implausible>,
     /// Terms the signatures selected but the extended filter did not confirm: (term, 2Δℓ of
-    /// the round plus the prior's Occam term ln det(I + DJD), the χ²_k quantile 1 − α it had to
+    /// the round plus the prior's Occam term ln det(I + SJS), S the prior σ, the χ²_k quantile 1 − α it had to
     /// pass, times the dispersion φ when above 1).
     pub unconfirmed: Vec<(String, f64, f64)>,
     /// Candidates whose regressor is proportional on these data to a baseline term's on the

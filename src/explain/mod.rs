@@ -1366,8 +1366,8 @@ struct Rounds {
     split_passes: Vec<(usize, Vec<usize>, selection::Scaled)>,
 }
 
-/// The Occam term ln det(I + D J D) of terms `added` (J their information through the pass of
-/// `sig`, D their prior σ in the extended configuration `cfg` of `model`): what the filter's
+/// The Occam term ln det(I + S J S) of terms `added` (J their information through the pass of
+/// `sig`, S the diagonal of their prior σ in the extended configuration `cfg` of `model`): what the filter's
 /// 2Δℓ pays for giving the terms a prior instead of fitting them freely. In a linear Gaussian
 /// model 2Δℓ + ln(1 + J σ²) = GLR · Jσ²/(1 + Jσ²): the GLR where the data outweigh the prior.
 fn occam(sig: &Signatures, added: &[usize], model: &Model, cfg: &FilterConfig) -> f64 {

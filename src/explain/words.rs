@@ -767,7 +767,7 @@ fn not_named_words(e: &Explanation, out: &mut Vec<String>) {
         let names: Vec<&str> = e.unconfirmed.iter().map(|u| u.0.as_str()).collect();
         let (g, p) = (e.unconfirmed[0].1, e.unconfirmed[0].2);
         out.push(format!(
-            "The signatures pointed at {} but the filter with them did not confirm it (2Δ log-likelihood {} with the prior's Occam term added back, against {}, the χ² quantile at α): not named; the misfit is something the candidates do not describe.",
+            "The signatures pointed at {} but the filter with them did not confirm it (2Δ log-likelihood {} with the prior's Occam term added back, against {}, φ times the χ²_k quantile at α): not named; the misfit is something the candidates do not describe.",
             names.join(", "),
             sig3(g),
             sig3(p)

@@ -52,7 +52,7 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         "implausible": e.implausible,
         "unconfirmed": e.unconfirmed
             .iter()
-            .map(|(t, g, p)| json!({"term": t, "two_delta_loglik": g, "bic_penalty": p}))
+            .map(|(t, g, p)| json!({"term": t, "two_delta_loglik_with_occam": g, "threshold": p}))
             .collect::<Vec<_>>(),
         "not_separable": e.not_separable
             .iter()
@@ -526,7 +526,7 @@ fn candidate_note(e: &Explanation, c: &crate::explain::CandidateTest) -> String 
     }
     if let Some((_, gain, penalty)) = e.unconfirmed.iter().find(|u| u.0 == c.term) {
         return format!(
-            "selected, but the extended filter did not confirm it (2Δℓ with the prior's Occam term {} below the χ² quantile at α {})",
+            "selected, but the extended filter did not confirm it (2Δℓ with the prior's Occam term {} below {}, φ times the χ²_k quantile at α)",
             sig3(*gain),
             sig3(*penalty)
         );
@@ -618,8 +618,10 @@ fn notes_section(s: &mut String) {
         "\nThe candidate tests are quasi-likelihood tests: when the baseline's innovations are \
          larger than predicted (mean NIS φ > 1), information and score are divided by φ. A term \
          is named only when its value is within 100 prior σ (`--prior` sets the sensor class) \
-         and the filter with it confirms the gain the signatures predicted (2Δ log-likelihood \
-         above the BIC penalty k ln N).\n",
+         and the filter with it confirms the gain the signatures predicted: its 2Δ \
+         log-likelihood, with the prior's Occam term ln det(I + S J S) added back (S the \
+         terms' prior σ, J their information), above φ times the χ²_k quantile 1 − α for the k \
+         terms added in the round.\n",
     );
     s.push_str(
         "\n**Not testable** means the data carry no information on the term (its regressor is \
