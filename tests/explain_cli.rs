@@ -314,7 +314,25 @@ fn explain_refuses_bad_input_with_the_reason() {
                 "--out",
                 o,
             ],
-            "the filter diverged",
+            "beyond the 1.00e6 ug/g^2 the term can physically have",
+        ),
+        (
+            vec![
+                "explain",
+                "--model",
+                "P13",
+                "--imu",
+                rlg,
+                "--static-aid",
+                "34.246048,108.909664,380",
+                "--init",
+                init,
+                "--json",
+                o,
+                "--out",
+                o,
+            ],
+            "the same path as --out",
         ),
         (
             vec![
@@ -371,6 +389,9 @@ fn a_prior_beyond_the_spec_limit_is_a_unit_slip() {
     let out = tmp("limit");
     for (prior, want) in [
         ("tau_x=5 s", "5000 ms is beyond the 100 ms"),
+        // the library terms' limits: d in s²/m read for µg/g², a g²-sensitivity in deg/s
+        ("d_z=0.5 s^2/m", "4.90e6 ug/g^2 is beyond the 1.00e6 ug/g^2"),
+        ("kgq_x=100 deg/s/g^2", "3.60e5 deg/h/g^2 is beyond the 72000 deg/h/g^2"),
         ("size_*=40 m", "40000 mm is beyond the 1000 mm"),
         // as many digits as it takes to differ from the limit
         ("tau_x=100.001 ms", "100.001 ms is beyond the 100 ms"),

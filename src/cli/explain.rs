@@ -76,6 +76,13 @@ fn check_json_option(args: &ExplainArgs, j: &Path) -> Result<()> {
     if j.is_dir() {
         bail!("--json {}: is a directory; give a file name", j.display());
     }
+    // the run makes --out a directory: as --json too the run would end refusing its own output
+    if same_file(j, &args.out) {
+        bail!(
+            "--json {}: the same path as --out (the run's directory); give the JSON file another name",
+            j.display()
+        );
+    }
     // inside --out it would be a file the run's directory did not list (explain.json is
     // there already)
     let parent = j
