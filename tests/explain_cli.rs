@@ -391,7 +391,10 @@ fn a_prior_beyond_the_spec_limit_is_a_unit_slip() {
         ("tau_x=5 s", "5000 ms is beyond the 100 ms"),
         // the library terms' limits: d in s²/m read for µg/g², a g²-sensitivity in deg/s
         ("d_z=0.5 s^2/m", "4.90e6 ug/g^2 is beyond the 1.00e6 ug/g^2"),
-        ("kgq_x=100 deg/s/g^2", "3.60e5 deg/h/g^2 is beyond the 72000 deg/h/g^2"),
+        (
+            "kgq_x=100 deg/s/g^2",
+            "3.60e5 deg/h/g^2 is beyond the 72000 deg/h/g^2",
+        ),
         ("size_*=40 m", "40000 mm is beyond the 1000 mm"),
         // as many digits as it takes to differ from the limit
         ("tau_x=100.001 ms", "100.001 ms is beyond the 100 ms"),
@@ -495,6 +498,46 @@ fn mems_drive_explain(out: &std::path::Path, extra: &[&str]) -> (bool, String, S
     args.extend(extra);
     args.extend(["--out", out.to_str().unwrap()]);
     sinsmodel(&args)
+}
+
+/// Open loop on the MEMS drive linearises about a free-inertial solution that tumbles: explain
+/// says so (a warning, the report's words and explain.json), naming --mode closed.
+#[test]
+fn open_loop_about_a_drifting_navigation_is_said() {
+    let out = tmp("mems-open");
+    let d = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/gnss-imu-drive");
+    let (imu, pos) = (format!("{d}/imu_1934.csv"), format!("{d}/gnss_1934_sf.pos"));
+    let noise = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/docs/real-data/mems_static_allan.json"
+    );
+    let mut args = vec!["explain", "--model", "P28+vertical", "--imu", &imu];
+    args.extend(["--aid", &pos, "--noise", noise]);
+    // the drive's start and priors, open loop instead of closed
+    let start = common::MEMS_DRIVE_START_AND_PRIORS;
+    let mut i = 0;
+    while i < start.len() {
+        if start[i] == "--mode" {
+            args.extend(["--mode", "open"]);
+        } else {
+            args.extend([start[i], start[i + 1]]);
+        }
+        i += 2;
+    }
+    args.extend(["--out", out.to_str().unwrap()]);
+    let (ok, _, stderr) = sinsmodel(&args);
+    assert!(ok, "{stderr}");
+    assert!(
+        stderr.contains("Open loop about a drifting navigation")
+            && stderr.contains("--mode closed"),
+        "{stderr}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("Open loop about a drifting navigation"));
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("explain.json")).unwrap()).unwrap();
+    assert!(j["linearisation"].as_str().unwrap().contains("deg"));
+    std::fs::remove_dir_all(&out).unwrap();
 }
 
 /// Both measured sets (docs/explain.md): only what is stable is asserted.

@@ -289,6 +289,9 @@ pub struct Explanation {
     pub baseline_priors_widened: bool,
     /// 2Δ log-likelihood of the baseline with the widened priors over the priors as given.
     pub baseline_priors_gain: Option<f64>,
+    /// Open loop about a navigation whose attitude error estimate passed 10°: why the linear
+    /// error model may not hold, in words (None in closed loop or within small angles).
+    pub linearisation: Option<String>,
     /// Normalised innovations of the baseline and extended passes, for plots.
     #[serde(skip)]
     pub innovations_before: Vec<Normalised>,

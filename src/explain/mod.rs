@@ -435,6 +435,7 @@ pub fn explain(
     let widened_kept = std::ptr::eq(ctx, &widened);
     let Stage {
         truth_warning,
+        linearisation,
         base_stats,
         innovations_before,
         model_error_before,
@@ -444,6 +445,7 @@ pub fn explain(
         r,
     } = stage;
     truth_warning.iter().for_each(|w| warn(w));
+    linearisation.iter().for_each(|w| warn(w));
     let excess = baseline_excess(&base_stats);
     // which findings are causes, judged on the rounds' extended pass; the causes' values then
     // come from the model they recommend, without the stand-ins (a stand-in beside a cause
@@ -523,6 +525,7 @@ pub fn explain(
         baseline_priors_tight: tight,
         baseline_priors_widened: widened_kept,
         baseline_priors_gain: prior_gain,
+        linearisation,
         innovations_before,
         innovations_after: normalised(&last_pass.run),
         model_error_before,
@@ -1168,6 +1171,52 @@ const SMALL_SHARE_PRIOR_SIGMAS: f64 = 5.0;
 /// times the prior's objection z² (z = its value in prior σ).
 const SMALL_SHARE_SUPPORT: f64 = 4.0;
 
+/// Attitude error estimate [rad] beyond which an open-loop pass is linearised about a navigation
+/// too far from the truth: at 10° the small-angle model's couplings are off by 1 − cos φ = 1.5 %
+/// and its neglected second-order terms, ½φ²·g on the specific force, reach 15 mg. (The
+/// embedded demo's hidden d drives its free navigation to 8.4° in 600 s, where explain still
+/// reads d within 1 %.)
+const MAX_OPEN_LOOP_TILT: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+/// The largest attitude error estimate |φ̂| [rad] of a pass and its time [s]: in open loop, how
+/// far in attitude the free navigation the errors are linearised about drifts.
+struct AttitudeDrift {
+    /// Indices of φ_n, φ_e, φ_d in the model.
+    phi: [Option<usize>; 3],
+    /// Largest |φ̂| so far [rad].
+    max: f64,
+    /// Its time [s].
+    t: f64,
+}
+
+impl filter::Observer for AttitudeDrift {
+    fn nav_sample(&mut self, s: &NavState, x: &[f64], _p: &[f64]) {
+        let v = self
+            .phi
+            .iter()
+            .map(|i| i.map_or(0.0, |i| x[i] * x[i]))
+            .sum::<f64>()
+            .sqrt();
+        if v > self.max {
+            self.max = v;
+            self.t = s.t;
+        }
+    }
+}
+
+impl AttitudeDrift {
+    /// What the drift means for an open-loop explain, in words (times from `t0` [s]).
+    fn words(&self, t0: f64) -> String {
+        let off = 100.0 * (1.0 - self.max.min(std::f64::consts::PI).cos());
+        format!(
+            "Open loop about a drifting navigation: the free-inertial solution the error model is linearised about reaches an attitude error of {} deg (the filter's estimate, {:.1} s after the start), where the small-angle model's couplings are off by 1 − cos φ = {} % and the terms it neglects, ½φ²·g on the specific force, can read as sensor or aiding terms. Run with --mode closed (the navigation corrected at every fix) before reading the findings below as properties of the sensor.",
+            sig3(self.max.to_degrees()),
+            self.t - t0,
+            sig3(off)
+        )
+    }
+}
+
 /// Prior σ beyond which a baseline term's estimate says its prior is too tight.
 const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
 
@@ -1175,6 +1224,8 @@ const TIGHT_PRIOR_SIGMAS: f64 = 3.0;
 struct Stage {
     /// What `--truth` contradicts in the baseline's estimate, in words.
     truth_warning: Option<String>,
+    /// Open loop about a navigation that drifts beyond small angles, in words.
+    linearisation: Option<String>,
     base_stats: PassStats,
     innovations_before: Vec<Normalised>,
     model_error_before: Vec<(f64, f64, f64)>,
@@ -1192,7 +1243,21 @@ fn baseline_and_select(
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Stage> {
     let cfg = (ctx.config_for)(ctx.baseline)?;
-    let base = run_pass(ctx.baseline, cands, ctx.data, &cfg, &mut |f| progress(1, f))?;
+    let mut drift = AttitudeDrift {
+        phi: ["phi_n", "phi_e", "phi_d"].map(|n| ctx.baseline.index_of(n)),
+        max: 0.0,
+        t: f64::NAN,
+    };
+    let base = run_pass_watched(
+        ctx.baseline,
+        cands,
+        ctx.data,
+        &cfg,
+        &mut |f| progress(1, f),
+        &mut drift,
+    )?;
+    let linearisation = (cfg.mode == filter::Mode::OpenLoop && drift.max > MAX_OPEN_LOOP_TILT)
+        .then(|| drift.words(ctx.data.start.t));
     let base_stats = base.stats.clone();
     let innovations_before = normalised(&base.run);
     // a truth not of this run's attitude (or time) makes every model-error figure meaningless
@@ -1217,6 +1282,7 @@ fn baseline_and_select(
     let r = select_and_retest(ctx, cands.to_vec(), base, &eligible, progress)?;
     Ok(Stage {
         truth_warning,
+        linearisation,
         base_stats,
         innovations_before,
         model_error_before,

@@ -50,6 +50,7 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         "candidates": e.candidates,
         "not_testable": e.not_testable,
         "implausible": e.implausible,
+        "linearisation": e.linearisation,
         "unconfirmed": e.unconfirmed
             .iter()
             .map(|(t, g, p)| json!({"term": t, "two_delta_loglik_with_occam": g, "threshold": p}))
