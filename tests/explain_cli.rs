@@ -486,6 +486,15 @@ fn rlg_static_explain(out: &std::path::Path) -> Vec<String> {
 /// explain on the shared MEMS drive as `docs/explain.md` §2 runs it, with `extra` options, into
 /// `out`: (success, stdout, stderr).
 fn mems_drive_explain(out: &std::path::Path, extra: &[&str]) -> (bool, String, String) {
+    mems_drive_explain_in("closed", out, extra)
+}
+
+/// [`mems_drive_explain`] in filter mode `mode` (`open` or `closed`).
+fn mems_drive_explain_in(
+    mode: &str,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> (bool, String, String) {
     let d = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/gnss-imu-drive");
     let (imu, pos) = (format!("{d}/imu_1934.csv"), format!("{d}/gnss_1934_sf.pos"));
     let noise = concat!(
@@ -494,7 +503,10 @@ fn mems_drive_explain(out: &std::path::Path, extra: &[&str]) -> (bool, String, S
     );
     let mut args = vec!["explain", "--model", "P28+vertical", "--imu", &imu];
     args.extend(["--aid", &pos, "--noise", noise]);
-    args.extend(common::MEMS_DRIVE_START_AND_PRIORS);
+    // the drive's start and priors (option, value pairs), in the mode asked for
+    for pair in common::MEMS_DRIVE_START_AND_PRIORS.chunks(2) {
+        args.extend([pair[0], if pair[0] == "--mode" { mode } else { pair[1] }]);
+    }
     args.extend(extra);
     args.extend(["--out", out.to_str().unwrap()]);
     sinsmodel(&args)
@@ -505,27 +517,7 @@ fn mems_drive_explain(out: &std::path::Path, extra: &[&str]) -> (bool, String, S
 #[test]
 fn open_loop_about_a_drifting_navigation_is_said() {
     let out = tmp("mems-open");
-    let d = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/gnss-imu-drive");
-    let (imu, pos) = (format!("{d}/imu_1934.csv"), format!("{d}/gnss_1934_sf.pos"));
-    let noise = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/docs/real-data/mems_static_allan.json"
-    );
-    let mut args = vec!["explain", "--model", "P28+vertical", "--imu", &imu];
-    args.extend(["--aid", &pos, "--noise", noise]);
-    // the drive's start and priors, open loop instead of closed
-    let start = common::MEMS_DRIVE_START_AND_PRIORS;
-    let mut i = 0;
-    while i < start.len() {
-        if start[i] == "--mode" {
-            args.extend(["--mode", "open"]);
-        } else {
-            args.extend([start[i], start[i + 1]]);
-        }
-        i += 2;
-    }
-    args.extend(["--out", out.to_str().unwrap()]);
-    let (ok, _, stderr) = sinsmodel(&args);
+    let (ok, _, stderr) = mems_drive_explain_in("open", &out, &[]);
     assert!(ok, "{stderr}");
     assert!(
         stderr.contains("Open loop about a drifting navigation")
