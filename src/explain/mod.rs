@@ -461,14 +461,8 @@ pub fn explain(
     let r = without_stand_ins(ctx, r, &judged, progress)?;
     let passed_over = passed_over(ctx, &r, &judged, &cands, progress)?;
     let stand_ins = judged_stand_ins(&r, &judged);
-    // the terms fitted but judged stand-ins: a noise level they take up is no finding either
-    let stand_in_terms: Vec<usize> = r
-        .named
-        .iter()
-        .zip(&judged)
-        .filter(|(_, f)| !f.is_cause())
-        .map(|(n, _)| n.term)
-        .collect();
+    // a noise level the terms judged stand-ins take up is no finding either
+    let stand_in_terms = judged_stand_in_terms(&r, &judged);
     let (noise_findings, noise_stage) =
         noise::stage(ctx, &r, &base_stats, &stand_in_terms, progress)?;
     let noise_pass = noise_stage.as_ref().map(|x| &x.0);
@@ -981,6 +975,16 @@ fn term_sensor(name: &str) -> Option<Sensor> {
 fn not_named(f: &mut Finding, why: String) {
     f.words.push_str(&format!(". Not named as a cause: {why}"));
     f.not_attributed = joined(f.not_attributed.take(), Some(why));
+}
+
+/// The term indices of the stand-ins among `judged` (one finding per named term of `r`).
+fn judged_stand_in_terms(r: &Rounds, judged: &[Finding]) -> Vec<usize> {
+    r.named
+        .iter()
+        .zip(judged)
+        .filter(|(_, f)| !f.is_cause())
+        .map(|(n, _)| n.term)
+        .collect()
 }
 
 /// The names of the stand-ins among `judged` (one finding per named term of `r`) and of the
