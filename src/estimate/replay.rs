@@ -35,6 +35,16 @@ enum Event {
     },
 }
 
+impl Event {
+    /// Bytes the event holds (its matrices or its row, and the fixed fields).
+    fn bytes(&self) -> usize {
+        match self {
+            Event::Propagate { psi, g } => 8 * (psi.len() + g.len()),
+            Event::Measure { h, .. } => 16 * h.len() + 64,
+        }
+    }
+}
+
 /// Watches an open-loop pass and records what a replay needs (see the module's note).
 pub struct Recorder {
     n: usize,
@@ -113,8 +123,17 @@ impl Recorder {
         self.psi.iter_mut().for_each(|v| *v = 0.0);
         (0..n).for_each(|i| self.psi[i * n + i] = 1.0);
         self.pending = false;
-        self.bytes += 8 * (psi.len() + g.len());
-        self.events.push(Event::Propagate { psi, g });
+        self.push(Event::Propagate { psi, g });
+    }
+
+    /// Keeps `e`, or drops the whole tape once it outgrows [`MAX_BYTES`].
+    fn push(&mut self, e: Event) {
+        self.bytes += e.bytes();
+        self.events.push(e);
+        if self.bytes > MAX_BYTES {
+            self.too_large = true;
+            self.events = Vec::new();
+        }
     }
 
     /// The tape, or None when the pass recorded none (no step) or it outgrew [`MAX_BYTES`].
@@ -174,8 +193,7 @@ impl Observer for Recorder {
             .filter(|(_, v)| **v != 0.0)
             .map(|(j, &v)| (j, v))
             .collect();
-        self.bytes += 16 * h.len() + 64;
-        self.events.push(Event::Measure {
+        self.push(Event::Measure {
             t,
             meas,
             comp,
@@ -183,10 +201,6 @@ impl Observer for Recorder {
             z,
             sigma,
         });
-        if self.bytes > MAX_BYTES {
-            self.too_large = true;
-            self.events = Vec::new();
-        }
     }
 }
 
@@ -277,6 +291,8 @@ impl Tape {
             });
         let n = self.n;
         let (live, nl) = (&self.live, self.live.len());
+        let mut off_live = vec![true; n];
+        live.iter().for_each(|&i| off_live[i] = false);
         let mut x = self.x0.clone();
         let mut p = self.p0.clone();
         let (mut u, mut k) = (vec![0.0; n], vec![0.0; n]);
@@ -312,10 +328,8 @@ impl Tape {
                     }
                     // the columns off L mirror the rows
                     for &i in live {
-                        for j in 0..n {
-                            if live.binary_search(&j).is_err() {
-                                p[j * n + i] = p[i * n + j];
-                            }
+                        for j in (0..n).filter(|&j| off_live[j]) {
+                            p[j * n + i] = p[i * n + j];
                         }
                     }
                     for (kg, &s) in ratios.iter().enumerate() {
@@ -396,12 +410,6 @@ impl Tape {
 
     /// Bytes the tape holds (the events' matrices and rows).
     pub fn bytes(&self) -> usize {
-        self.events
-            .iter()
-            .map(|e| match e {
-                Event::Propagate { psi, g } => 8 * (psi.len() + g.len()),
-                Event::Measure { h, .. } => 16 * h.len() + 64,
-            })
-            .sum()
+        self.events.iter().map(Event::bytes).sum()
     }
 }

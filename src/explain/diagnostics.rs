@@ -198,7 +198,12 @@ pub(super) fn segments(level: &[(f64, f64)], t_start: f64, t_end: f64) -> Vec<(f
 
 /// Total log-likelihood of a run's innovations, Σ −½(ν²/S + ln 2πS).
 pub fn innovation_loglik(run: &FilterRun) -> f64 {
-    run.innovations.iter().map(loglik_of).sum()
+    loglik_sum(&run.innovations)
+}
+
+/// Total log-likelihood of scalar innovations, Σ −½(ν²/S + ln 2πS).
+pub(super) fn loglik_sum(innovations: &[crate::estimate::filter::Innovation]) -> f64 {
+    innovations.iter().map(loglik_of).sum()
 }
 
 /// One scalar innovation's log-likelihood −½(ν²/S + ln 2πS).

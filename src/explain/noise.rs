@@ -70,7 +70,7 @@ impl<'a, 'd> Passes<'a, 'd> {
         let pass = run_pass_watched(model, &[], data, cfg, progress, &mut rec)?;
         let tape = rec.finish().filter(|t| {
             t.innovations(cfg).is_some_and(|inn| {
-                let l: f64 = inn.iter().map(super::diagnostics::loglik_of).sum();
+                let l = super::diagnostics::loglik_sum(&inn);
                 let l0 = pass.stats.loglik;
                 inn.len() == pass.run.innovations.len()
                     && (l - l0).abs() <= 1e-6 * l0.abs().max(1.0)
@@ -91,11 +91,7 @@ impl<'a, 'd> Passes<'a, 'd> {
 
     /// The innovation log-likelihood of the pass with configuration `cfg`.
     fn loglik(&self, cfg: &FilterConfig) -> anyhow::Result<f64> {
-        Ok(self
-            .innovations(cfg)?
-            .iter()
-            .map(super::diagnostics::loglik_of)
-            .sum())
+        Ok(super::diagnostics::loglik_sum(&self.innovations(cfg)?))
     }
 }
 
