@@ -214,6 +214,12 @@ fn covariance_kernels_match_dense_reference() {
             let mut p_gen: Vec<f64> = p0.transpose().as_slice().to_vec();
             (k.propagate_cov)(&a, dt, &q, &mut p_gen);
             check(&p_gen, "generated");
+            // the run-time path does the generated kernel's arithmetic: the same bits
+            let bits = |p: &[f64]| p.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert!(
+                bits(&p_rt) == bits(&p_gen),
+                "{name}: run-time P differs in bits"
+            );
         }
     }
 }

@@ -4,6 +4,7 @@
 
 use sinsmodel::estimate::filter::Observer;
 use sinsmodel::io::atomic_file::AtomicFile;
+use sinsmodel::io::fixed::write_sci;
 use sinsmodel::io::truth::{write_row, TruthRow};
 use sinsmodel::model::Model;
 use sinsmodel::nav::earth;
@@ -77,7 +78,8 @@ impl RowWriter {
                         write_row(&mut line, &r.row).map_err(|e| e.to_string())?;
                         line.pop(); // its newline
                         for v in &r.sig[..r.n_sig as usize] {
-                            write!(line, " {v:.4e}").map_err(|e| e.to_string())?;
+                            line.push(b' ');
+                            write_sci(&mut line, *v, 4).map_err(|e| e.to_string())?;
                         }
                         line.push(b'\n');
                         w.write_all(&line).map_err(|e| e.to_string())?;

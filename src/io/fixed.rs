@@ -1,6 +1,7 @@
-//! Fast fixed-point decimal formatting for large text outputs (a navigation row per IMU epoch):
-//! `value` rounded to `decimals` places through integer arithmetic, identical to `{:.d$}` for
-//! |value| · 10^d < 2^53.
+//! Fast decimal formatting for large text outputs (a navigation row per IMU epoch), byte for
+//! byte what `std`'s `{:.d$}` and `{:.d$e}` write: `value` scaled by an exact power of ten and
+//! rounded through integer arithmetic; a value whose digits that cannot settle for certain (out
+//! of range, not finite, within rounding error of a tie) is handed to `std` itself.
 
 use std::io::{self, Write};
 
@@ -48,6 +49,107 @@ pub fn write_fixed<W: Write>(w: &mut W, value: f64, decimals: usize) -> io::Resu
     w.write_all(&buf[k..])
 }
 
+/// Exact powers of ten 10⁰ … 10²² (every one is a double).
+const EXACT_POW10: [f64; 23] = [
+    1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// |value| · 10^k with one rounding (k within ±22), None beyond.
+fn scaled_by_pow10(a: f64, k: i32) -> Option<f64> {
+    let p = *EXACT_POW10.get(k.unsigned_abs() as usize)?;
+    Some(if k >= 0 { a * p } else { a / p })
+}
+
+/// Writes `value` in scientific notation with `decimals` (≤ 12) digits after the point, the
+/// bytes of `{:.decimals$e}` (`-1.2346e-5`, `0.0000e0`); digits that cannot be settled exactly
+/// here are left to `std`.
+pub fn write_sci<W: Write>(w: &mut W, value: f64, decimals: usize) -> io::Result<()> {
+    match sci_digits(value, decimals) {
+        Some((digits, exp)) => {
+            let mut buf = [0u8; 48];
+            let mut k = 0;
+            if value.is_sign_negative() {
+                buf[k] = b'-';
+                k += 1;
+            }
+            let mut d = [0u8; 13];
+            let mut rest = digits;
+            for slot in d[..=decimals].iter_mut().rev() {
+                *slot = b'0' + (rest % 10) as u8;
+                rest /= 10;
+            }
+            buf[k] = d[0];
+            k += 1;
+            if decimals > 0 {
+                buf[k] = b'.';
+                buf[k + 1..k + 1 + decimals].copy_from_slice(&d[1..=decimals]);
+                k += 1 + decimals;
+            }
+            buf[k] = b'e';
+            k += 1;
+            if exp < 0 {
+                buf[k] = b'-';
+                k += 1;
+            }
+            let mut e = [0u8; 4];
+            let mut ne = 0;
+            let mut x = exp.unsigned_abs();
+            loop {
+                e[ne] = b'0' + (x % 10) as u8;
+                ne += 1;
+                x /= 10;
+                if x == 0 {
+                    break;
+                }
+            }
+            for c in e[..ne].iter().rev() {
+                buf[k] = *c;
+                k += 1;
+            }
+            w.write_all(&buf[..k])
+        }
+        None => write!(w, "{value:.decimals$e}"),
+    }
+}
+
+/// The `decimals + 1` significant digits of |value| as an integer and its decimal exponent, when
+/// they are certain: finite non-zero value, exponent within reach of exact powers of ten, and
+/// the scaled value farther from a rounding tie than 10⁻¹⁵ of its size (its one rounding is
+/// within 1.2·10⁻¹⁶ of it).
+fn sci_digits(value: f64, decimals: usize) -> Option<(u64, i32)> {
+    if decimals > 12 || !value.is_finite() || value == 0.0 {
+        return None;
+    }
+    let a = value.abs();
+    let (lo, hi) = (EXACT_POW10[decimals], EXACT_POW10[decimals + 1]);
+    // decimal exponent from the binary one (within one), then settled by the scaled value
+    let e2 = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    let mut exp = (f64::from(e2) * std::f64::consts::LOG10_2).floor() as i32;
+    let mut scaled = scaled_by_pow10(a, decimals as i32 - exp)?;
+    for _ in 0..2 {
+        if scaled < lo - 1.0 {
+            exp -= 1;
+        } else if scaled >= hi + 1.0 {
+            exp += 1;
+        } else {
+            break;
+        }
+        scaled = scaled_by_pow10(a, decimals as i32 - exp)?;
+    }
+    // [lo − 1, lo) and [hi − 1, hi + 1): which exponent is right is not certain here
+    if scaled < lo || scaled >= hi - 1.0 {
+        return None;
+    }
+    // integer part and fraction exactly (scaled < 10¹³ < 2⁵³), rounded to nearest
+    let int = scaled as u64;
+    let frac = scaled - int as f64;
+    if (frac - 0.5).abs() < hi * 1e-15 {
+        return None;
+    }
+    Some((int + u64::from(frac > 0.5), exp))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -63,6 +165,53 @@ mod tests {
                 let b = format!("{v:.d$}");
                 assert_eq!(String::from_utf8(a).unwrap(), b, "{v} {d}");
             }
+        }
+    }
+
+    #[test]
+    fn scientific_matches_std_formatting() {
+        let mut rng = crate::sim::rng::Rng::new(5);
+        let check = |v: f64| {
+            for d in [0, 1, 3, 4, 6, 9, 12] {
+                let mut a = Vec::new();
+                write_sci(&mut a, v, d).unwrap();
+                let b = format!("{v:.d$e}");
+                assert_eq!(String::from_utf8(a).unwrap(), b, "{v:e} {d}");
+            }
+        };
+        for _ in 0..200_000 {
+            let u = rng.uniform();
+            let v = (rng.uniform() - 0.5) * 10f64.powf(u * 60.0 - 30.0);
+            check(v);
+            // next to the powers of ten and to ties at four decimals
+            let k = (u * 40.0 - 20.0).round() as i32;
+            let p = 10f64.powi(k);
+            check(p);
+            check(f64::from_bits(p.to_bits() + 1));
+            check(f64::from_bits(p.to_bits() - 1));
+            check(9.99995 * p);
+            check(1.00005 * p);
+            check((rng.uniform() * 1e5).round() / 1e5 * p);
+        }
+        // the fast path, not std, writes nearly every value in the navigation rows' range
+        let mut rng = crate::sim::rng::Rng::new(6);
+        let fast = (0..100_000)
+            .filter(|_| sci_digits(10f64.powf(rng.uniform() * 24.0 - 12.0), 4).is_some())
+            .count();
+        assert!(fast > 99_900, "{fast} of 100000 on the fast path");
+        for v in [
+            0.0,
+            -0.0,
+            f64::NAN,
+            f64::INFINITY,
+            -f64::INFINITY,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::MAX,
+            1.0,
+            -1.0,
+        ] {
+            check(v);
         }
     }
 }
