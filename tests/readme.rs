@@ -34,7 +34,7 @@ const QUICK: &[(&str, &str, &str)] = &[
     ),
     (
         "sinsmodel bench",
-        "sinsmodel bench --seconds 20 --explain-seconds 20 --memory-seconds 20",
+        "sinsmodel bench --seconds 20 --explain-seconds 20 --memory-seconds 20 --kf-gins-seconds 20",
         "the benchmark runs minutes of data per job by design",
     ),
     (

@@ -25,7 +25,15 @@ pub struct BenchArgs {
     /// 2.3 GB file, in at most 64 MiB); 0 skips it.
     #[arg(long, default_value_t = 600.0)]
     memory_seconds: f64,
+    /// Seconds of 200 Hz static IMU text for the KF-GINS job (issue 27's: the 21-state composed
+    /// model and P31+vertical, closed loop, covariance every sample, nav.txt at every sample, as
+    /// child processes; then each stage's cost per sample against its floor); 0 skips it.
+    #[arg(long, default_value_t = 3600.0)]
+    kf_gins_seconds: f64,
 }
+
+/// The KF-GINS job's 21-state model: P13+vertical with the gyro and accelerometer scale factors.
+pub const KF_GINS_MODEL: &str = "P13+vertical+kg_11+kg_22+kg_33+ka_11+ka_22+ka_33";
 
 /// Job 3 (library: `experiment::bench::explain_job`), printed.
 fn explain_job(seconds: f64) -> Result<()> {
@@ -71,6 +79,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.memory_seconds > 0.0 {
         memory_job(args.memory_seconds)?;
     }
+    if args.kf_gins_seconds > 0.0 {
+        kf_gins_files_job(args.kf_gins_seconds)?;
+    }
     Ok(())
 }
 
@@ -91,6 +102,14 @@ fn check_args(args: &BenchArgs) -> Result<()> {
         anyhow::bail!(
             "--memory-seconds {}: expected 0 (skip) or 10 to 86400 s",
             args.memory_seconds
+        );
+    }
+    if !(args.kf_gins_seconds.is_finite()
+        && (args.kf_gins_seconds == 0.0 || (10.0..=86_400.0).contains(&args.kf_gins_seconds)))
+    {
+        anyhow::bail!(
+            "--kf-gins-seconds {}: expected 0 (skip) or 10 to 86400 s",
+            args.kf_gins_seconds
         );
     }
     if args.explain_seconds > 0.0 && args.explain_seconds < 10.0 {
@@ -298,4 +317,78 @@ fn stream_against_whole(dir: &Path, data: &Path) -> Result<[(f64, f64); 4]> {
         }
     }
     Ok(best)
+}
+
+/// Job 5: issue 27's KF-GINS job on files, `seconds` [s] of 200 Hz static IMU text and 1 Hz
+/// GNSS: `filter` with the 21-state composed model and with P31+vertical as child processes
+/// (alternating, three each: fastest, slowest, peak memory), then each stage per sample
+/// against its floor (`experiment::bench_stages`); printed.
+fn kf_gins_files_job(seconds: f64) -> Result<()> {
+    use sinsmodel::experiment::bench_stages;
+    let dir = bench::scratch_dir()?.join("kf-gins");
+    std::fs::create_dir_all(&dir)?;
+    let text = bench_stages::kf_gins_scenario(seconds);
+    let sc = dir.join("scenario.toml");
+    std::fs::write(&sc, &text)?;
+    let data = dir.join("data");
+    let words = |w: &str| w.split(' ').map(OsString::from).collect::<Vec<_>>();
+    let mut sim_args = words("simulate");
+    sim_args.extend([
+        sc.clone().into(),
+        "--out".into(),
+        data.clone().into(),
+        "--force".into(),
+    ]);
+    run_child(&sim_args)?;
+    let job = |model: &str| -> Result<(f64, f64)> {
+        let mut a = words("filter --model");
+        a.push(model.into());
+        a.extend([
+            "--imu".into(),
+            data.join("imu.txt").into(),
+            "--aid".into(),
+            data.join("gnss.txt").into(),
+        ]);
+        a.extend(words(
+            "--init 28.22,112.99,0,0,0,0 --step 0.005 --mode closed --out",
+        ));
+        a.push(dir.join("out").into());
+        run_child(&a)
+    };
+    let (mut t21, mut t33) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        t21.push(job(KF_GINS_MODEL)?);
+        t33.push(job("P31+vertical")?);
+    }
+    let samples = (seconds * 200.0).round();
+    println!("job 5 (KF-GINS job on files): {seconds:.0} s of 200 Hz static IMU text, 1 Hz GNSS, closed loop, covariance and a nav.txt row every sample");
+    for (name, t) in [(KF_GINS_MODEL, &t21), ("P31+vertical (compiled)", &t33)] {
+        let lo = t.iter().map(|r| r.0).fold(f64::INFINITY, f64::min);
+        let hi = t.iter().map(|r| r.0).fold(0.0, f64::max);
+        let mem = t.iter().map(|r| r.1).fold(0.0, f64::max);
+        println!(
+            "  filter --model {name}: {lo:.2}-{hi:.2} s (3 runs), {:.2} us per sample, peak {mem:.1} MiB",
+            lo * 1e6 / samples
+        );
+    }
+    let sim = sinsmodel::sim::simulator::simulate(
+        &sinsmodel::sim::scenario::Scenario::parse(&text, "bench kf-gins")?,
+        |_| {},
+    );
+    let model = Model::parse(KF_GINS_MODEL)?;
+    let mut cfg = reproduce::config(&model, &Priors::default())?;
+    cfg.step_s = 1.0 / 200.0;
+    cfg.mode = sinsmodel::estimate::filter::Mode::ClosedLoop;
+    let aid = reproduce::aiding_from_truth(&sim, &Priors::default(), false, 1)?;
+    let st = bench_stages::stages(&model, &cfg, &sim, &aid, &data.join("imu.txt"))?;
+    println!("  stages of {KF_GINS_MODEL}, each alone in this process (us per sample, fastest of 3; floor where one is stated):");
+    for s in &st.stages {
+        println!("    {}", bench_stages::report_line(s));
+    }
+    println!(
+        "    whole filter in process    {:.3} us (data in memory, no output)",
+        st.filter_us
+    );
+    std::fs::remove_dir_all(&dir)?;
+    Ok(())
 }

@@ -4,6 +4,7 @@
 //! estimators; the estimators never use them.
 
 pub mod bench;
+pub mod bench_stages;
 pub mod eval_check;
 pub mod eval_report;
 pub mod explain_data;

@@ -111,6 +111,15 @@ impl SparsePropagator {
         self.b_cols.iter().map(Vec::len).sum()
     }
 
+    /// Multiply-adds of one [`Self::propagate`] (B's second-order products, M = B P, the four
+    /// columns of B P Bᵀ at a time; the adds of P + M + Mᵀ not counted).
+    pub fn mul_adds(&self) -> usize {
+        let n = self.n;
+        let products: usize = self.fill.iter().map(|g| g.pairs.len()).sum();
+        let nd4 = self.dyn_rows.len().div_ceil(4) * 4;
+        products + self.b_nnz() * n + self.dyn_rows.len() * nd4 * n
+    }
+
     /// P ← Φ P Φᵀ + diag(q)·dt; `a`, `p` n×n row-major, `q` [SI²/s], `dt` [s].
     pub fn propagate(&mut self, a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
         self.propagate_with_state(a, dt, q, p, None)
@@ -521,6 +530,14 @@ mod tests {
             let err = (DMatrix::from_row_slice(n, n, &p_w) - &dense).amax() / dense.amax();
             assert!(err < 1e-13, "n = {n}: relative error {err:e}");
         }
+    }
+
+    #[test]
+    fn multiply_adds_are_counted_from_the_pattern() {
+        // x0' = x1, x1' = x2: B = [[0, dt, dt²/2, 0], [0, 0, dt, 0]] on rows 0 and 1 of 4
+        let sp = SparsePropagator::new(4, &[(0, 1), (1, 2)]);
+        // one product A[0][1]·A[1][2]; M = B P: 3 non-zeros × 4; B P Bᵀ: 2 rows × 4 columns × 4
+        assert_eq!(sp.mul_adds(), 1 + 3 * 4 + 2 * 4 * 4);
     }
 
     #[test]
