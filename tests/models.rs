@@ -257,3 +257,26 @@ fn accumulator_uses_mean_of_squares() {
     );
     assert!(r[kx].abs() < 1e-9 * amp, "<f_x> = {}", r[kx]);
 }
+
+/// The all-at-once regressor evaluation (run-time accumulators of many regressors) gives each
+/// regressor's own value to the bit.
+#[test]
+fn every_regressor_at_once_equals_each_alone() {
+    use sinsmodel::model::generated::common;
+    let mut rng = Rng(91);
+    for _ in 0..200 {
+        let (_, f, w) = random_point(&mut rng);
+        let mut s = ImuSignals::new(f, w);
+        s.dw = w * rng.uniform(-3.0, 3.0);
+        s.df = f * rng.uniform(-3.0, 3.0);
+        let mut all = [0.0; common::REGRESSOR_COUNT];
+        common::regressor_values(&s, &mut all);
+        for (id, v) in all.iter().enumerate() {
+            assert_eq!(
+                v.to_bits(),
+                common::regressor_value(id, &s).to_bits(),
+                "{id}"
+            );
+        }
+    }
+}

@@ -1773,6 +1773,43 @@ pub fn regressor_value(id: usize, s: &ImuSignals) -> f64 {
     }
 }
 
+/// Every regressor's value at one IMU sample, in `REGRESSORS` order (the expressions of
+/// [`regressor_value`], for an accumulator that reads many of them).
+pub fn regressor_values(s: &ImuSignals, out: &mut [f64; REGRESSOR_COUNT]) {
+    let ImuSignals { f, w, dw, df, .. } = s;
+    out[0] = 1.0;
+    out[1] = w.x;
+    out[2] = w.y;
+    out[3] = w.z;
+    out[4] = f.x;
+    out[5] = f.y;
+    out[6] = f.z;
+    out[7] = f.x.powi(2);
+    out[8] = f.y.powi(2);
+    out[9] = f.z.powi(2);
+    out[10] = f.x * f.y;
+    out[11] = f.x * f.z;
+    out[12] = f.y * f.z;
+    out[13] = f.x.abs();
+    out[14] = f.y.abs();
+    out[15] = f.z.abs();
+    out[16] = f.x * f.x.abs();
+    out[17] = f.y * f.y.abs();
+    out[18] = f.z * f.z.abs();
+    out[19] = -(w.y.powi(2) + w.z.powi(2));
+    out[20] = -(w.x.powi(2) + w.z.powi(2));
+    out[21] = -(w.x.powi(2) + w.y.powi(2));
+    out[22] = w.x * w.y - dw.z;
+    out[23] = w.x * w.z + dw.y;
+    out[24] = w.x * w.y + dw.z;
+    out[25] = w.y * w.z - dw.x;
+    out[26] = w.x * w.z - dw.y;
+    out[27] = w.y * w.z + dw.x;
+    out[28] = -df.x;
+    out[29] = -df.y;
+    out[30] = -df.z;
+}
+
 /// Writes the structural non-zeros of the full (vertical) navigation block of A(t).
 pub fn fill_nav_block(nav: &NavPoint, a: &mut [[f64; NAV_COUNT]; NAV_COUNT]) {
     let lat = nav.lat;

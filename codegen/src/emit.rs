@@ -381,6 +381,10 @@ fn regressor_value_fn(spec: &Spec) -> TokenStream {
     });
     let all_regs: Vec<usize> = (0..spec.regressors.len()).collect();
     let (s_param, s_bind) = signals_binding(spec, &all_regs);
+    let all_values = spec.regressors.iter().enumerate().map(|(i, r)| {
+        let ast = &r.expr.ast;
+        quote!(out[#i] = #ast;)
+    });
     quote! {
         /// Value of regressor `id` at one IMU sample (its signals, FRD body frame).
         pub fn regressor_value(id: usize, #s_param: &ImuSignals) -> f64 {
@@ -389,6 +393,13 @@ fn regressor_value_fn(spec: &Spec) -> TokenStream {
                 #(#reg_arms)*
                 _ => panic!("regressor index {id} out of range"),
             }
+        }
+
+        /// Every regressor's value at one IMU sample, in `REGRESSORS` order (the expressions of
+        /// [`regressor_value`], for an accumulator that reads many of them).
+        pub fn regressor_values(#s_param: &ImuSignals, out: &mut [f64; REGRESSOR_COUNT]) {
+            #s_bind
+            #(#all_values)*
         }
     }
 }

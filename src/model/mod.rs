@@ -472,6 +472,9 @@ impl SignalRates {
     }
 }
 
+/// Above this many regressors a run-time accumulator evaluates all of them at once per sample.
+const MANY_REGRESSORS: usize = 6;
+
 impl RegressorAccumulator {
     /// An accumulator of the given regressors (indices into `common::REGRESSORS`).
     pub fn new(ids: Vec<usize>) -> RegressorAccumulator {
@@ -487,6 +490,14 @@ impl RegressorAccumulator {
     pub fn add(&mut self, sig: &ImuSignals) {
         match self.generated {
             Some(acc) => acc(&mut self.sum, sig),
+            // many regressors: each value once, in straight-line code
+            None if self.ids.len() > MANY_REGRESSORS => {
+                let mut v = [0.0; common::REGRESSOR_COUNT];
+                common::regressor_values(sig, &mut v);
+                for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
+                    *s += v[id];
+                }
+            }
             None => {
                 for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
                     *s += common::regressor_value(id, sig);
