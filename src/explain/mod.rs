@@ -29,6 +29,7 @@
 mod diagnostics;
 mod findings;
 mod noise;
+mod raw_noise;
 mod selection;
 mod signatures;
 mod words;

@@ -416,6 +416,7 @@ pub(super) fn stage(
     // a noise level is a constant of the sensor or the receiver: fitted on parts of the data
     // apart (while the body rotates or turns and otherwise; each half), it gives one scale
     let groups = innovation_groups(ctx.data, &pass)?;
+    let raw = super::raw_noise::read(ctx.data)?;
     let mut findings = Vec::new();
     for f in fits.iter().filter(|f| f.significant) {
         let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
@@ -455,6 +456,12 @@ pub(super) fn stage(
         }
         if let Some(why) = implausible_scale(f) {
             nf.words.push_str(&format!(". {why}"));
+            nf.stand_in.get_or_insert(why);
+        }
+        if let Some(why) = raw.and_then(|raw| not_in_the_raw_data(f, &stated, &raw)) {
+            nf.words.push_str(&format!(
+                ". It is not a finding about the sensor's noise: {why}; it stands in for something the model lacks: an effect that acts with the motion (vibration, a sensor term outside the candidates, a g-sensitivity, a scale error) or a correlated noise such as a bias instability"
+            ));
             nf.stand_in.get_or_insert(why);
         }
         findings.push(nf);
@@ -743,6 +750,30 @@ fn split_scales(
         out.push(c);
     }
     Ok(out)
+}
+
+/// Why a white-noise level `f` fitted above the stated `stated` is more than the raw increments
+/// `raw` show (see [`super::raw_noise`]); None for other levels and for a fit the raw data allow.
+fn not_in_the_raw_data(
+    f: &LevelFit,
+    stated: &Stated,
+    raw: &super::raw_noise::RawNoise,
+) -> Option<String> {
+    let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0;
+    let (what, stated_si, raw_si, to_unit, unit) = match f.level {
+        Level::GyroArw => ("gyro", stated.white.0, raw.gyro, deg_rt_h, "deg/sqrt(h)"),
+        Level::AccelVrw => (
+            "accelerometer",
+            stated.white.1,
+            raw.accel,
+            1e6 / G0,
+            "ug/sqrt(Hz)",
+        ),
+        _ => return None,
+    };
+    super::raw_noise::contradiction(
+        what, f.interval, stated_si, raw_si, to_unit, unit, raw.blocks,
+    )
 }
 
 /// The noise levels the filter was given (SI).
