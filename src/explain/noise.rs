@@ -458,11 +458,15 @@ pub(super) fn stage(
             nf.words.push_str(&format!(". {why}"));
             nf.stand_in.get_or_insert(why);
         }
-        if let Some(why) = raw.and_then(|raw| not_in_the_raw_data(f, &stated, &raw)) {
-            nf.words.push_str(&format!(
-                ". It is not a finding about the sensor's noise: {why}; it stands in for something the model lacks: an effect that acts with the motion (vibration, a sensor term outside the candidates, a g-sensitivity, a scale error) or a correlated noise such as a bias instability"
-            ));
-            nf.stand_in.get_or_insert(why);
+        match raw_reading(f, &stated, raw.as_ref()) {
+            Some(Err(why)) => {
+                nf.words.push_str(&format!(
+                    ". It is not a finding about the sensor's noise: {why}; it stands in for something the model lacks: an effect that acts with the motion (vibration, a sensor term outside the candidates, a g-sensitivity, a scale error) or a correlated noise such as a bias instability"
+                ));
+                nf.stand_in.get_or_insert(why);
+            }
+            Some(Ok(reading)) => nf.words.push_str(&format!("; {reading}")),
+            None => {}
         }
         findings.push(nf);
     }
@@ -752,26 +756,25 @@ fn split_scales(
     Ok(out)
 }
 
-/// Why a white-noise level `f` fitted above the stated `stated` is more than the raw increments
-/// `raw` show (see [`super::raw_noise`]); None for other levels and for a fit the raw data allow.
-fn not_in_the_raw_data(
+/// The raw increments' reading `raw` of white-noise level `f` (see [`super::raw_noise`]):
+/// Err(why) when the fit is more than they show, Ok(words) when they allow it; None for the
+/// other levels.
+fn raw_reading(
     f: &LevelFit,
     stated: &Stated,
-    raw: &super::raw_noise::RawNoise,
-) -> Option<String> {
+    raw: Option<&super::raw_noise::RawNoise>,
+) -> Option<Result<String, String>> {
     let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0;
-    let (what, stated_si, raw_si, to_unit, unit) = match f.level {
-        Level::GyroArw => ("gyro", stated.white.0, raw.gyro, deg_rt_h, "deg/sqrt(h)"),
-        Level::AccelVrw => (
-            "accelerometer",
-            stated.white.1,
-            raw.accel,
-            1e6 / G0,
-            "ug/sqrt(Hz)",
-        ),
+    let (what, stated_si, to_unit, unit) = match f.level {
+        Level::GyroArw => ("gyro", stated.white.0, deg_rt_h, "deg/sqrt(h)"),
+        Level::AccelVrw => ("accelerometer", stated.white.1, 1e6 / G0, "ug/sqrt(Hz)"),
         _ => return None,
     };
-    super::raw_noise::contradiction(
+    let Some(raw) = raw else {
+        return Some(Ok(super::raw_noise::no_reading(what)));
+    };
+    let raw_si = if what == "gyro" { raw.gyro } else { raw.accel };
+    super::raw_noise::judge(
         what, f.interval, stated_si, raw_si, to_unit, unit, raw.blocks,
     )
 }
