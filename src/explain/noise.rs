@@ -415,8 +415,9 @@ pub(super) fn stage(
     };
     // a noise level is a constant of the sensor or the receiver: fitted on parts of the data
     // apart (while the body rotates or turns and otherwise; each half), it gives one scale
-    let groups = innovation_groups(ctx.data, &pass)?;
-    let raw = super::raw_noise::read(ctx.data)?;
+    let mut raw = super::raw_noise::Reading::default();
+    let groups = innovation_groups(ctx.data, &pass, &mut raw)?;
+    let raw = raw.finish();
     let mut findings = Vec::new();
     for f in fits.iter().filter(|f| f.significant) {
         let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
@@ -566,8 +567,13 @@ fn implausible_scale(f: &LevelFit) -> Option<String> {
 /// Each innovation's group in the three splits of the noise levels: (0 at rest or moving
 /// straight, 1 while the body rotates or turns, to 2 s after), (0 first half, 1 second half of
 /// the updates) and (0 quiet, 1 while the body vibrates, to 2 s after; all 0 when the vibration
-/// level does not change across the data, see [`vibrating_spans`]).
-fn innovation_groups(data: &ExplainData, pass: &Pass) -> anyhow::Result<Vec<[usize; 3]>> {
+/// level does not change across the data, see [`vibrating_spans`]). Every sample also goes to
+/// the raw white-noise `raw` reading (the same pass serves both).
+fn innovation_groups(
+    data: &ExplainData,
+    pass: &Pass,
+    raw: &mut super::raw_noise::Reading,
+) -> anyhow::Result<Vec<[usize; 3]>> {
     // rotating spans from the rate averaged over 0.1 s; vibration from the scatter of the
     // specific force about its mean over the same 0.1 s
     let mut spans: Vec<(f64, f64)> = Vec::new();
@@ -577,6 +583,7 @@ fn innovation_groups(data: &ExplainData, pass: &Pass) -> anyhow::Result<Vec<[usi
     let (mut f_sum, mut f_sq, mut count) = (nalgebra::Vector3::zeros(), 0.0, 0usize);
     let mut on = false;
     while let Some(smp) = samples.next_sample()? {
+        raw.push(&smp);
         if t0.is_nan() {
             t0 = smp.t;
             t_prev = smp.t;
@@ -764,10 +771,9 @@ fn raw_reading(
     stated: &Stated,
     raw: Option<&super::raw_noise::RawNoise>,
 ) -> Option<Result<String, String>> {
-    let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0;
     let (what, stated_si, to_unit, unit) = match f.level {
-        Level::GyroArw => ("gyro", stated.white.0, deg_rt_h, "deg/sqrt(h)"),
-        Level::AccelVrw => ("accelerometer", stated.white.1, 1e6 / G0, "ug/sqrt(Hz)"),
+        Level::GyroArw => ("gyro", stated.white.0, DEG_RT_H, "deg/sqrt(h)"),
+        Level::AccelVrw => ("accelerometer", stated.white.1, UG_RT_HZ, "ug/sqrt(Hz)"),
         _ => return None,
     };
     let Some(raw) = raw else {
@@ -778,6 +784,11 @@ fn raw_reading(
         what, f.interval, stated_si, raw_si, to_unit, unit, raw.blocks,
     )
 }
+
+/// rad/√s → deg/√h (white gyro noise).
+const DEG_RT_H: f64 = 180.0 / std::f64::consts::PI * 60.0;
+/// m/s/√s → µg/√Hz (white accelerometer noise).
+const UG_RT_HZ: f64 = 1e6 / G0;
 
 /// The noise levels the filter was given (SI).
 struct Stated {
@@ -795,8 +806,6 @@ fn noise_finding(
     misfit_share: Option<f64>,
     two_delta_loglik: f64,
 ) -> Finding {
-    let deg_rt_h = 180.0 / std::f64::consts::PI * 60.0; // rad/√s → deg/√h
-    let ug_rt_hz = 1e6 / G0; // m/s/√s → µg/√Hz
     let (arw, vrw) = stated.white;
     let (grw, arw_bias) = stated.bias_rw;
     let (stated, unit, what) = match f.level {
@@ -813,12 +822,12 @@ fn noise_finding(
             "an accelerometer bias random walk (bias instability)".to_string(),
         ),
         Level::GyroArw => (
-            arw * deg_rt_h,
+            arw * DEG_RT_H,
             "deg/sqrt(h)",
             "a gyro white noise (angle random walk)".to_string(),
         ),
         Level::AccelVrw => (
-            vrw * ug_rt_hz,
+            vrw * UG_RT_HZ,
             "ug/sqrt(Hz)",
             "an accelerometer white noise (velocity random walk)".to_string(),
         ),

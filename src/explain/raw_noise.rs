@@ -10,7 +10,6 @@
 //! independent: under white noise alone it is AVAR·χ²₁₅/15 exactly, and the quietest fifth of
 //! the blocks is read against that spread.
 
-use super::ExplainData;
 use crate::estimate::stats;
 
 /// Length of one Allan cluster [s].
@@ -47,35 +46,45 @@ struct Block {
     tau: f64,
 }
 
-/// Reads [`RawNoise`] from `data`'s IMU increments; None when the data hold fewer than
-/// [`MIN_BLOCKS`] blocks of at least two samples per cluster (a sample interval longer than
-/// [`LONGEST_INTERVAL_S`] ends a block).
-pub(super) fn read(data: &ExplainData) -> anyhow::Result<Option<RawNoise>> {
-    let mut samples = data.imu.samples()?;
-    let (mut out, mut block) = ([Vec::new(), Vec::new()], Block::default());
-    let (mut sum, mut t_c, mut n_c) = ([nalgebra::Vector3::zeros(); 2], 0.0, 0usize);
-    let mut t_prev = f64::NAN;
-    while let Some(s) = samples.next_sample()? {
-        let dt = s.t - t_prev;
-        t_prev = s.t;
+/// The reading, sample by sample: fed every IMU sample of a pass the caller makes anyway
+/// ([`Reading::push`]), then [`Reading::finish`]ed.
+#[derive(Default)]
+pub(super) struct Reading {
+    /// Per sensor, each finished block's statistic and its τ [s].
+    out: [Vec<(f64, f64)>; 2],
+    block: Block,
+    /// The open cluster: summed increments, length [s], samples.
+    sum: [nalgebra::Vector3<f64>; 2],
+    t_c: f64,
+    n_c: usize,
+    t_prev: Option<f64>,
+}
+
+impl Reading {
+    /// Takes one sample (time [s], increments Δθ [rad] and Δv [m/s] over the interval before it).
+    pub(super) fn push(&mut self, s: &crate::io::imu::ImuSample) {
+        let dt = self.t_prev.map_or(f64::NAN, |t| s.t - t);
+        self.t_prev = Some(s.t);
         // (the first sample, a repeated time or NaN: no interval)
         if dt.is_nan() || dt <= 0.0 {
-            continue;
+            return;
         }
         // a gap breaks the block: no difference across it
         if dt > LONGEST_INTERVAL_S {
-            (block, sum, t_c, n_c) = (Block::default(), [nalgebra::Vector3::zeros(); 2], 0.0, 0);
-            continue;
+            self.block = Block::default();
+            self.close_cluster();
+            return;
         }
-        sum[0] += s.dtheta;
-        sum[1] += s.dv;
-        t_c += dt;
-        n_c += 1;
-        if t_c < CLUSTER_S - 0.5 * dt {
-            continue;
+        self.sum[0] += s.dtheta;
+        self.sum[1] += s.dv;
+        self.t_c += dt;
+        self.n_c += 1;
+        if self.t_c < CLUSTER_S - 0.5 * dt {
+            return;
         }
-        if n_c >= 2 {
-            let mean = [sum[0] / t_c, sum[1] / t_c];
+        if self.n_c >= 2 {
+            let mean = [self.sum[0] / self.t_c, self.sum[1] / self.t_c];
+            let block = &mut self.block;
             match block.open.take() {
                 Some(p) => {
                     for k in 0..2 {
@@ -85,37 +94,48 @@ pub(super) fn read(data: &ExplainData) -> anyhow::Result<Option<RawNoise>> {
                 None => block.open = Some(mean),
             }
             block.clusters += 1;
-            block.tau += t_c;
+            block.tau += self.t_c;
             if block.clusters == BLOCK_CLUSTERS {
                 let (d, tau) = (PAIRS as f64, block.tau / BLOCK_CLUSTERS as f64);
-                for (o, sum_sq) in out.iter_mut().zip(block.sums) {
+                for (o, sum_sq) in self.out.iter_mut().zip(block.sums) {
                     // ½ mean square difference, averaged over the three axes
                     o.push((sum_sq / (2.0 * 3.0 * d), tau));
                 }
-                block = Block::default();
+                *block = Block::default();
             }
         }
-        (sum, t_c, n_c) = ([nalgebra::Vector3::zeros(); 2], 0.0, 0);
+        self.close_cluster();
     }
-    let blocks = out[0].len();
-    if blocks < MIN_BLOCKS {
-        return Ok(None);
+
+    /// Starts the next cluster empty.
+    fn close_cluster(&mut self) {
+        (self.sum, self.t_c, self.n_c) = ([nalgebra::Vector3::zeros(); 2], 0.0, 0);
     }
-    // under white noise alone a block's statistic is AVAR · χ²_k / k, k = 3 axes × 5 pairs
-    let k = 3.0 * PAIRS as f64;
-    let q = stats::chi2_isf(1.0 - QUIET_FRACTION, k) / k;
-    let density = |v: &mut Vec<(f64, f64)>| {
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (avar, tau) = v[(v.len() as f64 * QUIET_FRACTION) as usize];
-        // white noise N: AVAR(τ) = N² / τ
-        (avar / q * tau).sqrt()
-    };
-    let [mut g, mut a] = out;
-    Ok(Some(RawNoise {
-        gyro: density(&mut g),
-        accel: density(&mut a),
-        blocks,
-    }))
+
+    /// [`RawNoise`] from the samples pushed; None when they held fewer than [`MIN_BLOCKS`]
+    /// blocks of at least two samples per cluster (a sample interval longer than
+    /// [`LONGEST_INTERVAL_S`] ends a block).
+    pub(super) fn finish(self) -> Option<RawNoise> {
+        let blocks = self.out[0].len();
+        if blocks < MIN_BLOCKS {
+            return None;
+        }
+        // under white noise alone a block's statistic is AVAR · χ²_k / k, k = 3 axes × 5 pairs
+        let k = 3.0 * PAIRS as f64;
+        let q = stats::chi2_isf(1.0 - QUIET_FRACTION, k) / k;
+        let density = |mut v: Vec<(f64, f64)>| {
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let (avar, tau) = v[(v.len() as f64 * QUIET_FRACTION) as usize];
+            // white noise N: AVAR(τ) = N² / τ
+            (avar / q * tau).sqrt()
+        };
+        let [g, a] = self.out;
+        Some(RawNoise {
+            gyro: density(g),
+            accel: density(a),
+            blocks,
+        })
+    }
 }
 
 /// How far a fitted white-noise scale's 95 % interval must lie above the raw reading's scale
@@ -165,7 +185,6 @@ pub(super) fn no_reading(what: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::estimate::filter::AidingEpoch;
     use crate::io::imu::{ImuData, ImuSample};
     use nalgebra::Vector3;
 
@@ -193,21 +212,9 @@ mod tests {
     }
 
     fn read_of(d: &ImuData) -> Option<RawNoise> {
-        let aid: [AidingEpoch; 0] = [];
-        let data = ExplainData {
-            imu: super::super::ImuInput::Memory(d),
-            aid: &aid,
-            truth: None,
-            start: crate::nav::strapdown::NavState {
-                t: 0.0,
-                lat: 0.5,
-                lon: 2.0,
-                h: 0.0,
-                v: Vector3::zeros(),
-                q: nalgebra::UnitQuaternion::identity(),
-            },
-        };
-        read(&data).unwrap()
+        let mut r = Reading::default();
+        d.samples.iter().for_each(|s| r.push(s));
+        r.finish()
     }
 
     #[test]

@@ -1,16 +1,13 @@
 //! Covariance propagation P ← Φ P Φᵀ + diag(q)·dt with Φ = I + A·dt + A²·dt²/2, for models
 //! composed at run time (the presets use their generated kernels), and a dense reference.
 //!
-//! The run-time kernel is written once, generic over the row length: a model of up to
-//! [`FIXED_WIDTH_MAX`] states runs a copy compiled for its own width (loops of known length,
+//! The run-time kernel is written once, generic over the row length: a model of up to 64
+//! states (the widths `by_width!` lists) runs a copy compiled for its own width (loops of known length,
 //! unrolled and vectorised like the generated kernels), a larger one the same code with the width
 //! read at run time. Every copy performs the same floating-point operations in the same order,
 //! so the results do not depend on which one ran.
 
 use nalgebra::DMatrix;
-
-/// Largest model [states] whose run-time covariance kernel is compiled for its own width.
-pub const FIXED_WIDTH_MAX: usize = 64;
 
 /// Sparse propagation with a run-time pattern (row-major (i, j) list of A's non-zeros).
 #[derive(Debug, Clone)]
@@ -24,7 +21,7 @@ pub struct SparsePropagator {
     b: Vec<f64>,
     /// Scratch: M = B P (nd × n).
     m: Vec<f64>,
-    /// Scratch: Bᵀ (n × nd rounded up to a multiple of 4; zero off B's pattern).
+    /// Scratch: Bᵀ (n × nd rounded up to a multiple of 4; zero off B's pattern), filled with B.
     bt: Vec<f64>,
     /// Scratch: B x (nd).
     dx: Vec<f64>,
@@ -197,7 +194,7 @@ impl SparsePropagator {
         x: Option<&mut [f64]>,
     ) {
         let n = self.width::<W>();
-        self.fill_b::<W>(a, dt);
+        self.fill_b(a, dt);
         // x = 0 (closed loop between updates) stays exactly +0 under Φ = I + B: skipped
         if let Some(x) = x.filter(|x| x.iter().any(|v| v.to_bits() != 0)) {
             let (b, dx) = (&self.b, &mut self.dx);
@@ -215,9 +212,10 @@ impl SparsePropagator {
         }
     }
 
-    /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows, into the scratch `b`.
+    /// B = Φ − I = A·dt + A²·dt²/2 on the dynamic rows, into the scratch `b`, and its
+    /// transpose into `bt` (once per step, however many matrices the step then propagates).
     #[inline(always)]
-    fn fill_b<const W: usize>(&mut self, a: &[f64], dt: f64) {
+    fn fill_b(&mut self, a: &[f64], dt: f64) {
         let half_dt2 = 0.5 * dt * dt;
         let b = &mut self.b;
         for g in &self.fill {
@@ -230,6 +228,12 @@ impl SparsePropagator {
                 5 => g.fill(5, a, dt, half_dt2, b),
                 6 => g.fill(6, a, dt, half_dt2, b),
                 l => g.fill(l, a, dt, half_dt2, b),
+            }
+        }
+        let (n, ndp) = (self.n, self.bt.len() / self.n.max(1));
+        for (r, cols) in self.b_cols.iter().enumerate() {
+            for &j in cols {
+                self.bt[j * ndp + r] = self.b[r * n + j];
             }
         }
     }
@@ -278,12 +282,6 @@ impl SparsePropagator {
         self.b_times::<W>(p);
         let nd = self.dyn_rows.len();
         let ndp = self.bt.len() / n;
-        let bt = &mut self.bt;
-        for (r, cols) in self.b_cols.iter().enumerate() {
-            for &j in cols {
-                bt[j * ndp + r] = self.b[r * n + j];
-            }
-        }
         let (bt, m) = (&self.bt, &self.m);
         let n4 = n - n % 4;
         for (r, &i) in self.dyn_rows.iter().enumerate() {
@@ -387,7 +385,7 @@ impl SparsePropagator {
         psi: &mut [f64],
     ) {
         let n = self.width::<W>();
-        self.fill_b::<W>(a, dt);
+        self.fill_b(a, dt);
         for (gk, qk) in g.iter_mut().zip(q) {
             self.sandwich::<W>(gk);
             for i in 0..n {
