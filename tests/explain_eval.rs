@@ -666,3 +666,136 @@ fn probe_power() {
         );
     }
 }
+
+/// An aiding σ that other fixes' misfit takes up is no finding about those fixes: all-600's
+/// case 73 (seed 11) states the gyro's white noise too small and nothing else; explain names the
+/// gyro level and also fitted the velocity fixes' σ above the σ they state (true: as stated),
+/// named until a fix's level had to be borne out by its own innovations.
+#[test]
+fn an_aiding_sigma_its_own_fixes_do_not_bear_out_is_not_named() {
+    use sinsmodel::experiment::explain_eval::{default_options, run_case_explained, EvalSpec};
+    let spec = EvalSpec {
+        seed: 11,
+        groups: sinsmodel::sim::hidden::all_groups()
+            .iter()
+            .map(|g| g.to_string())
+            .collect(),
+        ..EvalSpec::default()
+    };
+    let (c, e) = run_case_explained(&spec, 73, &default_options()).expect("the case runs");
+    assert_eq!(c.noise_misstated, vec!["gyro_arw".to_string()], "{c:?}");
+    let words = e.summary.join("\n");
+    let named: Vec<&String> = c
+        .noise_named
+        .iter()
+        .filter(|l| !c.noise_stand_ins.contains(l))
+        .collect();
+    assert_eq!(named, vec!["gyro_arw"], "{c:?}\n{words}");
+    assert_eq!(c.noise_stand_ins, vec!["sigma_vel_ne".to_string()], "{c:?}");
+    assert!(
+        words.contains("vel_ne fixes' own innovations do not bear it out"),
+        "{words}"
+    );
+}
+
+/// The rule above costs no power where a fix's σ is truly misstated: on a drive (P13, the
+/// noise stated right) the velocity fixes' σ is stated half what they carry, or twice, or the
+/// horizontal position fixes' half; explain names that level within 10 % of the true scale,
+/// not as a stand-in, and names no level when every σ is stated right. (Measured over 16 seeds:
+/// named in 32 of 32, the 95 % interval holds the true 2× in 26 of 32: the velocity fixes'
+/// intervals are too narrow when the accelerometer noise took part of their misfit in the
+/// joint fit.)
+#[test]
+fn a_misstated_aiding_sigma_is_named_near_its_scale() {
+    use sinsmodel::experiment::hidden::{run_hidden_on, simulate_case};
+    use sinsmodel::sim::hidden::{generate, CaseKind};
+    let case = generate(5, CaseKind::One("noise_gyro"), 600.0, 0.0);
+    let (sim, aid) = simulate_case(&case).expect("the case simulates");
+    let levels = [
+        ("sigma_vel_ne", 0.5),
+        ("sigma_vel_ne", 2.0),
+        ("sigma_pos_ne", 0.5),
+        ("none", 1.0),
+    ];
+    for (level, stated_over_true) in levels {
+        let mut stated = aid.clone();
+        for a in &mut stated {
+            match level {
+                "sigma_vel_ne" => a.vel.as_mut().expect("velocity fixes").1 *= stated_over_true,
+                "sigma_pos_ne" => {
+                    let s = &mut a.pos.as_mut().expect("position fixes").3;
+                    s[0] *= stated_over_true;
+                    s[1] *= stated_over_true;
+                }
+                _ => {}
+            }
+        }
+        let opts = sinsmodel::explain::ExplainOptions::default();
+        let out = run_hidden_on(&case, &sim, &stated, &opts).expect("explain runs");
+        let e = &out.explanation;
+        let words = e.summary.join("\n");
+        let aiding: Vec<&str> = e
+            .findings
+            .iter()
+            .filter(|f| f.term.starts_with("sigma_") && f.stand_in.is_none())
+            .map(|f| f.term.as_str())
+            .collect();
+        if level == "none" {
+            assert!(aiding.is_empty(), "{aiding:?} named:\n{words}");
+            continue;
+        }
+        assert_eq!(aiding, vec![level], "stated {stated_over_true}×:\n{words}");
+        let f = e.findings.iter().find(|f| f.term == level).expect("named");
+        let truth = 1.0 / stated_over_true;
+        let scale = f.scale.expect("a noise finding's scale");
+        assert!(
+            (scale / truth - 1.0).abs() < 0.1,
+            "{level}: fitted {scale}× for a true {truth}×:\n{words}"
+        );
+    }
+}
+
+/// Measurement probe (the figures in docs/explain.md and the test above): seeds 1–16 of the
+/// drive with the velocity or the horizontal position fixes' σ stated half what they carry;
+/// counts the seeds where the level is named (not a stand-in) and where its 95 % interval holds
+/// the true 2×. `cargo test --release --test explain_eval -- --ignored aiding_sigma_scan
+/// --nocapture`
+#[test]
+#[ignore]
+fn aiding_sigma_scan() {
+    use sinsmodel::experiment::hidden::{run_hidden_on, simulate_case};
+    use sinsmodel::sim::hidden::{generate, CaseKind};
+    let opts = sinsmodel::explain::ExplainOptions::default();
+    let (mut named, mut covered, mut runs) = (0, 0, 0);
+    for seed in 1..=16 {
+        let case = generate(seed, CaseKind::One("noise_gyro"), 600.0, 0.0);
+        let (sim, aid) = simulate_case(&case).expect("the case simulates");
+        for level in ["sigma_vel_ne", "sigma_pos_ne"] {
+            let mut stated = aid.clone();
+            for a in &mut stated {
+                if level == "sigma_vel_ne" {
+                    a.vel.as_mut().expect("velocity fixes").1 *= 0.5;
+                } else {
+                    let s = &mut a.pos.as_mut().expect("position fixes").3;
+                    s[0] *= 0.5;
+                    s[1] *= 0.5;
+                }
+            }
+            let out = run_hidden_on(&case, &sim, &stated, &opts).expect("explain runs");
+            runs += 1;
+            let found = out
+                .explanation
+                .findings
+                .iter()
+                .find(|f| f.term == level && f.stand_in.is_none());
+            let interval = found.and_then(|f| f.scale_interval);
+            named += usize::from(found.is_some());
+            covered += usize::from(interval.is_some_and(|[lo, hi]| lo <= 2.0 && 2.0 <= hi));
+            eprintln!(
+                "seed {seed} {level}: {:?} {interval:?}",
+                found.and_then(|f| f.scale)
+            );
+        }
+    }
+    eprintln!("named {named} of {runs}; the 95 % interval holds the true 2× in {covered}");
+}

@@ -805,15 +805,17 @@ fn held_only_by_the_stated_noise(
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<bool> {
     let (noise_pass, applied) = noise;
+    // (at the scales the findings state: refitted without the levels the raw increments rule
+    // out, where the extended pass holds the joint fits)
     let causes: Vec<(noise::Level, f64)> = applied
         .iter()
-        .filter(|(level, _)| {
+        .filter_map(|&(level, joint)| {
             let name = level.name();
             findings
                 .iter()
-                .any(|f| f.kind == "noise" && f.term == name && f.is_cause())
+                .find(|f| f.kind == "noise" && f.term == name && f.is_cause())
+                .map(|f| (level, f.scale.unwrap_or(joint)))
         })
-        .copied()
         .collect();
     let terms: Vec<usize> = findings
         .iter()
@@ -831,7 +833,7 @@ fn held_only_by_the_stated_noise(
     };
     // every level found is a cause: the extended pass is the one with the term
     let fresh;
-    let with = if causes.len() == applied.len() {
+    let with = if causes == *applied {
         noise_pass
     } else {
         fresh = pass_of(&r.model)?;

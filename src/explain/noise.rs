@@ -12,6 +12,11 @@
 //! where the last parabola falls by χ²₁(0.95)/2. [`stage`] runs it after the terms and turns
 //! the significant levels into findings.
 //!
+//! A finding is a claim about the sensor or the fixes, judged by rules beside the test: it holds
+//! across the data (the splits), a white noise does not exceed what the raw increments show
+//! (`raw_noise`; a level they rule out no longer shifts the others: [`Claims`]), and a fix's σ
+//! is borne out by those fixes' own innovations ([`not_borne_out_by_own_fixes`]).
+//!
 //! In open loop these passes are replays of one recorded pass (`estimate::replay`): the
 //! navigation, A(t), H and z do not depend on the noise there, so each costs well under 1 % of a
 //! pass; in closed loop they are full passes.
@@ -240,25 +245,27 @@ fn fit(
             f.level.apply(model, &mut out, f.scale);
         }
     }
-    refit_named(passes, &mut fits, &mut out)?;
+    let named: Vec<bool> = fits.iter().map(|f| f.significant).collect();
+    refit_named(passes, &mut fits, &named, &mut out)?;
     Ok((fits, out))
 }
 
-/// Refits each named (significant) level once more on `out`, where the levels not named are
-/// back at their stated values: a level the data do not need must not shift the value of one
-/// they do. Updates the fits' scales and intervals and `out`.
+/// Refits each `named` level once more on `out`, where the levels not named are back at their
+/// stated values: a level the data do not need must not shift the value of one they do.
+/// Updates the fits' scales and intervals and `out`.
 fn refit_named(
     passes: &Passes,
     fits: &mut [LevelFit],
+    named: &[bool],
     out: &mut FilterConfig,
 ) -> anyhow::Result<()> {
     let model = passes.model;
-    let moved = fits.iter().any(|f| !f.significant && f.scale != 1.0);
-    if !moved || !fits.iter().any(|f| f.significant) {
+    let moved = fits.iter().zip(named).any(|(f, &n)| !n && f.scale != 1.0);
+    if !moved || !named.contains(&true) {
         return Ok(());
     }
     let mut l_out = passes.loglik(out)?;
-    for f in fits.iter_mut().filter(|f| f.significant) {
+    for (f, _) in fits.iter_mut().zip(named).filter(|x| *x.1) {
         let level = f.level;
         let base = out.clone();
         let mut eval = |u: f64| -> anyhow::Result<f64> {
@@ -346,6 +353,9 @@ fn search(
     Ok((pts[k].0, pts[k].1, curv, edge))
 }
 
+/// Most sweeps of the claimed levels' refits in [`Claims::new`].
+const SETTLE_SWEEPS: usize = 4;
+
 /// Most filter passes per noise level (the start point's pass not counted).
 const MAX_EVALS: usize = 5;
 
@@ -399,35 +409,215 @@ pub(super) fn stage(
     if !fits.iter().any(|f| f.significant) {
         return Ok((Vec::new(), None));
     }
+    let stated = Stated {
+        white: cfg.sensor_noise(&r.model),
+        bias_rw: cfg.bias_random_walk(&r.model),
+    };
+    let bic = (r.pass.run.innovations.len().max(2) as f64).ln();
+    let mut raw = super::raw_noise::Reading::default();
+    let motion = Motion::read(ctx.data, &mut raw)?;
+    let raw = raw.finish();
+    let claims = Claims::new(
+        &passes,
+        &cfg,
+        &fits,
+        &stated,
+        raw.as_ref(),
+        (ctx.opts.alpha, bic),
+    )?;
+    // the extended pass holds every level at its joint fit, the ones that stand in too (as it
+    // holds the terms that do); the findings state the claims
+    let applied: Vec<(Level, f64)> = fits
+        .iter()
+        .filter(|f| f.significant)
+        .map(|f| (f.level, f.scale))
+        .collect();
     let pass = run_pass(&r.model, &[], ctx.data, &cfg_noise, &mut |f| {
         progress(round + 1, f)
     })?;
     let excess = baseline_excess(base);
     let removed = st.nis_mean - pass.stats.nis_mean;
+    // (the extended pass's reduction is shared by the joint fits' 2Δℓ)
     let total: f64 = fits
         .iter()
         .filter(|f| f.significant)
         .map(|f| f.two_delta_loglik)
         .sum();
-    let stated = Stated {
-        white: cfg.sensor_noise(&r.model),
-        bias_rw: cfg.bias_random_walk(&r.model),
+    let judge = Judge {
+        passes: &passes,
+        motion: &motion,
+        stated: &stated,
+        raw: raw.as_ref(),
+        bic,
     };
-    // a noise level is a constant of the sensor or the receiver: fitted on parts of the data
-    // apart (while the body rotates or turns and otherwise; each half), it gives one scale
-    let mut raw = super::raw_noise::Reading::default();
-    let groups = innovation_groups(ctx.data, &pass, &mut raw)?;
-    let raw = raw.finish();
     let mut findings = Vec::new();
-    for f in fits.iter().filter(|f| f.significant) {
-        let w = f.two_delta_loglik / total.max(f64::MIN_POSITIVE);
+    for (k, f) in claims.fits.iter().enumerate().filter(|x| x.1.significant) {
+        let w = fits[k].two_delta_loglik / total.max(f64::MIN_POSITIVE);
         let mut nf = noise_finding(
             f,
             &stated,
             excess.map(|e| removed * w / e),
             f.two_delta_loglik,
         );
-        nf.consistency = split_scales(&passes, &cfg_noise, f, &pass, &groups)?;
+        // a level the raw increments rule out is judged where it was fitted (beside the
+        // others' joint fits), the rest where the claims were refitted without it
+        let at = match (&claims.claimed, claims.contradicted[k]) {
+            (Some((cfg, inn)), false) => (cfg, inn.as_slice()),
+            _ => (&cfg_noise, pass.run.innovations.as_slice()),
+        };
+        judge.level(f, at, &mut nf)?;
+        findings.push(nf);
+    }
+    taken_up_by_stand_ins(ctx, r, &claims.fits, stand_ins, &mut findings)?;
+    Ok((findings, Some((pass, applied))))
+}
+
+/// The fits the findings state. A significant white-noise level the raw increments rule out
+/// (see [`raw_reading`]) is still reported as fitted, but the other significant levels are
+/// refitted with it back at its stated value: a level the data rule out must not shift the
+/// value of one they allow (a velocity random walk fitted several times the sensor's takes up
+/// part of the velocity fixes' own noise).
+struct Claims {
+    /// Every level's fit; the significant ones not ruled out refitted as above.
+    fits: Vec<LevelFit>,
+    /// Per fit: a significant level the raw increments rule out.
+    contradicted: Vec<bool>,
+    /// With a level ruled out: the configuration with the claimed levels at their scales (those
+    /// ruled out at stated) and its applied innovations; None when none is (the claims are the
+    /// joint fits, which the extended pass holds).
+    claimed: Option<(FilterConfig, Vec<Innovation>)>,
+}
+
+impl Claims {
+    /// The claims from the joint `fits` over the stated configuration `cfg`, given the raw
+    /// reading `raw`; `(alpha, bic)` the tests' level and the BIC penalty ln N. A claimed level is tested again after the refits (its
+    /// 2Δℓ the drop when it alone returns to its stated value): one no longer significant is no
+    /// claim, and the others are refitted without it.
+    fn new(
+        passes: &Passes,
+        cfg: &FilterConfig,
+        fits: &[LevelFit],
+        stated: &Stated,
+        raw: Option<&super::raw_noise::RawNoise>,
+        (alpha, bic): (f64, f64),
+    ) -> anyhow::Result<Claims> {
+        let contradicted: Vec<bool> = fits
+            .iter()
+            .map(|f| f.significant && matches!(raw_reading(f, stated, raw), Some(Err(_))))
+            .collect();
+        let mut fits = fits.to_vec();
+        if !contradicted.contains(&true) {
+            return Ok(Claims {
+                fits,
+                contradicted,
+                claimed: None,
+            });
+        }
+        let mut named: Vec<bool> = fits
+            .iter()
+            .zip(&contradicted)
+            .map(|(f, &c)| f.significant && !c)
+            .collect();
+        let with_named = |fits: &[LevelFit], named: &[bool]| {
+            let mut out = cfg.clone();
+            for (f, _) in fits.iter().zip(named).filter(|x| *x.1) {
+                f.level.apply(passes.model, &mut out, f.scale);
+            }
+            out
+        };
+        let mut out = with_named(&fits, &named);
+        settle(passes, &mut fits, &named, &mut out)?;
+        while retest(passes, &mut fits, &mut named, &out, (alpha, bic))? {
+            out = with_named(&fits, &named);
+            settle(passes, &mut fits, &named, &mut out)?;
+        }
+        let innovations = passes.innovations(&out)?;
+        Ok(Claims {
+            fits,
+            contradicted,
+            claimed: Some((out, innovations)),
+        })
+    }
+}
+
+/// Refits the `named` levels of `fits` on `out` in turn until their scales settle (one level
+/// moved shifts the others' optimum), at most [`SETTLE_SWEEPS`] times.
+fn settle(
+    passes: &Passes,
+    fits: &mut [LevelFit],
+    named: &[bool],
+    out: &mut FilterConfig,
+) -> anyhow::Result<()> {
+    for _ in 0..SETTLE_SWEEPS {
+        let before: Vec<f64> = fits.iter().map(|f| f.scale).collect();
+        refit_named(passes, fits, named, out)?;
+        let moved = fits
+            .iter()
+            .zip(&before)
+            .any(|(f, b)| (f.scale / b).log2().abs() > 0.01);
+        if !moved {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// Tests the `named` levels of `fits` again on `out` (which holds them): each one's 2Δℓ is the
+/// drop when it alone returns to its stated value; Holm over all levels (the others with their
+/// first 2Δℓ) at `alpha` and above `bic`. A level no longer significant is un-named and marked
+/// not significant; returns whether one was.
+fn retest(
+    passes: &Passes,
+    fits: &mut [LevelFit],
+    named: &mut [bool],
+    out: &FilterConfig,
+    (alpha, bic): (f64, f64),
+) -> anyhow::Result<bool> {
+    let l_out = passes.loglik(out)?;
+    for (f, _) in fits.iter_mut().zip(named.iter()).filter(|x| *x.1) {
+        let mut c = out.clone();
+        f.level.apply(passes.model, &mut c, 1.0 / f.scale);
+        f.two_delta_loglik = (2.0 * (l_out - passes.loglik(&c)?)).max(0.0);
+    }
+    let p: Vec<f64> = fits
+        .iter()
+        .map(|f| stats::chi2_sf(f.two_delta_loglik, 1.0))
+        .collect();
+    let mut dropped = false;
+    for ((f, a), n) in fits.iter_mut().zip(stats::holm(&p)).zip(named.iter_mut()) {
+        if *n {
+            f.p_holm = a;
+            if !(a <= alpha && f.two_delta_loglik > bic) {
+                (f.significant, *n, dropped) = (false, false, true);
+            }
+        }
+    }
+    Ok(dropped)
+}
+
+/// What judges a fitted level as a claim about the sensor or the fixes.
+struct Judge<'a, 'p, 'd> {
+    passes: &'a Passes<'p, 'd>,
+    motion: &'a Motion,
+    stated: &'a Stated,
+    raw: Option<&'a super::raw_noise::RawNoise>,
+    /// The BIC penalty ln N.
+    bic: f64,
+}
+
+impl Judge<'_, '_, '_> {
+    /// Judges level `f` fitted at configuration and innovations `at`, adding to its finding `nf`
+    /// the consistency splits and the words (and a stand-in reason) of every rule it fails.
+    fn level(
+        &self,
+        f: &LevelFit,
+        (cfg, inn): (&FilterConfig, &[Innovation]),
+        nf: &mut Finding,
+    ) -> anyhow::Result<()> {
+        // a noise level is a constant of the sensor or the receiver: fitted on parts of the data
+        // apart (while the body rotates or turns and otherwise; each half), it gives one scale
+        let groups = self.motion.groups(inn);
+        nf.consistency = split_scales(self.passes, cfg, f, inn, &groups)?;
         let why: Vec<String> = nf
             .consistency
             .iter()
@@ -459,7 +649,13 @@ pub(super) fn stage(
             nf.words.push_str(&format!(". {why}"));
             nf.stand_in.get_or_insert(why);
         }
-        match raw_reading(f, &stated, raw.as_ref()) {
+        if let Some(why) = not_borne_out_by_own_fixes(self.passes, cfg, f, inn, self.bic)? {
+            nf.words.push_str(&format!(
+                ". It is no finding about these fixes' σ: {why}; it takes up misfit of the other fixes that the model does not describe (a term outside the candidates, an aiding error such as a lever arm or a time offset, or correlated receiver errors), so do not read it as the stated σ being wrong"
+            ));
+            nf.stand_in.get_or_insert(why);
+        }
+        match raw_reading(f, self.stated, self.raw) {
             Some(Err(why)) => {
                 nf.words.push_str(&format!(
                     ". It is not a finding about the sensor's noise: {why}; it stands in for something the model lacks: an effect that acts with the motion (vibration, a sensor term outside the candidates, a g-sensitivity, a scale error) or a correlated noise such as a bias instability"
@@ -469,15 +665,8 @@ pub(super) fn stage(
             Some(Ok(reading)) => nf.words.push_str(&format!("; {reading}")),
             None => {}
         }
-        findings.push(nf);
+        Ok(())
     }
-    taken_up_by_stand_ins(ctx, r, &fits, stand_ins, &mut findings)?;
-    let applied = fits
-        .iter()
-        .filter(|f| f.significant)
-        .map(|f| (f.level, f.scale))
-        .collect();
-    Ok((findings, Some((pass, applied))))
 }
 
 /// A noise finding that is significant only while the terms the rules called stand-ins
@@ -505,8 +694,11 @@ fn taken_up_by_stand_ins(
     }
     let model = super::model_with(&r.model.name, stand_ins.iter().copied())?;
     let mut cfg_plus = ctx.extended_config(&model, &r.widened)?;
-    for f in fits.iter().filter(|f| f.significant) {
-        f.level.apply(&model, &mut cfg_plus, f.scale);
+    // the levels claimed so far beside them (one that stands in is back at its stated value)
+    for (k, f) in fits.iter().filter(|f| f.significant).enumerate() {
+        if findings[k].stand_in.is_none() {
+            f.level.apply(&model, &mut cfg_plus, f.scale);
+        }
     }
     let levels: Vec<Level> = open.iter().map(|(_, f)| f.level).collect();
     let passes = Passes::record(&model, ctx.data, &cfg_plus, &levels, &mut |_| {})?;
@@ -542,6 +734,64 @@ fn taken_up_by_stand_ins(
     Ok(())
 }
 
+/// Why aiding level `f` (a fix's stated σ, fitted on `cfg`, whose innovations are `inn`) is no claim
+/// about those fixes, in words: its gain 2Δℓ over the stated σ (the others kept at their fits)
+/// comes from the other measurements' innovations, while the fixes it scales give
+/// `threshold` (the BIC's ln N) or less of it on their own. None when they bear it out, and for
+/// the sensors' levels.
+///
+/// A fix's σ enters its own innovations' variance directly and the others' only through the
+/// filter's covariance, so a mis-stated σ shows first in its own innovations; a scale the
+/// others' innovations want instead takes up their misfit (a wider σ lets the filter's position
+/// or velocity drift further between them). Under a correctly stated σ the own gain at any
+/// scale is at most the largest one, χ²₁-distributed: such a stand-in goes unlabelled only when
+/// that exceeds the threshold.
+fn not_borne_out_by_own_fixes(
+    passes: &Passes,
+    cfg: &FilterConfig,
+    f: &LevelFit,
+    inn: &[Innovation],
+    threshold: f64,
+) -> anyhow::Result<Option<String>> {
+    let Level::Sigma(meas) = f.level else {
+        return Ok(None);
+    };
+    let mut stated = cfg.clone();
+    f.level.apply(passes.model, &mut stated, 1.0 / f.scale);
+    let at_stated = passes.innovations(&stated)?;
+    if at_stated.len() != inn.len() {
+        anyhow::bail!("the noise passes differ in their updates");
+    }
+    // 2Δℓ per measurement, in the order the measurements first appear
+    let mut gains: Vec<(&'static str, f64)> = Vec::new();
+    for (a, b) in inn.iter().zip(&at_stated) {
+        let g = 2.0 * (super::diagnostics::loglik_of(a) - super::diagnostics::loglik_of(b));
+        match gains.iter_mut().find(|x| x.0 == a.meas) {
+            Some(x) => x.1 += g,
+            None => gains.push((a.meas, g)),
+        }
+    }
+    let own = gains.iter().find(|x| x.0 == meas).map_or(0.0, |x| x.1);
+    if own > threshold {
+        return Ok(None);
+    }
+    let others: Vec<String> = gains
+        .iter()
+        .filter(|x| x.0 != meas)
+        .map(|x| format!("the {} innovations' {}", x.0, sig3(x.1)))
+        .collect();
+    let others = if others.is_empty() {
+        String::new()
+    } else {
+        format!(", while {}", others.join(" and "))
+    };
+    Ok(Some(format!(
+        "the {meas} fixes' own innovations do not bear it out: from the stated σ to the fit their log-likelihood changes by 2Δℓ {} (not above ln N = {}){others}",
+        sig3(own),
+        sig3(threshold)
+    )))
+}
+
 /// Most a sensor's noise level can be mis-stated by and still be read as that level: grades
 /// differ by one or two orders of magnitude, and within a grade the data sheets' values differ
 /// by a few times.
@@ -564,78 +814,90 @@ fn implausible_scale(f: &LevelFit) -> Option<String> {
     ))
 }
 
-/// Each innovation's group in the three splits of the noise levels: (0 at rest or moving
-/// straight, 1 while the body rotates or turns, to 2 s after), (0 first half, 1 second half of
-/// the updates) and (0 quiet, 1 while the body vibrates, to 2 s after; all 0 when the vibration
-/// level does not change across the data, see [`vibrating_spans`]). Every sample also goes to
-/// the raw white-noise `raw` reading (the same pass serves both).
-fn innovation_groups(
-    data: &ExplainData,
-    pass: &Pass,
-    raw: &mut super::raw_noise::Reading,
-) -> anyhow::Result<Vec<[usize; 3]>> {
-    // rotating spans from the rate averaged over 0.1 s; vibration from the scatter of the
-    // specific force about its mean over the same 0.1 s
-    let mut spans: Vec<(f64, f64)> = Vec::new();
-    let mut windows: Vec<(f64, f64, f64)> = Vec::new();
-    let mut samples = data.imu.samples()?;
-    let (mut t0, mut t_prev, mut acc) = (f64::NAN, f64::NAN, nalgebra::Vector3::zeros());
-    let (mut f_sum, mut f_sq, mut count) = (nalgebra::Vector3::zeros(), 0.0, 0usize);
-    let mut on = false;
-    while let Some(smp) = samples.next_sample()? {
-        raw.push(&smp);
-        if t0.is_nan() {
-            t0 = smp.t;
+/// Where the body rotates or turns and where it vibrates [s], read from the IMU: the splits of
+/// the noise levels ([`Motion::groups`]).
+struct Motion {
+    /// Spans while the rate averaged over 0.1 s is above [`super::signatures::ROTATING`].
+    rotating: Vec<(f64, f64)>,
+    /// Spans while the body vibrates (see [`vibrating_spans`]).
+    shaking: Vec<(f64, f64)>,
+}
+
+impl Motion {
+    /// Reads the spans in one pass over the IMU; every sample also goes to the raw white-noise
+    /// `raw` reading (the same pass serves both).
+    fn read(data: &ExplainData, raw: &mut super::raw_noise::Reading) -> anyhow::Result<Motion> {
+        // rotating spans from the rate averaged over 0.1 s; vibration from the scatter of the
+        // specific force about its mean over the same 0.1 s
+        let mut spans: Vec<(f64, f64)> = Vec::new();
+        let mut windows: Vec<(f64, f64, f64)> = Vec::new();
+        let mut samples = data.imu.samples()?;
+        let (mut t0, mut t_prev, mut acc) = (f64::NAN, f64::NAN, nalgebra::Vector3::zeros());
+        let (mut f_sum, mut f_sq, mut count) = (nalgebra::Vector3::zeros(), 0.0, 0usize);
+        let mut on = false;
+        while let Some(smp) = samples.next_sample()? {
+            raw.push(&smp);
+            if t0.is_nan() {
+                t0 = smp.t;
+                t_prev = smp.t;
+                continue;
+            }
+            acc += smp.dtheta;
+            let dt = smp.t - t_prev;
             t_prev = smp.t;
-            continue;
-        }
-        acc += smp.dtheta;
-        let dt = smp.t - t_prev;
-        t_prev = smp.t;
-        if dt > 0.0 {
-            let f = smp.dv / dt;
-            f_sum += f;
-            f_sq += f.norm_squared();
-            count += 1;
-        }
-        if smp.t - t0 >= 0.1 {
-            let rate = acc.norm() / (smp.t - t0);
-            if rate > super::signatures::ROTATING {
-                if !on {
-                    spans.push((t0, smp.t));
-                }
-                on = true;
-                if let Some(last) = spans.last_mut() {
-                    last.1 = smp.t;
-                }
-            } else if rate < 0.5 * super::signatures::ROTATING {
-                on = false;
+            if dt > 0.0 {
+                let f = smp.dv / dt;
+                f_sum += f;
+                f_sq += f.norm_squared();
+                count += 1;
             }
-            if count >= 2 {
-                let n = count as f64;
-                let scatter = (f_sq / n - (f_sum / n).norm_squared()).max(0.0).sqrt();
-                windows.push((t0, smp.t, scatter));
+            if smp.t - t0 >= 0.1 {
+                let rate = acc.norm() / (smp.t - t0);
+                if rate > super::signatures::ROTATING {
+                    if !on {
+                        spans.push((t0, smp.t));
+                    }
+                    on = true;
+                    if let Some(last) = spans.last_mut() {
+                        last.1 = smp.t;
+                    }
+                } else if rate < 0.5 * super::signatures::ROTATING {
+                    on = false;
+                }
+                if count >= 2 {
+                    let n = count as f64;
+                    let scatter = (f_sq / n - (f_sum / n).norm_squared()).max(0.0).sqrt();
+                    windows.push((t0, smp.t, scatter));
+                }
+                t0 = smp.t;
+                acc = nalgebra::Vector3::zeros();
+                (f_sum, f_sq, count) = (nalgebra::Vector3::zeros(), 0.0, 0);
             }
-            t0 = smp.t;
-            acc = nalgebra::Vector3::zeros();
-            (f_sum, f_sq, count) = (nalgebra::Vector3::zeros(), 0.0, 0);
         }
-    }
-    let shaking = vibrating_spans(&windows);
-    let inn = &pass.run.innovations;
-    let half = inn.len() / 2;
-    let within = |sp: &[(f64, f64)], t: f64| sp.iter().any(|&(a, b)| t >= a && t <= b + 2.0);
-    Ok(inn
-        .iter()
-        .enumerate()
-        .map(|(k, i)| {
-            [
-                usize::from(within(&spans, i.t)),
-                usize::from(k >= half),
-                usize::from(within(&shaking, i.t)),
-            ]
+        Ok(Motion {
+            rotating: spans,
+            shaking: vibrating_spans(&windows),
         })
-        .collect())
+    }
+
+    /// Each innovation's group in the three splits of the noise levels: (0 at rest or moving
+    /// straight, 1 while the body rotates or turns, to 2 s after), (0 first half, 1 second half
+    /// of the updates) and (0 quiet, 1 while the body vibrates, to 2 s after; all 0 when the
+    /// vibration level does not change across the data).
+    fn groups(&self, inn: &[Innovation]) -> Vec<[usize; 3]> {
+        let half = inn.len() / 2;
+        let within = |sp: &[(f64, f64)], t: f64| sp.iter().any(|&(a, b)| t >= a && t <= b + 2.0);
+        inn.iter()
+            .enumerate()
+            .map(|(k, i)| {
+                [
+                    usize::from(within(&self.rotating, i.t)),
+                    usize::from(k >= half),
+                    usize::from(within(&self.shaking, i.t)),
+                ]
+            })
+            .collect()
+    }
 }
 
 /// The spans [s] where the body vibrates, from 0.1-s windows (start, end, RMS scatter of the
@@ -665,13 +927,13 @@ fn vibrating_spans(windows: &[(f64, f64, f64)]) -> Vec<(f64, f64)> {
 }
 
 /// Level `f`'s scale fitted on each group of each split apart: passes at half and twice the
-/// fitted scale beside `pass` (which has it), a parabola in log₂ s through each group's
+/// fitted scale beside the innovations `inn` of `cfg` (which has it), a parabola in log₂ s through each group's
 /// log-likelihood; σ from its curvature. Groups without curvature carry no information.
 fn split_scales(
     passes: &Passes,
     cfg: &FilterConfig,
     f: &LevelFit,
-    pass: &Pass,
+    inn: &[Innovation],
     groups: &[[usize; 3]],
 ) -> anyhow::Result<Vec<super::Consistency>> {
     let loglik_by_group = |inn: &[Innovation]| -> [[f64; 2]; 3] {
@@ -694,7 +956,7 @@ fn split_scales(
         }
         at.push(loglik_by_group(&inn));
     }
-    let mid = loglik_by_group(&pass.run.innovations);
+    let mid = loglik_by_group(inn);
     let mut out = Vec::new();
     for (split, name, labels) in [
         (

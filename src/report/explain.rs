@@ -112,7 +112,12 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
             f.equivalent.join(", ")
         ));
     }
-    for f in e.findings.iter().filter(|f| f.kind == "noise") {
+    // (a noise level that stands in is left out above: no advice to state it)
+    for f in e
+        .findings
+        .iter()
+        .filter(|f| f.kind == "noise" && f.stand_in.is_none())
+    {
         s.push_str(&format!(
             "# noise, not a term: {} = {} {} ({}× the stated; give it with --noise or the aiding's σ).\n",
             f.term,
