@@ -490,9 +490,10 @@ struct Claims {
 
 impl Claims {
     /// The claims from the joint `fits` over the stated configuration `cfg`, given the raw
-    /// reading `raw`; `(alpha, bic)` the tests' level and the BIC penalty ln N. A claimed level is tested again after the refits (its
-    /// 2Δℓ the drop when it alone returns to its stated value): one no longer significant is no
-    /// claim, and the others are refitted without it.
+    /// reading `raw`; `(alpha, bic)` are the tests' level and the BIC penalty ln N. A claimed
+    /// level is tested again after the refits (its 2Δℓ the drop when it alone returns to its
+    /// stated value): one no longer significant is no claim, and the others are refitted
+    /// without it.
     fn new(
         passes: &Passes,
         cfg: &FilterConfig,
@@ -734,11 +735,11 @@ fn taken_up_by_stand_ins(
     Ok(())
 }
 
-/// Why aiding level `f` (a fix's stated σ, fitted on `cfg`, whose innovations are `inn`) is no claim
-/// about those fixes, in words: its gain 2Δℓ over the stated σ (the others kept at their fits)
-/// comes from the other measurements' innovations, while the fixes it scales give
-/// `threshold` (the BIC's ln N) or less of it on their own. None when they bear it out, and for
-/// the sensors' levels.
+/// Why aiding level `f` (a fix's stated σ, fitted on `cfg`, whose innovations are `inn`) is no
+/// claim about those fixes, in words: from the stated σ to the fit (the others kept at their
+/// fits), the log-likelihood of the fixes it scales rises by `threshold` (the BIC's ln N) or
+/// less, and any gain comes from the other measurements' innovations. None when they bear it
+/// out, and for the sensors' levels.
 ///
 /// A fix's σ enters its own innovations' variance directly and the others' only through the
 /// filter's covariance, so a mis-stated σ shows first in its own innovations; a scale the
