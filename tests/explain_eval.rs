@@ -700,26 +700,33 @@ fn an_aiding_sigma_its_own_fixes_do_not_bear_out_is_not_named() {
 
 /// The rule above costs no power where a fix's σ is truly misstated: on a drive (P13, the
 /// noise stated right) the velocity fixes' σ is stated half what they carry, or twice, or the
-/// horizontal position fixes' half; explain names that level within 10 % of the true scale,
-/// not as a stand-in, and names no level when every σ is stated right. (Measured over 16 seeds:
-/// named in 32 of 32, the 95 % interval holds the true 2× in 26 of 32: the velocity fixes'
-/// intervals are too narrow when the accelerometer noise took part of their misfit in the
-/// joint fit.)
+/// horizontal position fixes' half (with the velocity fixes, and without); explain names that
+/// level within 10 % of the true scale, not as a stand-in, and no other level, and names no
+/// level when every σ is stated right. (Measured over 16 seeds, `aiding_sigma_scan`: named in
+/// 32 of 32, the 95 % interval holds the true 2× in 27 of 32: the velocity fixes' intervals
+/// are too narrow when the accelerometer noise took part of their misfit in the joint fit.)
 #[test]
 fn a_misstated_aiding_sigma_is_named_near_its_scale() {
     use sinsmodel::experiment::hidden::{run_hidden_on, simulate_case};
     use sinsmodel::sim::hidden::{generate, CaseKind};
     let case = generate(5, CaseKind::One("noise_gyro"), 600.0, 0.0);
     let (sim, aid) = simulate_case(&case).expect("the case simulates");
+    // (the last: position fixes only, whose σ is stated half; before a refitted level was
+    // tested again, a level fitted beside it could keep the gain of the joint fit)
     let levels = [
         ("sigma_vel_ne", 0.5),
         ("sigma_vel_ne", 2.0),
         ("sigma_pos_ne", 0.5),
         ("none", 1.0),
+        ("sigma_pos_ne only", 0.5),
     ];
-    for (level, stated_over_true) in levels {
+    for (label, stated_over_true) in levels {
+        let level = label.trim_end_matches(" only");
         let mut stated = aid.clone();
         for a in &mut stated {
+            if label.ends_with(" only") {
+                a.vel = None;
+            }
             match level {
                 "sigma_vel_ne" => a.vel.as_mut().expect("velocity fixes").1 *= stated_over_true,
                 "sigma_pos_ne" => {
@@ -734,17 +741,22 @@ fn a_misstated_aiding_sigma_is_named_near_its_scale() {
         let out = run_hidden_on(&case, &sim, &stated, &opts).expect("explain runs");
         let e = &out.explanation;
         let words = e.summary.join("\n");
-        let aiding: Vec<&str> = e
+        // every noise level named as a cause (the sensors' are stated right)
+        let named: Vec<&str> = e
             .findings
             .iter()
-            .filter(|f| f.term.starts_with("sigma_") && f.stand_in.is_none())
+            .filter(|f| f.kind == "noise" && f.is_cause())
             .map(|f| f.term.as_str())
             .collect();
         if level == "none" {
-            assert!(aiding.is_empty(), "{aiding:?} named:\n{words}");
+            assert!(named.is_empty(), "{named:?} named:\n{words}");
             continue;
         }
-        assert_eq!(aiding, vec![level], "stated {stated_over_true}×:\n{words}");
+        assert_eq!(
+            named,
+            vec![level],
+            "{label} stated {stated_over_true}×:\n{words}"
+        );
         let f = e.findings.iter().find(|f| f.term == level).expect("named");
         let truth = 1.0 / stated_over_true;
         let scale = f.scale.expect("a noise finding's scale");

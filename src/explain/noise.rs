@@ -245,24 +245,34 @@ fn fit(
             f.level.apply(model, &mut out, f.scale);
         }
     }
-    let named: Vec<bool> = fits.iter().map(|f| f.significant).collect();
-    refit_named(passes, &mut fits, &named, &mut out)?;
+    // refitted, a level's gain is tested again (it was measured beside the unnamed levels'
+    // fits): one no longer significant is no claim, and the others are refitted without it
+    let mut named: Vec<bool> = fits.iter().map(|f| f.significant).collect();
+    let mut moved = refit_named(passes, &mut fits, &named, &mut out)?;
+    while moved && retest(passes, &mut fits, &mut named, &out, (opts.alpha, bic))? {
+        out = cfg.clone();
+        for (f, _) in fits.iter().zip(&named).filter(|x| *x.1) {
+            f.level.apply(model, &mut out, f.scale);
+        }
+        moved = refit_named(passes, &mut fits, &named, &mut out)?;
+    }
     Ok((fits, out))
 }
 
 /// Refits each `named` level once more on `out`, where the levels not named are back at their
 /// stated values: a level the data do not need must not shift the value of one they do.
-/// Updates the fits' scales and intervals and `out`.
+/// Updates the fits' scales and intervals and `out`; returns whether it refitted (some level
+/// not named had moved from its stated value).
 fn refit_named(
     passes: &Passes,
     fits: &mut [LevelFit],
     named: &[bool],
     out: &mut FilterConfig,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<bool> {
     let model = passes.model;
     let moved = fits.iter().zip(named).any(|(f, &n)| !n && f.scale != 1.0);
     if !moved || !named.contains(&true) {
-        return Ok(());
+        return Ok(false);
     }
     let mut l_out = passes.loglik(out)?;
     for (f, _) in fits.iter_mut().zip(named).filter(|x| *x.1) {
@@ -284,7 +294,7 @@ fn refit_named(
             f.interval = interval(f.scale, curv);
         }
     }
-    Ok(())
+    Ok(true)
 }
 
 /// The 95 % interval of a scale fitted at `scale` where ℓ(log₂ s) has curvature `curv` (ℓ ≈
@@ -650,6 +660,12 @@ impl Judge<'_, '_, '_> {
             nf.words.push_str(&format!(". {why}"));
             nf.stand_in.get_or_insert(why);
         }
+        if let Some(why) = holds_the_stated_value(f) {
+            nf.words.push_str(&format!(
+                ". It is no finding that the stated value is wrong: {why}"
+            ));
+            nf.stand_in.get_or_insert(why);
+        }
         if let Some(why) = not_borne_out_by_own_fixes(self.passes, cfg, f, inn, self.bic)? {
             nf.words.push_str(&format!(
                 ". It is no finding about these fixes' σ: {why}; it takes up misfit of the other fixes that the model does not describe (a term outside the candidates, an aiding error such as a lever arm or a time offset, or correlated receiver errors), so do not read it as the stated σ being wrong"
@@ -779,7 +795,11 @@ fn not_borne_out_by_own_fixes(
     let others: Vec<String> = gains
         .iter()
         .filter(|x| x.0 != meas)
-        .map(|x| format!("the {} innovations' {}", x.0, sig3(x.1)))
+        .enumerate()
+        .map(|(k, x)| {
+            let verb = if k == 0 { " changes" } else { "" };
+            format!("that of the {} innovations{verb} by {}", x.0, sig3(x.1))
+        })
         .collect();
     let others = if others.is_empty() {
         String::new()
@@ -791,6 +811,24 @@ fn not_borne_out_by_own_fixes(
         sig3(own),
         sig3(threshold)
     )))
+}
+
+/// Why level `f` is no finding though its test passed, in words: its 95 % interval holds the
+/// stated value (scale 1). The test's 2Δℓ is the drop with the others at their fits, the
+/// interval the curvature about the fit; where the likelihood is far from a parabola they can
+/// disagree, and a claim whose own interval holds the stated value says nothing. None for a
+/// level at its search bound (no interval) and an interval without 1.
+fn holds_the_stated_value(f: &LevelFit) -> Option<String> {
+    let [lo, hi] = f.interval;
+    if f.at_bound != 0 || !(lo.is_finite() && hi.is_finite()) || !(lo <= 1.0 && 1.0 <= hi) {
+        return None;
+    }
+    Some(format!(
+        "its 95 % interval ({}–{}×) holds the stated value, so the data do not tell the two apart (its 2Δℓ {} is the drop with the other levels at their fits, where the likelihood is no parabola)",
+        sig3(lo),
+        sig3(hi),
+        sig3(f.two_delta_loglik)
+    ))
 }
 
 /// Most a sensor's noise level can be mis-stated by and still be read as that level: grades
@@ -1043,9 +1081,13 @@ fn raw_reading(
         return Some(Ok(super::raw_noise::no_reading(what)));
     };
     let raw_si = if what == "gyro" { raw.gyro } else { raw.accel };
-    super::raw_noise::judge(
-        what, f.interval, stated_si, raw_si, to_unit, unit, raw.blocks,
-    )
+    // at a search bound the fit is a bound: at most its scale (no lower end) or at least it
+    let interval = match f.at_bound {
+        -1 => [0.0, f.scale],
+        1 => [f.scale, f64::INFINITY],
+        _ => f.interval,
+    };
+    super::raw_noise::judge(what, interval, stated_si, raw_si, to_unit, unit, raw.blocks)
 }
 
 /// rad/√s → deg/√h (white gyro noise).
@@ -1271,6 +1313,26 @@ mod tests {
         assert!(implausible_scale(&fit(Level::GyroBiasRw, 0.01)).is_some());
         // an aiding σ may be stated for fixes that carry none
         assert!(implausible_scale(&fit(Level::Sigma("pos_h"), 0.001)).is_none());
+    }
+
+    #[test]
+    fn a_level_whose_interval_holds_the_stated_value_is_no_finding() {
+        let fit = |interval: [f64; 2], at_bound| LevelFit {
+            level: Level::GyroArw,
+            scale: (interval[0] * interval[1]).sqrt(),
+            interval,
+            at_bound,
+            two_delta_loglik: 11.9,
+            p_holm: 0.001,
+            significant: true,
+        };
+        let why = holds_the_stated_value(&fit([0.609, 1.10], 0)).unwrap();
+        assert!(why.contains("0.609–1.10×") && why.contains("11.9"), "{why}");
+        assert!(holds_the_stated_value(&fit([0.25, 0.78], 0)).is_none());
+        assert!(holds_the_stated_value(&fit([1.02, 1.3], 0)).is_none());
+        // at a search bound there is no interval to judge
+        assert!(holds_the_stated_value(&fit([0.5, 2.0], -1)).is_none());
+        assert!(holds_the_stated_value(&fit([0.5, f64::INFINITY], 0)).is_none());
     }
 
     #[test]

@@ -166,7 +166,7 @@ pub(super) fn judge(
     );
     Some(if interval[0] > MARGIN * raw_scale {
         Err(format!(
-            "{reading}, and the fit's 95 % interval starts at {}× the stated, above {MARGIN}× that: the level the filter needs is not the sensor's white noise",
+            "{reading}, and the fit is at least {}× the stated (its 95 % interval's lower end, or its search bound), above {MARGIN}× that: the level the filter needs is not the sensor's white noise",
             super::sig3(interval[0])
         ))
     } else {

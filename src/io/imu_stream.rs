@@ -88,6 +88,10 @@ pub struct ImuStream {
     ended: bool,
     /// The samples after the head not yet judged.
     window: Vec<ImuSample>,
+    /// Intervals longer than twice the median (samples missing, within [`MAX_GAP_INTERVALS`]).
+    short_gaps: u64,
+    /// The longest of them [s] and the time before it [s].
+    longest_gap: (f64, f64),
 }
 
 /// A check of the samples of one window after the head (consecutive, in time order); its error
@@ -176,6 +180,8 @@ impl ImuStream {
             judges: Vec::new(),
             ended: false,
             window: Vec::new(),
+            short_gaps: 0,
+            longest_gap: (0.0, f64::NAN),
         };
         // validate the head in order, as every later sample will be (prev_t then stands at the
         // last head sample, where the samples after the head continue)
@@ -314,6 +320,12 @@ impl ImuStream {
                         self.interval
                     );
                 }
+                if d > 2.0 * self.interval {
+                    self.short_gaps += 1;
+                    if d > self.longest_gap.0 {
+                        self.longest_gap = (d, p);
+                    }
+                }
                 d
             }
             None => self.interval,
@@ -406,7 +418,31 @@ impl ImuStream {
             return Ok(());
         }
         self.ended = true;
+        self.say_gaps();
         self.judges.iter_mut().try_for_each(|j| j(&[]))
+    }
+
+    /// Warns (once per run) of the intervals longer than twice the median the file held: the
+    /// run integrates across them, but samples a logger dropped take their increments with them.
+    fn say_gaps(&self) {
+        if let Some(w) = self.gap_warning() {
+            crate::io::warnings::warn_once(&w);
+        }
+    }
+
+    /// The words of [`ImuStream::say_gaps`] for the samples read so far; None without such
+    /// intervals.
+    fn gap_warning(&self) -> Option<String> {
+        if self.short_gaps == 0 {
+            return None;
+        }
+        let (d, t) = self.longest_gap;
+        Some(format!(
+            "--imu {}: {} interval(s) longer than twice the median {:.4} s (the longest {d:.4} s after t = {t:.3} s): integrated across; if the logger dropped those samples, their increments (motion) are lost, if it summed them into the next sample nothing is; `sinsmodel imu-check` lists the clock",
+            self.name,
+            self.short_gaps,
+            self.interval
+        ))
     }
 
     /// Reads and drops the samples whose time is at or before `t` [s] (a run that starts at
@@ -560,6 +596,36 @@ mod tests {
                 })
                 .collect(),
         }
+    }
+
+    /// Intervals of 2–5 median intervals (dropped samples) pass, and are said once at the end.
+    #[test]
+    fn short_gaps_are_said() {
+        let mut ts: Vec<f64> = (1..=3000).map(|k| k as f64 * 0.01).collect();
+        let read = |ts: &[f64]| {
+            let mut s = ImuStream::from_data(data(ts, 0.1), "mem").unwrap();
+            let mut n = 0;
+            while s.next().unwrap().is_some() {
+                n += 1;
+            }
+            (n, s.gap_warning())
+        };
+        assert_eq!(read(&ts), (3000, None));
+        // three samples dropped after the head (a 0.04-s interval), two more later, and a jitter
+        // of 1.9 intervals, not a gap
+        ts.remove(2001);
+        ts.remove(2001);
+        ts.remove(2001);
+        ts.remove(2500);
+        ts.remove(2500);
+        ts[2700] += 0.009;
+        let (n, w) = read(&ts);
+        assert_eq!(n, 2995);
+        let w = w.expect("a warning");
+        assert!(
+            w.starts_with("--imu mem: 2 interval(s) longer than twice the median 0.0100 s (the longest 0.0400 s after t = 20.010 s)"),
+            "{w}"
+        );
     }
 
     #[test]

@@ -24,6 +24,17 @@ pub fn warn(text: &str) {
     keep(text);
 }
 
+/// Says `text` as a warning on stderr and keeps it, unless it is kept already (a run that reads
+/// the same file many times says it once).
+pub fn warn_once(text: &str) {
+    let new = KEPT
+        .lock()
+        .is_ok_and(|v| v.len() < KEPT_MAX && !v.iter().any(|x| x == text));
+    if new {
+        warn(text);
+    }
+}
+
 /// The warnings kept so far, in the order said; forgets them.
 pub fn take() -> Vec<String> {
     KEPT.lock()

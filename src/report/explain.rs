@@ -106,11 +106,22 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
         ));
     }
     for f in e.findings.iter().filter(|f| f.not_attributed.is_some()) {
-        s.push_str(&format!(
-            "# {} is left out: the data cannot tell it from {} and the priors would choose.\n",
-            f.term,
-            f.equivalent.join(", ")
-        ));
+        if f.equivalent.is_empty() {
+            s.push_str(&format!(
+                "# {} is left out: it is not attributed ({}).\n",
+                f.term,
+                f.not_attributed
+                    .as_deref()
+                    .unwrap_or_default()
+                    .replace('\n', " ")
+            ));
+        } else {
+            s.push_str(&format!(
+                "# {} is left out: the data cannot tell it from {} and the priors would choose.\n",
+                f.term,
+                f.equivalent.join(", ")
+            ));
+        }
     }
     // (a noise level that stands in is left out above: no advice to state it)
     for f in e
@@ -118,13 +129,23 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
         .iter()
         .filter(|f| f.kind == "noise" && f.stand_in.is_none())
     {
-        s.push_str(&format!(
-            "# noise, not a term: {} = {} {} ({}× the stated; give it with --noise or the aiding's σ).\n",
-            f.term,
-            sig3(f.estimate),
-            f.unit,
-            f.scale.map(sig3).unwrap_or_default()
-        ));
+        // a level at its search bound is no estimate: the bound, said as one
+        let line = match f.scale_bound {
+            Some(b) => format!(
+                "# noise, not a term: {} {b} {} {} (at the search bound: the likelihood still rises beyond it; give a value there with --noise or the aiding's σ).\n",
+                f.term,
+                sig3(f.estimate),
+                f.unit
+            ),
+            None => format!(
+                "# noise, not a term: {} = {} {} ({}× the stated; give it with --noise or the aiding's σ).\n",
+                f.term,
+                sig3(f.estimate),
+                f.unit,
+                f.scale.map(sig3).unwrap_or_default()
+            ),
+        };
+        s.push_str(&line);
     }
     if e.findings
         .iter()
@@ -578,12 +599,16 @@ fn findings_section(e: &Explanation, s: &mut String) {
                 )
             })
             .unwrap_or_default();
+        // a level at its search bound is a bound, not an estimate
+        let value = match f.scale_bound {
+            Some("at most") => format!("≤ {}", num(f.estimate)),
+            Some(_) => format!("≥ {}", num(f.estimate)),
+            None => format!("{} ± {}", num(f.estimate), num(f.sigma)),
+        };
         s.push_str(&format!(
-            "- **{}** = {} ± {} {}: {verdict}{share} (llr {:.1}, p {}; round {}).\n\n  <details><summary>In full</summary>{}</details>\n\n",
+            "- **{}** = {}: {verdict}{share} (llr {:.1}, p {}; round {}).\n\n  <details><summary>In full</summary>{}</details>\n\n",
             f.term,
-            num(f.estimate),
-            num(f.sigma),
-            notation(&f.unit),
+            notation(&format!("{value} {}", f.unit)),
             f.llr,
             num(f.p_value),
             f.round,
@@ -641,13 +666,16 @@ fn notes_section(s: &mut String) {
     );
     s.push_str(
         "\n**Found** is a finding named as a cause: significant, plausible in its prior σ, \
-         holding across the data in every split tested (its consistency table) and not in a class \
-         the data cannot separate. **Fitted, but not a cause** is significant but fails one of \
-         those: implausible in its prior σ (or, for a noise level, more than 30× from the stated), \
-         not one value across the data, or removing little of the misfit; its words say which, \
-         and it is no property of the sensor: it probably stands in for something the candidates \
-         lack. **Fitted, not attributed** is significant, but its class holds members whose \
-         values differ by an order of magnitude or more: none is named.\n",
+         holding across the data in every split tested (its consistency in explain.json) and not \
+         in a class whose members' values differ by an order of magnitude or more. **Fitted, but \
+         not a cause** is significant but fails one of those, or a noise level's own rules: \
+         implausible in its prior σ, a sensor's noise level more than 30× from the stated or above \
+         what the raw increments show, a fix's σ its own innovations do not bear out, an interval \
+         that holds the stated value, not one value across the data, or removing little of the \
+         misfit; its words say which, and it is no property of the sensor: it probably stands in \
+         for something the candidates lack. **Fitted, not attributed** is significant, but its \
+         class holds members whose values differ by an order of magnitude or more: none is \
+         named.\n",
     );
 }
 
