@@ -323,12 +323,13 @@ fn a_noise_level_the_stand_ins_take_up_is_not_named() {
     assert!(c.named.is_empty() && !c.wrong_term, "{c:?}");
 }
 
-/// A white-noise level the raw increments do not show is no finding about the noise: all-600's
-/// case 28 (seed 11) states the gyro's white noise too small and nothing else; explain names
-/// the gyro level, and also fitted the accelerometer's above its stated value (named until the
-/// fit was read against the Allan deviation of the raw increments, which show the stated value).
-#[test]
-fn a_white_noise_the_raw_increments_do_not_show_is_not_named() {
+/// Case `index` of the all-600 campaign (seed 11, every group), run and explained.
+fn all_600_case(
+    index: usize,
+) -> (
+    sinsmodel::experiment::explain_eval::CaseResult,
+    sinsmodel::explain::Explanation,
+) {
     use sinsmodel::experiment::explain_eval::{default_options, run_case_explained, EvalSpec};
     let spec = EvalSpec {
         seed: 11,
@@ -338,7 +339,16 @@ fn a_white_noise_the_raw_increments_do_not_show_is_not_named() {
             .collect(),
         ..EvalSpec::default()
     };
-    let (c, e) = run_case_explained(&spec, 28, &default_options()).expect("the case runs");
+    run_case_explained(&spec, index, &default_options()).expect("the case runs")
+}
+
+/// A white-noise level the raw increments do not show is no finding about the noise: all-600's
+/// case 28 (seed 11) states the gyro's white noise too small and nothing else; explain names
+/// the gyro level, and also fitted the accelerometer's above its stated value (named until the
+/// fit was read against the Allan deviation of the raw increments, which show the stated value).
+#[test]
+fn a_white_noise_the_raw_increments_do_not_show_is_not_named() {
+    let (c, e) = all_600_case(28);
     assert_eq!(c.noise_misstated, vec!["gyro_arw".to_string()], "{c:?}");
     let named: Vec<&String> = c
         .noise_named
@@ -673,16 +683,7 @@ fn probe_power() {
 /// named until a fix's level had to be borne out by its own innovations.
 #[test]
 fn an_aiding_sigma_its_own_fixes_do_not_bear_out_is_not_named() {
-    use sinsmodel::experiment::explain_eval::{default_options, run_case_explained, EvalSpec};
-    let spec = EvalSpec {
-        seed: 11,
-        groups: sinsmodel::sim::hidden::all_groups()
-            .iter()
-            .map(|g| g.to_string())
-            .collect(),
-        ..EvalSpec::default()
-    };
-    let (c, e) = run_case_explained(&spec, 73, &default_options()).expect("the case runs");
+    let (c, e) = all_600_case(73);
     assert_eq!(c.noise_misstated, vec!["gyro_arw".to_string()], "{c:?}");
     let words = e.summary.join("\n");
     let named: Vec<&String> = c
