@@ -660,6 +660,9 @@ impl Judge<'_, '_, '_> {
             nf.words.push_str(&format!(". {why}"));
             nf.stand_in.get_or_insert(why);
         }
+        if let Some(hint) = unit_slip(f) {
+            nf.words.push_str(&format!(". {hint}"));
+        }
         if let Some(why) = holds_the_stated_value(f) {
             nf.words.push_str(&format!(
                 ". It is no finding that the stated value is wrong: {why}"
@@ -811,6 +814,24 @@ fn not_borne_out_by_own_fixes(
         sig3(own),
         sig3(threshold)
     )))
+}
+
+/// The unit slip a fix's σ scale `f` looks like, in words: within 1.3× of 1/100 or 1/1000
+/// (a σ column in cm or mm, cm/s or mm/s, read as m or m/s); None otherwise and for the
+/// sensors' levels (their units are named by `--noise` and checked there).
+fn unit_slip(f: &LevelFit) -> Option<String> {
+    let Level::Sigma(meas) = f.level else {
+        return None;
+    };
+    let (unit, per) = [("cm", 1e-2), ("mm", 1e-3)]
+        .into_iter()
+        .find(|&(_, k)| (f.scale / k).ln().abs() < 1.3f64.ln())?;
+    let si = if meas.starts_with("vel") { "m/s" } else { "m" };
+    Some(format!(
+        "A scale this close to {} is what the fixes' σ in {unit}{} read as {si} gives: check the file's σ columns and their unit (the file's σ are SI)",
+        sig3(per),
+        if si == "m/s" { "/s" } else { "" }
+    ))
 }
 
 /// Why level `f` is no finding though its test passed, in words: its 95 % interval holds the
@@ -1313,6 +1334,26 @@ mod tests {
         assert!(implausible_scale(&fit(Level::GyroBiasRw, 0.01)).is_some());
         // an aiding σ may be stated for fixes that carry none
         assert!(implausible_scale(&fit(Level::Sigma("pos_h"), 0.001)).is_none());
+    }
+
+    #[test]
+    fn a_fix_sigma_scale_of_a_unit_slip_is_said() {
+        let fit = |level, scale: f64| LevelFit {
+            level,
+            scale,
+            interval: [scale / 1.05, scale * 1.05],
+            at_bound: 0,
+            two_delta_loglik: 1e4,
+            p_holm: 0.0,
+            significant: true,
+        };
+        let w = unit_slip(&fit(Level::Sigma("pos_ne"), 0.00101)).unwrap();
+        assert!(w.contains("0.001") && w.contains("in mm read as m "), "{w}");
+        let w = unit_slip(&fit(Level::Sigma("vel_ne"), 0.0098)).unwrap();
+        assert!(w.contains("in cm/s read as m/s"), "{w}");
+        assert!(unit_slip(&fit(Level::Sigma("pos_ne"), 0.2)).is_none());
+        assert!(unit_slip(&fit(Level::Sigma("pos_h"), 2.44e-4)).is_none());
+        assert!(unit_slip(&fit(Level::AccelVrw, 0.001)).is_none());
     }
 
     #[test]
