@@ -248,15 +248,50 @@ fn fit(
     // refitted, a level's gain is tested again (it was measured beside the unnamed levels'
     // fits): one no longer significant is no claim, and the others are refitted without it
     let mut named: Vec<bool> = fits.iter().map(|f| f.significant).collect();
-    let mut moved = refit_named(passes, &mut fits, &named, &mut out)?;
-    while moved && retest(passes, &mut fits, &mut named, &out, (opts.alpha, bic))? {
-        out = cfg.clone();
-        for (f, _) in fits.iter().zip(&named).filter(|x| *x.1) {
-            f.level.apply(model, &mut out, f.scale);
-        }
-        moved = refit_named(passes, &mut fits, &named, &mut out)?;
-    }
+    refit_and_retest(
+        passes,
+        cfg,
+        &mut fits,
+        &mut named,
+        &mut out,
+        (opts.alpha, bic),
+        1,
+    )?;
     Ok((fits, out))
+}
+
+/// `cfg` with the `named` levels of `fits` at their scales.
+fn with_levels(
+    model: &Model,
+    cfg: &FilterConfig,
+    fits: &[LevelFit],
+    named: &[bool],
+) -> FilterConfig {
+    let mut out = cfg.clone();
+    for (f, _) in fits.iter().zip(named).filter(|x| *x.1) {
+        f.level.apply(model, &mut out, f.scale);
+    }
+    out
+}
+
+/// Refits the `named` levels of `fits` on `out` (= `cfg` with them; [`settle`], at most
+/// `sweeps` times) and, when that moved them, tests them again ([`retest`]); while one is
+/// dropped, the rest are refitted from `cfg` without it and tested again.
+fn refit_and_retest(
+    passes: &Passes,
+    cfg: &FilterConfig,
+    fits: &mut [LevelFit],
+    named: &mut [bool],
+    out: &mut FilterConfig,
+    tests: (f64, f64),
+    sweeps: usize,
+) -> anyhow::Result<()> {
+    let mut moved = settle(passes, fits, named, out, sweeps)?;
+    while moved && retest(passes, fits, named, out, tests)? {
+        *out = with_levels(passes.model, cfg, fits, named);
+        moved = settle(passes, fits, named, out, sweeps)?;
+    }
+    Ok(())
 }
 
 /// Refits each `named` level once more on `out`, where the levels not named are back at their
@@ -529,19 +564,16 @@ impl Claims {
             .zip(&contradicted)
             .map(|(f, &c)| f.significant && !c)
             .collect();
-        let with_named = |fits: &[LevelFit], named: &[bool]| {
-            let mut out = cfg.clone();
-            for (f, _) in fits.iter().zip(named).filter(|x| *x.1) {
-                f.level.apply(passes.model, &mut out, f.scale);
-            }
-            out
-        };
-        let mut out = with_named(&fits, &named);
-        settle(passes, &mut fits, &named, &mut out)?;
-        while retest(passes, &mut fits, &mut named, &out, (alpha, bic))? {
-            out = with_named(&fits, &named);
-            settle(passes, &mut fits, &named, &mut out)?;
-        }
+        let mut out = with_levels(passes.model, cfg, &fits, &named);
+        refit_and_retest(
+            passes,
+            cfg,
+            &mut fits,
+            &mut named,
+            &mut out,
+            (alpha, bic),
+            SETTLE_SWEEPS,
+        )?;
         let innovations = passes.innovations(&out)?;
         Ok(Claims {
             fits,
@@ -552,16 +584,20 @@ impl Claims {
 }
 
 /// Refits the `named` levels of `fits` on `out` in turn until their scales settle (one level
-/// moved shifts the others' optimum), at most [`SETTLE_SWEEPS`] times.
+/// moved shifts the others' optimum), at most `sweeps` times; returns whether the first sweep
+/// refitted ([`refit_named`]: some level not named had moved from its stated value).
 fn settle(
     passes: &Passes,
     fits: &mut [LevelFit],
     named: &[bool],
     out: &mut FilterConfig,
-) -> anyhow::Result<()> {
-    for _ in 0..SETTLE_SWEEPS {
+    sweeps: usize,
+) -> anyhow::Result<bool> {
+    let mut refitted = false;
+    for sweep in 0..sweeps {
         let before: Vec<f64> = fits.iter().map(|f| f.scale).collect();
-        refit_named(passes, fits, named, out)?;
+        let ran = refit_named(passes, fits, named, out)?;
+        refitted |= sweep == 0 && ran;
         let moved = fits
             .iter()
             .zip(&before)
@@ -570,7 +606,7 @@ fn settle(
             break;
         }
     }
-    Ok(())
+    Ok(refitted)
 }
 
 /// Tests the `named` levels of `fits` again on `out` (which holds them): each one's 2Δℓ is the

@@ -11,11 +11,19 @@ static KEPT: Mutex<Vec<String>> = Mutex::new(Vec::new());
 
 /// Keeps `text` (a warning without its "warning: ") for the run's report, once.
 pub fn keep(text: &str) {
-    if let Ok(mut v) = KEPT.lock() {
-        if v.len() < KEPT_MAX && !v.iter().any(|x| x == text) {
-            v.push(text.to_string());
-        }
+    keep_new(text);
+}
+
+/// Keeps `text` as [`keep`] does; returns whether it was not kept before.
+fn keep_new(text: &str) -> bool {
+    let Ok(mut v) = KEPT.lock() else {
+        return false;
+    };
+    let new = v.len() < KEPT_MAX && !v.iter().any(|x| x == text);
+    if new {
+        v.push(text.to_string());
     }
+    new
 }
 
 /// Says `text` as a warning on stderr and keeps it for the run's report.
@@ -27,11 +35,8 @@ pub fn warn(text: &str) {
 /// Says `text` as a warning on stderr and keeps it, unless it is kept already (a run that reads
 /// the same file many times says it once).
 pub fn warn_once(text: &str) {
-    let new = KEPT
-        .lock()
-        .is_ok_and(|v| v.len() < KEPT_MAX && !v.iter().any(|x| x == text));
-    if new {
-        warn(text);
+    if keep_new(text) {
+        eprintln!("warning: {text}");
     }
 }
 

@@ -276,6 +276,15 @@ fn figure(n: usize, file: &str, caption: &str) -> String {
     )
 }
 
+/// "≤" or "≥" for a noise level at its search bound (`scale_bound` at most or at least); None
+/// for an estimate.
+fn bound_sign(f: &crate::explain::Finding) -> Option<&'static str> {
+    match f.scale_bound? {
+        "at most" => Some("≤"),
+        _ => Some("≥"),
+    }
+}
+
 /// The findings at a glance: one row each with its value ± σ, its kind, the share of the
 /// baseline's excess misfit it removes and whether it is named as a cause; nothing without
 /// findings.
@@ -296,12 +305,7 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
         } else {
             "**found: a cause**"
         };
-        let bound = match f.scale_bound {
-            Some("at most") => Some("≤"),
-            Some(_) => Some("≥"),
-            None => None,
-        };
-        let value = match (f.scale, bound) {
+        let value = match (f.scale, bound_sign(f)) {
             (Some(k), Some(cmp)) if f.unit == "x stated" => {
                 format!("{cmp} {}× the stated σ (a bound, no estimate)", sig3(k))
             }
@@ -600,9 +604,8 @@ fn findings_section(e: &Explanation, s: &mut String) {
             })
             .unwrap_or_default();
         // a level at its search bound is a bound, not an estimate
-        let value = match f.scale_bound {
-            Some("at most") => format!("≤ {}", num(f.estimate)),
-            Some(_) => format!("≥ {}", num(f.estimate)),
+        let value = match bound_sign(f) {
+            Some(cmp) => format!("{cmp} {}", num(f.estimate)),
             None => format!("{} ± {}", num(f.estimate), num(f.sigma)),
         };
         s.push_str(&format!(
