@@ -530,8 +530,11 @@ struct Engine<'a> {
     f_sum: Vector3<f64>,
     /// Σ of the step's body rates [rad/s] (its mean is the point's w_b).
     w_sum: Vector3<f64>,
-    /// The solution's velocity over the last second, for the point's acceleration a_ned.
+    /// The mechanisation's velocity over the last second, for the point's acceleration a_ned.
     accel: crate::nav::nav_point::AccelWindow,
+    /// The velocity the mechanisation alone gives [m/s]: the start's plus every step's change,
+    /// without the updates' corrections (whose jumps are not the vehicle's acceleration).
+    mech_v: Vector3<f64>,
     in_step: usize,
     step_t0: f64,
     /// The solution's velocity at the start of the step [m/s] (for the step's acceleration).
@@ -607,6 +610,7 @@ impl<'a> Engine<'a> {
             f_sum: Vector3::zeros(),
             w_sum: Vector3::zeros(),
             accel: crate::nav::nav_point::AccelWindow::default(),
+            mech_v: start.v,
             in_step: 0,
             step_t0: start.t,
             step_v0: start.v,
@@ -675,7 +679,8 @@ impl<'a> Engine<'a> {
         let f_mean = self.f_sum / self.in_step as f64;
         self.np.update(s.lat, s.h, s.v, &s.dcm(), &f_mean);
         self.np.set_rate(&(self.w_sum / self.in_step as f64));
-        self.np.set_acceleration(&self.accel.push(t, s.v));
+        self.mech_v += s.v - self.step_v0;
+        self.np.set_acceleration(&self.accel.push(t, self.mech_v));
         if step_dt > 0.0 {
             self.np
                 .set_step_acceleration(&((s.v - self.step_v0) / step_dt));
