@@ -183,9 +183,16 @@ impl DataOptions {
         if use_vel && self.zupt.is_some() {
             bail!("--zupt and GNSS velocity aiding both give the velocity: choose one (--aid-use pos keeps --zupt)");
         }
+        // a known time offset re-stamps the fixes: the one stamped t is the trajectory at t + dt,
+        // so the filter takes it there (exact to every order, where the H of dt_gnss is first
+        // order in dt)
+        let shift = self.gnss_delay_s()?.unwrap_or(0.0);
         let fixes = fixes
             .into_iter()
-            .map(|(p, v)| (p, if use_vel { v } else { None }))
+            .map(|(mut p, v)| {
+                p.t += shift;
+                (p, if use_vel { v } else { None })
+            })
             .collect();
         Ok(AidPlan::Fixes(fixes, zupt, use_pos))
     }

@@ -170,7 +170,8 @@ pub struct DataOptions {
     #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub outage: Vec<String>,
     /// Known IMU–GNSS time offset with its unit (`92 ms`, `0.092 s`): a fix stamped t is the
-    /// trajectory at t + OFFSET (the spec term dt_gnss), applied in the residuals; needs --aid.
+    /// trajectory at t + OFFSET (the spec term dt_gnss), applied by re-stamping the fixes
+    /// (exact, where the term's H is first order); needs --aid.
     #[cfg_attr(feature = "cli", arg(long, allow_hyphen_values = true))]
     pub gnss_delay: Option<String>,
     /// Known GNSS antenna lever arm, IMU to antenna in the body frame (FRD): X,Y,Z [m] (the spec

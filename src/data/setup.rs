@@ -46,27 +46,51 @@ pub fn apply_opened(
 }
 
 impl DataOptions {
-    /// The known GNSS term values of `--gnss-delay` and `--lever-arm`: (term index, SI), each
-    /// checked for syntax and physics.
+    /// The known IMU–GNSS time offset of `--gnss-delay` [s], checked for syntax and physics:
+    /// the fixes are re-stamped by it (a fix stamped t is taken at t + dt).
+    pub fn gnss_delay_s(&self) -> Result<Option<f64>> {
+        let Some(text) = &self.gnss_delay else {
+            return Ok(None);
+        };
+        let dt = crate::io::units::parse_quantity_as(text, "s").with_context(|| {
+            format!(
+                "--gnss-delay `{text}`: expected a time with its unit, e.g. `92 ms` or `0.092 s`"
+            )
+        })?;
+        if !dt.is_finite() || dt.abs() > 1.0 {
+            bail!(
+                "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second difference belongs in --clock-offset)"
+            );
+        }
+        if dt != 0.0 && dt.abs() < 1e-3 {
+            bail!(
+                "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
+                dt * 1e3
+            );
+        }
+        if !self.has_gnss() {
+            bail!("--gnss-delay and --lever-arm describe a GNSS receiver: they need --aid (a GNSS file)");
+        }
+        Ok(Some(dt))
+    }
+
+    /// The known aiding term values of `--gnss-delay`, `--lever-arm` and `--mounting`: (term
+    /// index, SI), each checked for syntax and physics. The time offset is applied by
+    /// re-stamping the fixes ([`DataOptions::gnss_delay_s`]), the others in the residuals
+    /// ([`DataOptions::residual_known`]).
     pub fn known_gnss(&self) -> Result<Vec<(usize, f64)>> {
         let mut out = Vec::new();
-        if let Some(text) = &self.gnss_delay {
-            let dt = crate::io::units::parse_quantity_as(text, "s").with_context(|| {
-                format!("--gnss-delay `{text}`: expected a time with its unit, e.g. `92 ms` or `0.092 s`")
-            })?;
-            if !dt.is_finite() || dt.abs() > 1.0 {
-                bail!(
-                    "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second difference belongs in --clock-offset)"
-                );
-            }
-            if dt != 0.0 && dt.abs() < 1e-3 {
-                bail!(
-                    "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
-                    dt * 1e3
-                );
-            }
+        if let Some(dt) = self.gnss_delay_s()? {
             out.push((term("dt_gnss", "--gnss-delay")?, dt));
         }
+        out.extend(self.residual_known()?);
+        Ok(out)
+    }
+
+    /// The known aiding term values applied in the residuals (z − H θ): `--lever-arm` and
+    /// `--mounting`, (term index, SI).
+    pub fn residual_known(&self) -> Result<Vec<(usize, f64)>> {
+        let mut out = Vec::new();
         if let Some(l) = &self.lever_arm {
             if l.len() != 3 {
                 bail!(
@@ -169,8 +193,13 @@ impl DataOptions {
         }
         for (t, v) in self.known_gnss()? {
             let info = &common::TERMS[t];
+            let how = if info.name == "dt_gnss" {
+                "the fixes re-stamped by it, exact to every order"
+            } else {
+                "applied in the residuals"
+            };
             lines.push(format!(
-                "known GNSS value applied in the residuals: {} = {} {} ({}); a {} state in the model estimates what is left on top of it",
+                "known GNSS value, {how}: {} = {} {} ({}); a {} state in the model estimates what is left on top of it",
                 info.name,
                 v / info.display_to_si,
                 info.display,
@@ -326,7 +355,7 @@ impl DataOptions {
             None => Mode::OpenLoop,
         };
         cfg.step_s = args.step_given()?.unwrap_or(DEFAULT_STEP_S);
-        cfg.known_gnss = args.known_gnss()?;
+        cfg.known_gnss = args.residual_known()?;
         if !args.has_gnss() {
             if let Some(t) = model.states.iter().find_map(|s| match *s {
                 crate::model::catalog::StateRef::Term(k)

@@ -145,7 +145,8 @@ impl Finding {
 #[derive(Debug, Clone, Serialize)]
 pub struct Consistency {
     /// The split: `time` (halves of the aiding epochs), `speed` (below and from the median
-    /// aided speed), `motion` (by the body axis of the most recent rotation); for noise levels
+    /// aided speed), `motion` (by the body axis of the most recent rotation), `manoeuvre`,
+    /// `measurement` (by the kind of fix, for the aiding's own terms); for noise levels
     /// `rotation` (rotating or turning, or not), `time` and `vibration` (vibrating or quiet).
     pub split: String,
     /// The groups with information, each with its estimate and σ (display unit); a group
@@ -292,6 +293,9 @@ pub struct Explanation {
     /// Open loop about a navigation whose attitude error estimate passed 10°: why the linear
     /// error model may not hold, in words (None in closed loop or within small angles).
     pub linearisation: Option<String>,
+    /// The time offset fitted to every order by re-stamping the fixes (explain run again on
+    /// them); None when no offset was found or it was too small to refit.
+    pub restamp: Option<super::restamp::Restamp>,
     /// Normalised innovations of the baseline and extended passes, for plots.
     #[serde(skip)]
     pub innovations_before: Vec<Normalised>,
@@ -535,6 +539,7 @@ impl Consistency {
                     "grouped by {}, the updates give {list} (χ² {} on {} degrees of freedom): it does not hold across the data",
                     match self.split.as_str() {
                         "motion" => "the last rotation's axis",
+                        "measurement" => "the kind of fix",
                         other => other,
                     },
                     sig3(self.chi2),

@@ -30,6 +30,7 @@ mod diagnostics;
 mod findings;
 mod noise;
 mod raw_noise;
+pub mod restamp;
 mod selection;
 mod signatures;
 mod words;
@@ -347,6 +348,7 @@ fn run_pass_watched(
     }
     splits.push(Split::Motion);
     splits.push(Split::Manoeuvre);
+    splits.push(Split::Measurement);
     let mut sig = Signatures::new(model, cands, &splits);
     let mut samples = data.imu.samples()?;
     let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
@@ -395,10 +397,9 @@ pub fn explain(
         opts,
     };
     let mut stage = baseline_and_select(&first, &cands, progress)?;
-    // a baseline term the data put beyond a few of its prior σ even with the findings added:
-    // its prior is too tight for this sensor and the baseline biased (before the findings, such
-    // a term may only be absorbing what a missing term does); explain runs again with priors
-    // that hold the data's values
+    // a baseline term beyond a few prior σ even with the findings added: its prior is too tight
+    // for this sensor and the baseline biased (before the findings it may only absorb what a
+    // missing term does); explain runs again with priors that hold the data's values
     let tight = tight_priors(
         baseline,
         &stage.r.model,
@@ -517,6 +518,7 @@ pub fn explain(
             None => misfit_unexplained.map(|u| u.max(0.0)),
         },
         stand_ins_left_out: rerun.is_some(),
+        restamp: None,
         baseline_priors_tight: tight,
         baseline_priors_widened: widened_kept,
         baseline_priors_gain: prior_gain,
@@ -1067,7 +1069,8 @@ fn joined(a: Option<String>, b: Option<String>) -> Option<String> {
     }
 }
 
-/// For each cause among `judged` (one per named term of `r`) that is a GNSS term, the GNSS
+/// For each GNSS finding among `judged` (one per named term of `r`; a cause or a stand-in, not
+/// an unattributed class), the GNSS
 /// library terms withheld from the candidates `cands` are tried in its place, one filter pass
 /// each: when one fits the data as well (log-likelihood within 2 of the rounds' model), the
 /// finding may stand in for it (a body-x lever arm moves the fixes in turns as speed × a time
@@ -1083,7 +1086,8 @@ fn withheld_rivals(
     let mut out = vec![None; judged.len()];
     for (k, (f, n)) in judged.iter().zip(&r.named).enumerate() {
         let info = &common::TERMS[n.term];
-        if !f.is_cause() || !info.sensor.enters_h() {
+        // (a stand-in too: its words should name the rival that may take its place)
+        if f.not_attributed.is_some() || !info.sensor.enters_h() {
             continue;
         }
         let rivals = (0..common::TERMS.len()).filter(|&w| {
@@ -1750,9 +1754,12 @@ fn complete_findings(
             scale_bound: None,
             halves: split_halves(&n.splits, "time"),
             speed_halves: split_halves(&n.splits, "speed"),
+            // the kinds of fix test the aiding's own terms (a sensor term's information from
+            // positions and from velocities is one signature seen twice)
             consistency: n
                 .splits
                 .iter()
+                .filter(|(split, _)| *split != Split::Measurement || info.sensor.enters_h())
                 .map(|(split, est)| {
                     Consistency::test(split.name(), &|k| split.group_label(k), est)
                 })
@@ -1962,6 +1969,30 @@ fn model_error_series(run: &FilterRun) -> Vec<(f64, f64, f64)> {
             })
         })
         .collect()
+}
+
+/// Term `term`'s estimates (display unit) from each kind of fix alone (positions, velocities,
+/// attitudes) through `model`'s filter on these data, each with the others' information left
+/// out, and whether they describe one value (the findings' split test): a time offset of the
+/// fixes must be one value for the receiver's positions and its velocities.
+pub fn measurement_consistency(
+    model: &Model,
+    term: usize,
+    data: &ExplainData,
+    cfg: &FilterConfig,
+    opts: &ExplainOptions,
+) -> anyhow::Result<Consistency> {
+    let pass = run_pass(model, &[term], data, cfg, &mut |_| {})?;
+    let sc = selection::scaled(&pass.sig, opts);
+    let (split, est) = selection::split_estimates(&sc, &[term], 0, &[])
+        .into_iter()
+        .find(|(s, _)| *s == Split::Measurement)
+        .expect("the pass keeps the split by measurement");
+    Ok(Consistency::test(
+        split.name(),
+        &|k| split.group_label(k),
+        &est,
+    ))
 }
 
 /// Information (SI, 1/θ²) the signature of term `term` carries through `model`'s filter on

@@ -85,6 +85,21 @@ pub(super) enum Split {
     /// By manoeuvre: the updates since each rotation began (before the first, then one group
     /// per rotation, the last of [`MAX_MANOEUVRES`] holding the rest).
     Manoeuvre,
+    /// By the kind of fix: positions, velocities, attitudes (a timing, lever arm or mounting of
+    /// the aiding moves each kind by its own H; one value must fit them all).
+    Measurement,
+}
+
+/// The group of [`Split::Measurement`] of an update of measurement `meas`: 0 position,
+/// 1 velocity (NED or body), 2 attitude or any other.
+fn measurement_group(meas: &str) -> usize {
+    if meas.starts_with("pos") {
+        0
+    } else if meas.starts_with("vel") {
+        1
+    } else {
+        2
+    }
 }
 
 /// Most groups of [`Split::Manoeuvre`].
@@ -98,6 +113,7 @@ impl Split {
             Split::Speed(_) => "speed",
             Split::Motion => "motion",
             Split::Manoeuvre => "manoeuvre",
+            Split::Measurement => "measurement",
         }
     }
 
@@ -107,6 +123,7 @@ impl Split {
             Split::Time(_) | Split::Speed(_) => 2,
             Split::Motion => 4,
             Split::Manoeuvre => MAX_MANOEUVRES,
+            Split::Measurement => 3,
         }
     }
 
@@ -127,6 +144,9 @@ impl Split {
             (Split::Manoeuvre, 0) => "before any rotation".into(),
             (Split::Manoeuvre, k) if k + 1 == MAX_MANOEUVRES => format!("from rotation {k} on"),
             (Split::Manoeuvre, k) => format!("rotation {k}"),
+            (Split::Measurement, 0) => "from the position fixes".into(),
+            (Split::Measurement, 1) => "from the velocity fixes".into(),
+            (Split::Measurement, _) => "from the attitude fixes".into(),
         }
     }
 }
@@ -385,6 +405,7 @@ impl Observer for Signatures {
                 Split::Speed(v_half) => usize::from(speed >= v_half),
                 Split::Motion => axis,
                 Split::Manoeuvre => manoeuvre,
+                Split::Measurement => measurement_group(meas),
             };
             let (info, score) = (&mut acc.info[k], &mut acc.score[k]);
             for a in 0..m {

@@ -51,6 +51,7 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         "not_testable": e.not_testable,
         "implausible": e.implausible,
         "linearisation": e.linearisation,
+        "restamp": e.restamp,
         "unconfirmed": e.unconfirmed
             .iter()
             .map(|(t, g, p)| json!({"term": t, "two_delta_loglik_with_occam": g, "threshold": p}))
@@ -99,6 +100,19 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
          # and rebuild; then `--model {base}_explained{}`.\n",
         if vertical { "+vertical" } else { "" }
     );
+    let offset_cause = e
+        .findings
+        .iter()
+        .any(|f| f.term == "dt_gnss" && f.is_cause());
+    if let (Some(r), true) = (&e.restamp, offset_cause) {
+        let shift = r.passes.last().map_or(0.0, |p| p[0]);
+        s.push_str(&format!(
+            "# dt_gnss was fitted on the fixes re-stamped by {} ms (its first-order H falls short at\n\
+             # this offset): run the model with --gnss-delay '{} ms'; its dt_gnss state holds what is left.\n",
+            crate::explain::sig3(shift),
+            crate::explain::sig3(shift)
+        ));
+    }
     for f in e.findings.iter().filter(|f| f.stand_in.is_some()) {
         s.push_str(&format!(
             "# {} is left out: it probably stands in for an effect the candidates do not describe.\n",
