@@ -93,7 +93,7 @@ pub fn run(args: &FilterArgs) -> Result<()> {
     let run = filter_pass(&model, &cfg, &mut inputs, &mut nav, &mut files)?;
     if let Some(tr) = inputs.truth.take() {
         tr.finish()?;
-        check_truth_coverage(&files.errors)?;
+        check_truth_coverage(&files.errors, args.data.gnss_delay.as_deref())?;
     }
     let (t_first, t_last) = (inputs.imu.first_t(), inputs.imu.last_t());
     sinsmodel::data::check_inside(files.errors.len(), inputs.aid.len(), start.t, t_last)?;
@@ -323,13 +323,17 @@ fn written(with_truth: bool, with_outages: bool) -> Vec<&'static str> {
     names
 }
 
-/// The truth must have a row at the update epochs: none is an error (another clock?), some
-/// missing a warning.
-fn check_truth_coverage(errors: &[(f64, Option<[f64; 2]>)]) -> Result<()> {
+/// The truth must have a row at the update epochs: none is an error (another clock, or fixes
+/// re-stamped by `delay`, `--gnss-delay`, between its rows?), some missing a warning.
+fn check_truth_coverage(errors: &[(f64, Option<[f64; 2]>)], delay: Option<&str>) -> Result<()> {
     let covered = errors.iter().filter(|e| e.1.is_some()).count();
     if covered == 0 && !errors.is_empty() {
+        let why = match delay {
+            Some(d) => format!("--gnss-delay `{d}` re-stamps the fixes, and their epochs now fall between the truth's rows: give the truth at the IMU rate, or leave --truth out"),
+            None => "is it on the IMU's and the aiding's clock?".to_string(),
+        };
         anyhow::bail!(
-            "--truth: the truth file has no row at any of the {} update epochs ({:.3} .. {:.3} s): is it on the IMU's and the aiding's clock?",
+            "--truth: the truth file has no row at any of the {} update epochs ({:.3} .. {:.3} s): {why}",
             errors.len(),
             errors[0].0,
             errors[errors.len() - 1].0

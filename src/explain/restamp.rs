@@ -19,20 +19,34 @@ pub const MAX_RESTAMPS: usize = 4;
 /// The largest total re-stamp [s] explain tries (`--gnss-delay`'s bound).
 const MAX_SHIFT_S: f64 = 1.0;
 
+/// One run on re-stamped fixes.
+#[derive(Debug, Clone, Serialize)]
+pub struct Pass {
+    /// The shift the fixes carried [ms] (the user's `--gnss-delay` on the first run).
+    pub shift_ms: f64,
+    /// The offset the run fitted on top [ms]: its dt_gnss cause, else its candidate test alone.
+    pub estimate_ms: f64,
+    /// Its σ [ms].
+    pub sigma_ms: f64,
+    /// The run's other GNSS causes that take up the candidate test's offset (it is then no
+    /// offset on top: the run's causes fit that misfit).
+    pub taken_up_by: Vec<String>,
+}
+
 /// How a time offset was fitted by re-stamping the fixes.
 #[derive(Debug, Clone, Serialize)]
 pub struct Restamp {
-    /// Each run: the shift the fixes carried [ms], and the offset it fitted on top [ms] with
-    /// its σ [ms] (the last run's from its candidate test alone when it names none).
-    pub passes: Vec<[f64; 3]>,
-    /// The offset in all [ms]: the last shift plus what the last run fitted on top.
+    /// The runs, the first on the fixes as given.
+    pub passes: Vec<Pass>,
+    /// The offset in all [ms]: the last shift plus what the last run fitted on top (none when
+    /// other causes take it up).
     pub total_ms: f64,
     /// Its σ [ms] (the last run's).
     pub sigma_ms: f64,
     /// Causes the first run (dt_gnss to first order) named that the re-stamped fixes do not
     /// bear out: (term, its first-run words).
     pub dropped: Vec<(String, String)>,
-    /// Mean NIS of the baseline on the fixes as stamped (the first run's).
+    /// Mean NIS of the baseline on the fixes as given (the first run's).
     pub nis_as_stamped: f64,
 }
 
@@ -44,12 +58,43 @@ fn offset_cause(e: &Explanation) -> Option<(f64, f64)> {
         .map(|f| (f.estimate, f.sigma))
 }
 
+/// What run `e` (on fixes shifted by `shift_ms`) leaves of the offset: its dt_gnss cause, else
+/// its candidate test alone, which the run's other GNSS causes may take up.
+fn left_by(e: &Explanation, shift_ms: f64) -> Pass {
+    if let Some((d, s)) = offset_cause(e) {
+        return Pass {
+            shift_ms,
+            estimate_ms: d,
+            sigma_ms: s,
+            taken_up_by: Vec::new(),
+        };
+    }
+    let (d, s) = e
+        .candidates
+        .iter()
+        .find(|c| c.term == "dt_gnss")
+        .map_or((0.0, f64::NAN), |c| (c.glr_estimate, c.glr_sigma));
+    let taken_up_by = e
+        .findings
+        .iter()
+        .filter(|f| f.is_cause() && f.kind == "measurement" && f.term != "dt_gnss")
+        .map(|f| f.term.clone())
+        .collect();
+    Pass {
+        shift_ms,
+        estimate_ms: d,
+        sigma_ms: s,
+        taken_up_by,
+    }
+}
+
 /// explain with a time offset fitted to every order: `run(shift)` is explain on the fixes
-/// re-stamped by `shift` [s] (`given` [s]: the user's `--gnss-delay`, 0 without). When the
-/// first run names dt_gnss as a cause of at least [`RESTAMP_MIN_S`], the fixes are re-stamped
-/// by it and explain runs again, up to [`MAX_RESTAMPS`] times, while what is left (the run's
-/// dt_gnss cause, else its candidate test alone) is at least that and beyond 3σ; the last run
-/// is the answer, with dt_gnss in all as its first finding.
+/// re-stamped by `shift` [s] (`given` [s]: the user's `--gnss-delay`, 0 without), `by_fix(shift)`
+/// the test of what is left there from each kind of fix alone. When the first run names
+/// dt_gnss as a cause of at least [`RESTAMP_MIN_S`], the fixes are re-stamped by it and explain
+/// runs again, up to [`MAX_RESTAMPS`] times, while what is left (the run's dt_gnss cause, else
+/// its candidate test alone unless the run's other GNSS causes take it up) is at least that
+/// and beyond 3σ; the last run is the answer, with dt_gnss in all as its first finding.
 pub fn explain_restamped(
     given: f64,
     mut run: impl FnMut(f64) -> anyhow::Result<Explanation>,
@@ -63,62 +108,84 @@ pub fn explain_restamped(
         return Ok(first);
     }
     let mut shift = given + d * 1e-3;
-    let mut passes = vec![[given * 1e3, d, s]];
+    let mut passes = vec![Pass {
+        shift_ms: given * 1e3,
+        estimate_ms: d,
+        sigma_ms: s,
+        taken_up_by: Vec::new(),
+    }];
     for _ in 0..MAX_RESTAMPS {
         if shift.abs() > MAX_SHIFT_S {
-            break;
+            let why = format!(
+                "the offset found in all, {} ms, is beyond ±1 s, the most explain re-stamps the fixes by (the spec's limit of dt_gnss): check the clocks (a whole second between the IMU's and the receiver's?)",
+                sig3(shift * 1e3)
+            );
+            return Ok(unsettled(first, &passes, &why));
         }
         let e = run(shift)?;
-        // what is left: the run's finding, else its candidate test alone
-        let (d, s) = offset_cause(&e).unwrap_or_else(|| {
-            e.candidates
-                .iter()
-                .find(|c| c.term == "dt_gnss")
-                .map_or((0.0, f64::NAN), |c| (c.glr_estimate, c.glr_sigma))
-        });
-        passes.push([shift * 1e3, d, s]);
-        if d.abs() * 1e-3 >= RESTAMP_MIN_S && d.abs() > 3.0 * s {
+        let left = left_by(&e, shift * 1e3);
+        let (d, s) = (left.estimate_ms, left.sigma_ms);
+        let more =
+            left.taken_up_by.is_empty() && d.abs() * 1e-3 >= RESTAMP_MIN_S && d.abs() > 3.0 * s;
+        passes.push(left);
+        if more {
             // still an offset to take out
             shift += d * 1e-3;
             continue;
         }
-        let total = shift * 1e3 + d;
-        // an offset the re-stamped fixes bring back to nothing was no offset: the first run
-        // stands (its words say what the offset was fitted as)
-        if total.abs() <= 3.0 * s || !s.is_finite() {
-            return Ok(first);
+        if !s.is_finite() {
+            return Ok(unsettled(
+                first,
+                &passes,
+                "the last run gives no σ for what is left",
+            ));
         }
         // one offset for every kind of fix: what is left on the re-stamped fixes, from the
         // positions alone and from the velocities alone
         let split = by_fix(shift)?;
-        return Ok(fold(&first, e, passes, split));
+        return Ok(fold(&first, e, passes, split, given * 1e3));
     }
-    // no convergence within the runs (or beyond ±1 s): the first run stands, said
-    let mut e = first;
+    let why = format!(
+        "{} runs on re-stamped fixes did not settle",
+        passes.len() - 1
+    );
+    Ok(unsettled(first, &passes, &why))
+}
+
+/// The first run `e`, its summary opened by why the re-stamping of `passes` did not settle.
+fn unsettled(mut e: Explanation, passes: &[Pass], why: &str) -> Explanation {
     e.summary.insert(
         0,
         format!(
-            "The time offset was refitted on re-stamped fixes {} times without settling (shifts {} ms): the findings below are the first run's, with the offset to first order; read it, and what stands beside it, with care.",
-            passes.len() - 1,
+            "The time offset was refitted on re-stamped fixes (shifts {} ms), but {why}: the findings below are the first run's, with the offset to first order; read it, and what stands beside it, with care.",
             passes
                 .iter()
-                .map(|p| sig3(p[0]))
+                .map(|p| sig3(p.shift_ms))
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
     );
-    Ok(e)
+    e
 }
 
 /// The last run `last` (on fixes re-stamped by its pass's shift) with dt_gnss in all as its
-/// first finding: the first run's finding with the offset, σ, share and words of all passes.
+/// first finding: the first run's finding with the offset, σ, share and words of all passes;
+/// a stand-in when the kinds of fix (`split`) want different offsets, and no cause when the
+/// offset in all is none (`given_ms`: the user's `--gnss-delay`, then not borne out).
 fn fold(
     first: &Explanation,
     mut last: Explanation,
-    passes: Vec<[f64; 3]>,
+    passes: Vec<Pass>,
     split: Consistency,
+    given_ms: f64,
 ) -> Explanation {
-    let [shift, rest, sigma] = *passes.last().expect("at least two passes");
+    let end = passes.last().expect("at least two passes");
+    let (shift, sigma) = (end.shift_ms, end.sigma_ms);
+    let rest = if end.taken_up_by.is_empty() {
+        end.estimate_ms
+    } else {
+        0.0
+    };
     let total = shift + rest;
     let mut f: Finding = first
         .findings
@@ -130,6 +197,9 @@ fn fold(
     f.estimate = total;
     f.sigma = sigma;
     f.misfit_share = (nis0 > 1.0).then(|| (nis0 - last.baseline.nis_mean) / (nis0 - 1.0));
+    // the evidence of the re-stamp: the baseline's log-likelihood on the re-stamped fixes
+    // against the fixes as given
+    f.two_delta_loglik = 2.0 * (last.baseline.loglik - first.baseline.loglik);
     let dropped: Vec<(String, String)> = first
         .findings
         .iter()
@@ -145,12 +215,21 @@ fn fold(
     let steps: Vec<String> = passes
         .iter()
         .map(|p| {
-            let on = if p[0] == 0.0 {
+            let on = if p.shift_ms == 0.0 {
                 "on the fixes as stamped".to_string()
             } else {
-                format!("on the fixes shifted by {} ms", sig3(p[0]))
+                format!("on the fixes shifted by {} ms", sig3(p.shift_ms))
             };
-            format!("{} ± {} ms {on}", sig3(p[1]), sig3(p[2]))
+            let taken = if p.taken_up_by.is_empty() {
+                String::new()
+            } else {
+                format!(" alone, which {} there take up", p.taken_up_by.join(", "))
+            };
+            format!(
+                "{} ± {} ms {on}{taken}",
+                sig3(p.estimate_ms),
+                sig3(p.sigma_ms)
+            )
         })
         .collect();
     f.headline = format!(
@@ -173,14 +252,68 @@ fn fold(
             ". The first run, with the offset to first order, also named {}: on the re-stamped fixes {} not, so {} stood in for the offset's higher orders",
             dropped
                 .iter()
-                .map(|(_, h)| h.as_str())
+                .map(|(t, h)| format!("{t} ({h})"))
                 .collect::<Vec<_>>()
                 .join(", "),
             if dropped.len() == 1 { "it is" } else { "they are" },
             if dropped.len() == 1 { "it" } else { "they" },
         ));
     }
-    if !split.holds {
+    judge(&mut f, (total, sigma, shift), given_ms, &split);
+    f.consistency.retain(|c| c.split != split.split);
+    f.consistency.push(split);
+    last.findings.retain(|g| g.term != "dt_gnss");
+    last.findings.insert(0, f);
+    last.restamp = Some(Restamp {
+        passes,
+        total_ms: total,
+        sigma_ms: sigma,
+        dropped,
+        nis_as_stamped: nis0,
+    });
+    last.summary = summary(&last);
+    last.summary.insert(
+        0,
+        format!(
+            "The GNSS fixes were re-stamped by {} ms, the time offset the runs found (`--gnss-delay '{} ms'` does the same; {} ± {} ms more is left on top, in the offset's value below): the baseline pass, the candidates and every other finding below are on the re-stamped fixes; the baseline's mean NIS on the fixes as given was {}.",
+            sig3(shift),
+            sig3(shift),
+            sig3(rest),
+            sig3(sigma),
+            sig3(nis0)
+        ),
+    );
+    last
+}
+
+/// The verdict on the offset in all `f` ((total, σ, the last shift) [ms]): no cause when the
+/// fixes want none in all (`given_ms`: the user's `--gnss-delay`, then not borne out), a
+/// stand-in when the kinds of fix (`split`) want different ones.
+fn judge(
+    f: &mut Finding,
+    (total, sigma, shift): (f64, f64, f64),
+    given_ms: f64,
+    split: &Consistency,
+) {
+    if total.abs() <= 3.0 * sigma {
+        // the re-stamped fixes want no offset in all
+        let why = if given_ms != 0.0 {
+            format!(
+                "in all the fixes want no offset ({} ± {} ms): the --gnss-delay given, {} ms, is not borne out, and the fixes as stamped are on the IMU's clock",
+                sig3(total),
+                sig3(sigma),
+                sig3(given_ms)
+            )
+        } else {
+            format!(
+                "in all the fixes want no offset ({} ± {} ms): the first run's was the first-order fit's artefact",
+                sig3(total),
+                sig3(sigma)
+            )
+        };
+        f.words.push_str(&format!(". Not named as a cause: {why}"));
+        f.not_attributed = Some(why);
+    } else if !split.holds {
         // the kinds of fix want different offsets: no one time offset of the receiver
         let by: Vec<String> = split
             .groups
@@ -204,25 +337,4 @@ fn fold(
         ));
         f.stand_in = Some(why);
     }
-    f.consistency.retain(|c| c.split != split.split);
-    f.consistency.push(split);
-    last.findings.retain(|g| g.term != "dt_gnss");
-    last.findings.insert(0, f);
-    last.restamp = Some(Restamp {
-        passes,
-        total_ms: total,
-        sigma_ms: sigma,
-        dropped,
-        nis_as_stamped: nis0,
-    });
-    last.summary = summary(&last);
-    last.summary.insert(
-        0,
-        format!(
-            "The GNSS fixes were re-stamped by {} ms (the time offset explain found, refitted to every order; `--gnss-delay '{} ms'` does the same): the baseline pass and every finding below are on the re-stamped fixes.",
-            sig3(shift),
-            sig3(shift)
-        ),
-    );
-    last
 }

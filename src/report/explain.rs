@@ -105,7 +105,7 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
         .iter()
         .any(|f| f.term == "dt_gnss" && f.is_cause());
     if let (Some(r), true) = (&e.restamp, offset_cause) {
-        let shift = r.passes.last().map_or(0.0, |p| p[0]);
+        let shift = r.passes.last().map_or(0.0, |p| p.shift_ms);
         s.push_str(&format!(
             "# dt_gnss was fitted on the fixes re-stamped by {} ms (its first-order H falls short at\n\
              # this offset): run the model with --gnss-delay '{} ms'; its dt_gnss state holds what is left.\n",
