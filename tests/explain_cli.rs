@@ -928,8 +928,14 @@ fn nine_rotation_turntable(dir: &std::path::Path, seq: &[(&str, i32)]) -> PathBu
         ));
     }
     scen.push_str("[errors]\ntau_x = \"2 ms\"\ntau_y = \"2 ms\"\ntau_z = \"2 ms\"\n[noise]\narw = \"0.01 deg/sqrt(h)\"\nvrw = \"10 ug/sqrt(Hz)\"\n");
-    let scen_path = dir.join("tt.toml");
-    std::fs::write(&scen_path, scen).unwrap();
+    simulated(dir, &scen)
+}
+
+/// `sinsmodel simulate` of the scenario text `scenario`, written to `dir`/scenario.toml, into
+/// `dir`/sim; returns the simulation's directory.
+fn simulated(dir: &Path, scenario: &str) -> PathBuf {
+    let scen_path = dir.join("scenario.toml");
+    std::fs::write(&scen_path, scenario).unwrap();
     let sim = dir.join("sim");
     let (ok, _, stderr) = sinsmodel(&[
         "simulate",
@@ -1049,17 +1055,7 @@ fn simulated_drive(dir: &Path, rate_hz: f64) -> PathBuf {
          [noise]\narw = \"0.1 deg/sqrt(h)\"\nvrw = \"50 ug/sqrt(Hz)\"\n\
          [gnss]\nrate_hz = {rate_hz}\nsigma_ne = \"0.1 m\"\nsigma_d = \"0.2 m\"\nsigma_v = \"0.02 m/s\"\n"
     ));
-    let scenario = dir.join("late.toml");
-    std::fs::write(&scenario, sc).unwrap();
-    let sim = dir.join("sim");
-    let (ok, _, stderr) = sinsmodel(&[
-        "simulate",
-        scenario.to_str().unwrap(),
-        "--out",
-        sim.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
-    sim
+    simulated(dir, &sc)
 }
 
 /// explain (P13, tactical grade, the drive's noise) on the simulated drive `sim` with the

@@ -460,10 +460,15 @@ fn check_plan_at_start(plan: &AidPlan, start: &NavState, note: &mut dyn FnMut(&s
         AidPlan::Fixes(fixes, _, _) => {
             let after = fixes.iter().filter(|f| f.0.t > t0).count();
             if after < 10 {
-                bail!(
-                    "only {after} of {} aiding epochs come after the IMU start ({t0:.3} s); at least 10 are needed (the filter works on innovations)",
-                    fixes.len()
-                );
+                let of = if after == fixes.len() {
+                    format!("the file has only {after} aiding epochs")
+                } else {
+                    format!(
+                        "only {after} of {} aiding epochs come after the IMU start ({t0:.3} s)",
+                        fixes.len()
+                    )
+                };
+                bail!("{of}; at least 10 are needed (the filter works on innovations)");
             }
             // the initial position and the first aiding fix must describe the same place
             if let Some(f) = fixes.iter().map(|f| &f.0).find(|f| f.t > t0) {

@@ -59,17 +59,21 @@ impl DataOptions {
         })?;
         if !dt.is_finite() || dt.abs() > 1.0 {
             bail!(
-                "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second difference belongs in --clock-offset)"
-            );
-        }
-        if dt != 0.0 && dt.abs() < 1e-3 {
-            bail!(
-                "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
-                dt * 1e3
+                "--gnss-delay `{text}`: {dt} s is beyond ±1 s; an IMU–GNSS time offset is milliseconds to a few hundred (ms read as s? a UTC–GPST leap-second or whole-second difference of the clocks belongs in the stamps: --clock-offset for a GNSS_IMU .csv, else the files' own time columns)"
             );
         }
         if !self.has_gnss() {
             bail!("--gnss-delay and --lever-arm describe a GNSS receiver: they need --aid (a GNSS file)");
+        }
+        if dt == 0.0 {
+            // (none: `0 s` and `-0 s` leave the fixes as stamped)
+            return Ok(None);
+        }
+        if dt.abs() < 1e-3 {
+            bail!(
+                "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
+                dt * 1e3
+            );
         }
         Ok(Some(dt))
     }
