@@ -1058,6 +1058,14 @@ fn simulated_drive(dir: &Path, rate_hz: f64) -> PathBuf {
     simulated(dir, &sc)
 }
 
+/// The dt_gnss finding among `findings` (explain's `stderr` in the panic without one).
+fn time_offset<'a>(findings: &'a [serde_json::Value], stderr: &str) -> &'a serde_json::Value {
+    findings
+        .iter()
+        .find(|f| f["term"] == "dt_gnss")
+        .unwrap_or_else(|| panic!("no time offset fitted: {stderr}"))
+}
+
 /// explain (P13, tactical grade, the drive's noise) on the simulated drive `sim` with the
 /// aiding file `aid`, into `out`; returns explain.json and stderr.
 fn explain_drive(
@@ -1110,10 +1118,7 @@ fn a_late_gnss_stamp_is_refitted_to_every_order() {
     let out = dir.join("explain");
     let (v, stderr) = explain_drive(&sim, &aid, &out, &[]);
     let findings = v["findings"].as_array().unwrap();
-    let dt = findings
-        .iter()
-        .find(|f| f["term"] == "dt_gnss")
-        .unwrap_or_else(|| panic!("no time offset named: {stderr}"));
+    let dt = time_offset(findings, &stderr);
     let (ms, sigma) = (
         dt["estimate"].as_f64().unwrap(),
         dt["sigma"].as_f64().unwrap(),
@@ -1179,10 +1184,7 @@ fn a_velocity_latency_of_its_own_is_no_time_offset() {
     let out = dir.join("explain");
     let (v, stderr) = explain_drive(&sim, &aid, &out, &[]);
     let findings = v["findings"].as_array().unwrap();
-    let dt = findings
-        .iter()
-        .find(|f| f["term"] == "dt_gnss")
-        .unwrap_or_else(|| panic!("no time offset fitted: {stderr}"));
+    let dt = time_offset(findings, &stderr);
     let why = dt["stand_in"].as_str().unwrap_or_else(|| panic!("{dt}"));
     eprintln!("positions 0.2 s, velocities 0.3 s late: {why}");
     assert!(
@@ -1214,10 +1216,7 @@ fn a_wrong_known_offset_is_not_borne_out() {
         &["--gnss-delay", "200 ms"],
     );
     let findings = v["findings"].as_array().unwrap();
-    let dt = findings
-        .iter()
-        .find(|f| f["term"] == "dt_gnss")
-        .unwrap_or_else(|| panic!("no time offset fitted: {stderr}"));
+    let dt = time_offset(findings, &stderr);
     let why = dt["not_attributed"]
         .as_str()
         .unwrap_or_else(|| panic!("{dt}"));

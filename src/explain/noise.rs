@@ -237,17 +237,14 @@ fn fit(
     let p: Vec<f64> = fits.iter().map(|f| f.p_holm).collect();
     let adj = stats::holm(&p);
     let bic = (innovations.max(2) as f64).ln();
-    let mut out = cfg.clone();
     for (f, a) in fits.iter_mut().zip(adj) {
         f.p_holm = a;
         f.significant = a <= opts.alpha && f.two_delta_loglik > bic;
-        if f.significant {
-            f.level.apply(model, &mut out, f.scale);
-        }
     }
     // refitted, a level's gain is tested again (it was measured beside the unnamed levels'
     // fits): one no longer significant is no claim, and the others are refitted without it
     let mut named: Vec<bool> = fits.iter().map(|f| f.significant).collect();
+    let mut out = with_levels(model, cfg, &fits, &named);
     refit_and_retest(
         passes,
         cfg,

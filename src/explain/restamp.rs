@@ -51,7 +51,7 @@ pub struct Restamp {
 }
 
 /// The time offset [ms] and its σ [ms] of `e`'s dt_gnss finding when it is a cause.
-fn offset_cause(e: &Explanation) -> Option<(f64, f64)> {
+pub fn offset_cause(e: &Explanation) -> Option<(f64, f64)> {
     e.findings
         .iter()
         .find(|f| f.term == "dt_gnss" && f.is_cause())

@@ -100,10 +100,7 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
          # and rebuild; then `--model {base}_explained{}`.\n",
         if vertical { "+vertical" } else { "" }
     );
-    let offset_cause = e
-        .findings
-        .iter()
-        .any(|f| f.term == "dt_gnss" && f.is_cause());
+    let offset_cause = crate::explain::restamp::offset_cause(e).is_some();
     if let (Some(r), true) = (&e.restamp, offset_cause) {
         let shift = r.passes.last().map_or(0.0, |p| p.shift_ms);
         s.push_str(&format!(
