@@ -105,6 +105,11 @@ pub struct Finding {
     /// the estimate's magnitude rounded up to one significant digit, at most the term's
     /// `limit`), to give with `--prior` if the sensor can have such a value. Null otherwise.
     pub suggested_prior: Option<f64>,
+    /// For a GNSS finding that probably stands in for an IMU–GNSS time offset (the offset,
+    /// fitted to every order on the fixes re-stamped by it, fits the data as well in its
+    /// place): that offset and its σ [ms]; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset_in_place: Option<[f64; 2]>,
     /// Why no member of its equivalence class is named as the cause: the values they would need
     /// differ by 10× or more in prior σ and even the most plausible lies beyond 3 prior σ (the
     /// priors, which do not fit this sensor, would choose, not the data); the finding then

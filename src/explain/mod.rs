@@ -456,8 +456,9 @@ pub fn explain(
     // a GNSS cause that a GNSS term withheld from the candidates fits as well may stand in for it
     let rivals = withheld_rivals(ctx, &r, &judged, &cands, progress)?;
     for (f, rival) in judged.iter_mut().zip(&rivals) {
-        if let Some(why) = rival {
-            f.stand_in = joined(f.stand_in.take(), Some(why.clone()));
+        if let Some(rival) = rival {
+            f.stand_in = joined(f.stand_in.take(), Some(rival.why.clone()));
+            f.offset_in_place = rival.offset;
         }
     }
     let r = without_stand_ins(ctx, r, &judged, progress)?;
@@ -475,16 +476,15 @@ pub fn explain(
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
     keep_stand_ins(ctx, &r, &mut findings, judged, rivals, misfit_unexplained);
     mark_passed_over(&mut findings, &stand_ins, &passed_over);
-    companions_move(ctx, &r, &tests, &mut findings, progress)?;
-    aiding_and_sensor_confounded(ctx, &r, &mut findings, progress)?;
-    value_not_fixed(&mut findings);
+    let offset_in_place = judge_final(ctx, &r, &tests, &mut findings, &cands, progress)?;
     findings.extend(noise_findings);
     let held_by_noise = match &noise_stage {
         Some(noise) => held_only_by_the_stated_noise(ctx, &r, noise, &mut findings, progress)?,
         None => false,
     };
     // a term these rules unname leaves the extended model: its pass is run again without it
-    let (model_name, rerun) = if small_beside_the_unexplained(&mut findings, opts) | held_by_noise {
+    let unnamed = small_beside_the_unexplained(&mut findings, opts) | held_by_noise;
+    let (model_name, rerun) = if unnamed | offset_in_place {
         let applied = noise_stage.as_ref().map_or(&[][..], |x| &x.1[..]);
         causes_only_pass(ctx, &r, &findings, applied, progress)?
     } else {
@@ -710,6 +710,68 @@ fn value_not_fixed(findings: &mut [Finding]) {
     }
 }
 
+/// The rules that judge the findings of the rounds `r` once their values are final (`tests`:
+/// the candidates' tests; `cands`: the candidates): a companion that moves, an aiding term
+/// confounded with a sensor term, a value not fixed, a GNSS cause beside an offset that is none.
+/// Returns whether the last unnamed a cause (its term then leaves the extended model).
+fn judge_final(
+    ctx: &Context,
+    r: &Rounds,
+    tests: &[CandidateTest],
+    findings: &mut [Finding],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<bool> {
+    companions_move(ctx, r, tests, findings, progress)?;
+    aiding_and_sensor_confounded(ctx, r, findings, progress)?;
+    value_not_fixed(findings);
+    offset_stand_ins(ctx, r, findings, cands, progress)
+}
+
+/// Each GNSS cause among `findings` (final, of the rounds `r`) beside which the time offset is
+/// no cause (not named, its value not fixed, or no candidate) is tried with the offset in its
+/// place, fitted to every order on the fixes re-stamped by it: a lever arm along the track
+/// moves the fixes as speed × an offset does, and the rounds may name it first. When the
+/// offset fits the data as well, the finding stands in for it. Returns whether any did.
+fn offset_stand_ins(
+    ctx: &Context,
+    r: &Rounds,
+    findings: &mut [Finding],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<bool> {
+    let term = |name: &str| common::TERMS.iter().position(|t| t.name == name);
+    let Some(w) = term("dt_gnss") else {
+        return Ok(false);
+    };
+    if findings.iter().any(|f| f.term == "dt_gnss" && f.is_cause()) {
+        return Ok(false);
+    }
+    let others: Vec<usize> = findings
+        .iter()
+        .filter(|f| !f.is_cause() && f.term != "dt_gnss")
+        .filter_map(|f| term(&f.term))
+        .collect();
+    let mut any = false;
+    for f in findings.iter_mut().filter(|f| f.is_cause()) {
+        let Some(t) = term(&f.term).filter(|&t| t != w && common::TERMS[t].sensor.enters_h())
+        else {
+            continue;
+        };
+        let Some(rival) = offset_in_place(ctx, r, t, w, &others, cands, progress)? else {
+            continue;
+        };
+        f.stand_in = Some(rival.why);
+        f.offset_in_place = rival.offset;
+        f.suggested_prior = None;
+        let info = &common::TERMS[t];
+        (f.headline, f.words) =
+            finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+        any = true;
+    }
+    Ok(any)
+}
+
 /// Each finding that was judged no cause (`judged`, one per named term of `r`, in order) keeps
 /// the value it was fitted with; its words say what is left now (`unexplained`), with the
 /// withheld GNSS term it may stand in for (`rivals`).
@@ -718,7 +780,7 @@ fn keep_stand_ins(
     r: &Rounds,
     findings: &mut [Finding],
     judged: Vec<Finding>,
-    rivals: Vec<Option<String>>,
+    rivals: Vec<Option<Rival>>,
     unexplained: Option<f64>,
 ) {
     for (((f, j), n), rival) in findings.iter_mut().zip(judged).zip(&r.named).zip(rivals) {
@@ -731,10 +793,10 @@ fn keep_stand_ins(
             .is_none()
             .then(|| suggested_prior(f, ctx.opts))
             .flatten();
-        f.stand_in = f
-            .stand_in
-            .as_ref()
-            .and(joined(stand_in_reason(f, unexplained, ctx.opts), rival));
+        f.stand_in = f.stand_in.as_ref().and(joined(
+            stand_in_reason(f, unexplained, ctx.opts),
+            rival.map(|r| r.why),
+        ));
         let info = &common::TERMS[n.term];
         (f.headline, f.words) =
             finding_words(f, info, prior_sigma(n.term, ctx.opts) / info.display_to_si);
@@ -1070,19 +1132,27 @@ fn joined(a: Option<String>, b: Option<String>) -> Option<String> {
 }
 
 /// For each GNSS finding among `judged` (one per named term of `r`; a cause or a stand-in, not
-/// an unattributed class), the GNSS
-/// library terms withheld from the candidates `cands` are tried in its place, one filter pass
-/// each: when one fits the data as well (log-likelihood within 2 of the rounds' model), the
-/// finding may stand in for it (a body-x lever arm moves the fixes in turns as speed × a time
-/// offset does), and its reason says which, with the value. None where no rival fits.
+/// an unattributed class), the GNSS library terms withheld from the candidates `cands` are
+/// tried in its place, one filter pass each, and so is a time offset that is no cause here:
+/// when one fits the data as well (log-likelihood within 2 of the rounds' model), the finding
+/// may stand in for it (a body-x lever arm moves the fixes in turns as speed × a time offset
+/// does, an accelerometer delay beside it takes the rest), and its reason says which, with the
+/// value. None where no rival fits.
 fn withheld_rivals(
     ctx: &Context,
     r: &Rounds,
     judged: &[Finding],
     cands: &[usize],
     progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<Vec<Option<String>>> {
-    let l_named = r.pass.stats.loglik;
+) -> anyhow::Result<Vec<Option<Rival>>> {
+    let offset = common::TERMS.iter().position(|t| t.name == "dt_gnss");
+    let offset_is_cause = judged.iter().any(|f| f.term == "dt_gnss" && f.is_cause());
+    let stand_ins: Vec<usize> = judged
+        .iter()
+        .zip(&r.named)
+        .filter(|(f, _)| f.stand_in.is_some())
+        .map(|(_, n)| n.term)
+        .collect();
     let mut out = vec![None; judged.len()];
     for (k, (f, n)) in judged.iter().zip(&r.named).enumerate() {
         let info = &common::TERMS[n.term];
@@ -1091,42 +1161,171 @@ fn withheld_rivals(
             continue;
         }
         let rivals = (0..common::TERMS.len()).filter(|&w| {
+            let withheld = !cands.contains(&w) && !r.model.states.contains(&StateRef::Term(w));
             common::TERMS[w].sensor == info.sensor
-                && !cands.contains(&w)
-                && !r.model.states.contains(&StateRef::Term(w))
+                && w != n.term
+                && (withheld || (Some(w) == offset && !offset_is_cause))
         });
         for w in rivals {
-            let rival = &common::TERMS[w];
-            // the rounds' terms beyond the baseline, the finding's replaced by the rival
-            let terms = r.model.states.iter().filter_map(|s| match *s {
-                StateRef::Term(t) if !ctx.baseline.states.contains(s) => {
-                    Some(if t == n.term { w } else { t })
-                }
-                _ => None,
-            });
-            let m = model_with(&ctx.baseline.name, terms)?;
-            let cfg = ctx.extended_config(&m, &r.widened)?;
-            let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
-            let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {
-                continue;
+            let rival = if Some(w) == offset {
+                offset_in_place(ctx, r, n.term, w, &stand_ins, cands, progress)?
+            } else {
+                term_in_place(ctx, r, n.term, w, progress)?.map(|why| Rival { why, offset: None })
             };
-            if p.stats.loglik >= l_named - 2.0 {
-                out[k] = Some(format!(
-                    "{} ({}; not a candidate here) in its place fits the data {}: {} = {} {} gives a log-likelihood {} against {}; offer it as a candidate to tell them apart",
-                    rival.name,
-                    rival.doc,
-                    if p.stats.loglik > l_named + 2.0 { "better" } else { "as well" },
-                    rival.name,
-                    sig3(last.x[i] / rival.display_to_si),
-                    rival.display,
-                    sig3(p.stats.loglik),
-                    sig3(l_named)
-                ));
+            if rival.is_some() {
+                out[k] = rival;
                 break;
             }
         }
     }
     Ok(out)
+}
+
+/// Why the finding of term `t` may stand in for `w` (a GNSS term withheld from the candidates)
+/// when the rounds' model with `w` in its place fits the data as well, else None.
+fn term_in_place(
+    ctx: &Context,
+    r: &Rounds,
+    t: usize,
+    w: usize,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Option<String>> {
+    let rival = &common::TERMS[w];
+    // the rounds' terms beyond the baseline, the finding's replaced by the rival
+    let terms = extra_terms(ctx, r).map(|x| if x == t { w } else { x });
+    let m = model_with(&ctx.baseline.name, terms)?;
+    let cfg = ctx.extended_config(&m, &r.widened)?;
+    let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
+    let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {
+        return Ok(None);
+    };
+    Ok(rival_words(
+        rival,
+        true,
+        last.x[i],
+        "",
+        p.stats.loglik,
+        r.pass.stats.loglik,
+    ))
+}
+
+/// Why the finding of term `t` may stand in for a time offset (term `w`, no cause here) when
+/// the offset fits the data as well in its place, fitted to every order on the fixes re-stamped
+/// by it: first with the rounds' other terms but the stand-ins `stand_ins` (an accelerometer
+/// delay takes the along-track part of an offset), then, when that falls short and other terms
+/// are left, alone (a delay named a cause beside the lever arm takes that part too); else None.
+fn offset_in_place(
+    ctx: &Context,
+    r: &Rounds,
+    t: usize,
+    w: usize,
+    stand_ins: &[usize],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Option<Rival>> {
+    let rival = &common::TERMS[w];
+    let others: Vec<usize> = extra_terms(ctx, r)
+        .filter(|x| *x != t && *x != w && !stand_ins.contains(x))
+        .collect();
+    let dropped: Vec<&str> = extra_terms(ctx, r)
+        .filter(|x| *x != t && *x != w && stand_ins.contains(x))
+        .map(|x| common::TERMS[x].name)
+        .collect();
+    let all: Vec<&str> = extra_terms(ctx, r)
+        .filter(|x| *x != t && *x != w)
+        .map(|x| common::TERMS[x].name)
+        .collect();
+    let tries = [
+        (&others[..], dropped),
+        (&[][..], if others.is_empty() { vec![] } else { all }),
+    ];
+    for (k, (keep, without)) in tries.into_iter().enumerate() {
+        if k == 1 && without.is_empty() {
+            break;
+        }
+        let m = model_with(&ctx.baseline.name, keep.iter().copied().chain([w]))?;
+        let cfg = ctx.extended_config(&m, &r.widened)?;
+        let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
+        let Some(i) = m.index_of(rival.name) else {
+            return Ok(None);
+        };
+        let Some(o) = restamp::rival_offset(ctx.data, &m, i, &cfg, &p, &r.pass, &mut |x| {
+            progress(r.rounds + 1, x)
+        })?
+        else {
+            return Ok(None);
+        };
+        let how = format!(
+            " (± {} {}, fitted to every order on the fixes re-stamped by it{}; log-likelihoods over the fixes both runs take)",
+            sig3(o.sigma_s / rival.display_to_si),
+            rival.display,
+            if without.is_empty() {
+                String::new()
+            } else {
+                format!(", without {}", without.join(", "))
+            }
+        );
+        let withheld = !cands.contains(&w);
+        let unit = 1.0 / rival.display_to_si;
+        let words = rival_words(rival, withheld, o.offset_s, &how, o.loglik, o.loglik_named);
+        if let Some(why) = words {
+            return Ok(Some(Rival {
+                why,
+                offset: Some([o.offset_s * unit, o.sigma_s * unit]),
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// A term that fits the data as well in a finding's place.
+#[derive(Clone)]
+struct Rival {
+    /// Why the finding may stand in for it.
+    why: String,
+    /// For a time offset: its value and σ (display unit, ms).
+    offset: Option<[f64; 2]>,
+}
+
+/// The terms of the rounds' model beyond the baseline.
+fn extra_terms<'a>(ctx: &'a Context, r: &'a Rounds) -> impl Iterator<Item = usize> + 'a {
+    r.model.states.iter().filter_map(|s| match *s {
+        StateRef::Term(t) if !ctx.baseline.states.contains(s) => Some(t),
+        _ => None,
+    })
+}
+
+/// The words of a rival that fits the data as well as the finding (log-likelihood `l_rival`
+/// at least `l_named` − 2) at `value` (SI; `how`: how it was fitted), else None; `withheld`:
+/// it was no candidate.
+fn rival_words(
+    rival: &crate::model::catalog::TermInfo,
+    withheld: bool,
+    value: f64,
+    how: &str,
+    l_rival: f64,
+    l_named: f64,
+) -> Option<String> {
+    (l_rival >= l_named - 2.0).then(|| {
+        format!(
+            "{} ({}; {}) in its place fits the data {}: {} = {} {}{} gives a log-likelihood {} against {}; {}",
+            rival.name,
+            rival.doc,
+            if withheld { "not a candidate here" } else { "a candidate that was not named" },
+            if l_rival > l_named + 2.0 { "better" } else { "as well" },
+            rival.name,
+            sig3(value / rival.display_to_si),
+            rival.display,
+            how,
+            sig3(l_rival),
+            sig3(l_named),
+            if withheld {
+                "offer it as a candidate to tell them apart"
+            } else {
+                "the data do not tell them apart"
+            }
+        )
+    })
 }
 
 /// The instrument terms of `baseline` whose final estimate in `run` (a pass of `model`, the
@@ -1720,6 +1919,7 @@ fn complete_findings(
             prior_sigmas: (estimate / to_display).abs() / prior_sigma(t, ctx.opts),
             stand_in: None,
             suggested_prior: None,
+            offset_in_place: None,
             // the priors choose within a class when they differ by an order of magnitude; they
             // are credible for that only while the chosen member sits within 3 of its prior σ
             not_attributed: (n.prior_ratio >= selection::UNATTRIBUTED_RATIO
@@ -2044,6 +2244,7 @@ mod tests {
             prior_sigmas,
             stand_in: None,
             suggested_prior: None,
+            offset_in_place: None,
             not_attributed: None,
             scale: None,
             scale_interval: None,

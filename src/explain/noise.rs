@@ -1279,6 +1279,7 @@ fn noise_finding(
         prior_sigmas: 0.0,
         stand_in: None,
         suggested_prior: None,
+        offset_in_place: None,
         not_attributed: None,
         scale: Some(f.scale),
         scale_interval: bound.is_none().then_some(f.interval),

@@ -7,6 +7,7 @@
 
 use super::findings::{Consistency, Explanation, Finding};
 use super::words::{sig3, summary};
+use crate::estimate::filter::AidingEpoch;
 use serde::Serialize;
 
 /// Smallest time offset [s] a pass refits on re-stamped fixes: below, the first-order H's
@@ -58,6 +59,19 @@ pub fn offset_cause(e: &Explanation) -> Option<(f64, f64)> {
         .map(|f| (f.estimate, f.sigma))
 }
 
+/// The time offset [ms] and its σ [ms] a GNSS finding of `e` probably stands in for, when the
+/// offset was fitted there but named no cause (a lever arm along the track took its place, say):
+/// the fixes are then re-stamped by it as by a cause.
+fn offset_in_place(e: &Explanation) -> Option<(f64, f64)> {
+    if !e.candidates.iter().any(|c| c.term == "dt_gnss") {
+        return None;
+    }
+    e.findings
+        .iter()
+        .find_map(|f| f.offset_in_place)
+        .map(|[d, s]| (d, s))
+}
+
 /// What run `e` (on fixes shifted by `shift_ms`) leaves of the offset: its dt_gnss cause, else
 /// its candidate test alone, which the run's other GNSS causes may take up.
 fn left_by(e: &Explanation, shift_ms: f64) -> Pass {
@@ -101,7 +115,7 @@ pub fn explain_restamped(
     mut by_fix: impl FnMut(f64) -> anyhow::Result<Consistency>,
 ) -> anyhow::Result<Explanation> {
     let first = run(given)?;
-    let Some((d, s)) = offset_cause(&first) else {
+    let Some((d, s)) = offset_cause(&first).or_else(|| offset_in_place(&first)) else {
         return Ok(first);
     };
     if d.abs() * 1e-3 < RESTAMP_MIN_S {
@@ -187,12 +201,9 @@ fn fold(
         0.0
     };
     let total = shift + rest;
-    let mut f: Finding = first
-        .findings
-        .iter()
-        .find(|f| f.term == "dt_gnss")
-        .expect("the first run named the offset")
-        .clone();
+    let mut f = offset_finding(first);
+    // (the first run's verdict on it, to first order, is replaced by the one below)
+    (f.stand_in, f.not_attributed, f.offset_in_place) = (None, None, None);
     let nis0 = first.baseline.nis_mean;
     f.estimate = total;
     f.sigma = sigma;
@@ -286,6 +297,56 @@ fn fold(
     last
 }
 
+/// The first run `e`'s dt_gnss finding, or, where it named none (a lever arm along the track
+/// took the offset's place), one made from its candidate test and the finding that stands in
+/// for it (the values are set by the caller).
+fn offset_finding(e: &Explanation) -> Finding {
+    if let Some(f) = e.findings.iter().find(|f| f.term == "dt_gnss") {
+        return f.clone();
+    }
+    let g = e
+        .findings
+        .iter()
+        .find(|f| f.offset_in_place.is_some())
+        .expect("the first run named the offset, or a finding standing in for it");
+    let info = crate::model::generated::common::TERMS
+        .iter()
+        .find(|t| t.name == "dt_gnss")
+        .expect("the spec declares dt_gnss");
+    let test = e.candidates.iter().find(|c| c.term == "dt_gnss");
+    let of = |x: fn(&super::findings::CandidateTest) -> f64| test.map_or(f64::NAN, x);
+    let prior = info.sigma / info.display_to_si;
+    let [d, _] = g.offset_in_place.unwrap_or_default();
+    Finding {
+        term: info.name.to_string(),
+        kind: "measurement",
+        unit: info.display.to_string(),
+        llr: of(|c| c.llr),
+        p_value: of(|c| c.p_holm),
+        equivalent: Vec::new(),
+        equivalent_estimates: Vec::new(),
+        glr_estimate: of(|c| c.glr_estimate),
+        glr_sigma: of(|c| c.glr_sigma),
+        confounded_with: None,
+        regressor_mean: 1.0,
+        regressor_unit: "1".into(),
+        regressor_excited_mean: 1.0,
+        excited_fraction: 1.0,
+        effect_excited: d,
+        effect: d,
+        effect_unit: info.display.to_string(),
+        separate_by: Vec::new(),
+        prior_sigma: prior,
+        prior_widened: false,
+        prior_sigmas: (d / prior).abs(),
+        suggested_prior: None,
+        halves: None,
+        speed_halves: None,
+        consistency: Vec::new(),
+        ..g.clone()
+    }
+}
+
 /// The verdict on the offset in all `f` ((total, σ, the last shift) [ms]): no cause when the
 /// fixes want none in all (`given_ms`: the user's `--gnss-delay`, then not borne out), a
 /// stand-in when the kinds of fix (`split`) want different ones.
@@ -337,4 +398,115 @@ fn judge(
         ));
         f.stand_in = Some(why);
     }
+}
+
+/// `aid` with its GNSS fixes (positions, velocities) re-stamped by `shift` [s] (the one stamped
+/// t taken at t + shift, as `--gnss-delay` does), other aiding (body velocity, attitude) where it
+/// was; epochs at or before `t0` [s] (the start) dropped.
+pub(super) fn restamped_aid(aid: &[AidingEpoch], shift: f64, t0: f64) -> Vec<AidingEpoch> {
+    let mut out = Vec::with_capacity(aid.len());
+    for e in aid {
+        if e.pos.is_some() || e.vel.is_some() {
+            out.push(AidingEpoch {
+                t: e.t + shift,
+                pos: e.pos,
+                vel: e.vel,
+                body_vel: None,
+                att: None,
+            });
+        }
+        if e.body_vel.is_some() || e.att.is_some() {
+            out.push(AidingEpoch {
+                pos: None,
+                vel: None,
+                ..e.clone()
+            });
+        }
+    }
+    out.retain(|e| e.t > t0);
+    // stable: a re-stamped fix keeps its place among epochs of one time
+    out.sort_by(|a, b| a.t.total_cmp(&b.t));
+    out
+}
+
+/// A time offset in a finding's place, fitted to every order.
+pub(super) struct RivalOffset {
+    /// The offset in all [s]: the re-stamp plus what the last pass fitted on top.
+    pub(super) offset_s: f64,
+    /// Its σ [s] (the last pass's).
+    pub(super) sigma_s: f64,
+    /// The re-stamped passes' log-likelihood over the fixes both runs take.
+    pub(super) loglik: f64,
+    /// The named model's over the same fixes.
+    pub(super) loglik_named: f64,
+}
+
+/// dt_gnss (state `i` of `m`, the rounds' model with it in a finding's place) fitted to every
+/// order: `first` is `m`'s pass on the fixes as given (its dt_gnss first order); while what it
+/// leaves is at least [`RESTAMP_MIN_S`] and beyond 3σ (at most [`MAX_RESTAMPS`] times, within
+/// ±1 s in all), `m` runs again on the fixes re-stamped by the offset so far. The
+/// log-likelihoods compare the last pass with `named` (the rounds' pass on the fixes as given)
+/// over the fixes whose stamps lie inside both runs (the re-stamp's margin off either end).
+pub(super) fn rival_offset(
+    data: &super::ExplainData,
+    m: &crate::model::Model,
+    i: usize,
+    cfg: &crate::estimate::filter::FilterConfig,
+    first: &super::Pass,
+    named: &super::Pass,
+    progress: &mut dyn FnMut(f64),
+) -> anyhow::Result<Option<RivalOffset>> {
+    let fitted = |p: &super::Pass| p.run.records.last().map(|r| (r.x[i], r.sigma[i]));
+    let Some((mut d, mut s)) = fitted(first) else {
+        return Ok(None);
+    };
+    let mut shift = 0.0;
+    let mut last = None;
+    for _ in 0..MAX_RESTAMPS {
+        if d.abs() < RESTAMP_MIN_S || d.abs() < 3.0 * s || (shift + d).abs() > MAX_SHIFT_S {
+            break;
+        }
+        shift += d;
+        let aid = restamped_aid(data.aid, shift, data.start.t);
+        let moved = super::ExplainData { aid: &aid, ..*data };
+        let p = super::run_pass(m, &[], &moved, cfg, progress)?;
+        let Some(x) = fitted(&p) else {
+            return Ok(None);
+        };
+        (d, s) = x;
+        last = Some(p);
+    }
+    let p = last.as_ref().unwrap_or(first);
+    let shift_of = if last.is_some() { shift } else { 0.0 };
+    // the fixes both runs take: stamps inside the given ones by the re-stamp on either side
+    let stamps = || {
+        data.aid
+            .iter()
+            .filter(|e| e.pos.is_some() || e.vel.is_some())
+    };
+    let (Some(lo), Some(hi)) = (stamps().next(), stamps().next_back()) else {
+        return Ok(None);
+    };
+    let (lo, hi) = (
+        lo.t.max(data.start.t) + shift_of.abs(),
+        hi.t - shift_of.abs(),
+    );
+    // a fix's stamp (the GNSS measurements moved by the re-stamp, the references did not)
+    let stamp = |n: &crate::estimate::filter::Innovation, by: f64| match n.meas {
+        "vel_body" | "att_ref" => n.t,
+        _ => n.t - by,
+    };
+    let over = |run: &crate::estimate::filter::FilterRun, by: f64| {
+        run.innovations
+            .iter()
+            .filter(|n| stamp(n, by) > lo && stamp(n, by) <= hi)
+            .map(super::diagnostics::loglik_of)
+            .sum::<f64>()
+    };
+    Ok(Some(RivalOffset {
+        offset_s: shift_of + d,
+        sigma_s: s,
+        loglik: over(&p.run, shift_of),
+        loglik_named: over(&named.run, 0.0),
+    }))
 }

@@ -281,7 +281,13 @@ fn share_and_stand_in(f: &Finding, what_else: &str) -> String {
             sig3(f.two_delta_loglik)
         ));
     }
-    if let Some(why) = &f.stand_in {
+    if let (Some(why), Some([d, sd])) = (&f.stand_in, f.offset_in_place) {
+        s.push_str(&format!(
+            ". It probably stands in for an IMU–GNSS time offset of {} ± {} ms ({why}){what_else}",
+            sig3(d),
+            sig3(sd)
+        ));
+    } else if let Some(why) = &f.stand_in {
         s.push_str(&format!(
             ". It probably stands in for an effect the candidates do not describe ({why}){what_else}"
         ));
