@@ -1192,6 +1192,42 @@ fn an_offset_a_lever_arm_took_is_refitted_and_named() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Stamps 0.9 s early: to first order the offset is held only by the stated noise (a vel_ne σ
+/// 4× the stated was named the cause); refitted on re-stamped fixes it is the offset, and the
+/// noise level is no cause. Stamps 1.5 s late: the offset found is beyond the ±1 s explain
+/// re-stamps by, and nothing is named a cause.
+#[test]
+fn a_large_offset_is_refitted_or_names_nothing() {
+    let dir = tmp("early-900ms");
+    let sim = simulated_drive(&dir, 1.0);
+    let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, -0.9), &dir.join("early"), &[]);
+    let findings = v["findings"].as_array().unwrap();
+    let dt = time_offset(findings, &stderr);
+    let (ms, sigma) = (
+        dt["estimate"].as_f64().unwrap(),
+        dt["sigma"].as_f64().unwrap(),
+    );
+    eprintln!("stamps 0.9 s early: dt_gnss {ms} ± {sigma} ms");
+    assert!(is_cause(dt) && (ms - 900.0).abs() <= 3.0 * sigma, "{dt}");
+    for f in findings.iter().filter(|f| f["term"] != "dt_gnss") {
+        assert!(
+            !is_cause(f),
+            "{} named beside the offset: {stderr}",
+            f["term"]
+        );
+    }
+    let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, 1.5), &dir.join("late"), &[]);
+    for f in v["findings"].as_array().unwrap() {
+        assert!(
+            !is_cause(f),
+            "{} named beside a 1.5-s offset: {stderr}",
+            f["term"]
+        );
+    }
+    assert!(stderr.contains("beyond ±1 s"), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_late_gnss_stamp_is_refitted_to_every_order() {
     let dir = tmp("late-stamps");
