@@ -31,6 +31,7 @@ mod findings;
 mod noise;
 mod raw_noise;
 pub mod restamp;
+mod rivals;
 mod selection;
 mod signatures;
 mod words;
@@ -454,37 +455,36 @@ pub fn explain(
     // takes part of its value)
     let mut judged = complete_findings(ctx, &r, excess, None)?;
     // a GNSS cause that a GNSS term withheld from the candidates fits as well may stand in for it
-    let rivals = withheld_rivals(ctx, &r, &judged, &cands, progress)?;
-    for (f, rival) in judged.iter_mut().zip(&rivals) {
-        if let Some(rival) = rival {
-            f.stand_in = joined(f.stand_in.take(), Some(rival.why.clone()));
-            f.offset_in_place = rival.offset;
-        }
-    }
+    let rivals = rivals::withheld_rivals(ctx, &r, &mut judged, &cands, progress)?;
     let r = without_stand_ins(ctx, r, &judged, progress)?;
     let passed_over = passed_over(ctx, &r, &judged, &cands, progress)?;
     let stand_ins = judged_stand_ins(&r, &judged);
     // a noise level the terms judged stand-ins take up is no finding either
     let stand_in_terms = judged_stand_in_terms(&r, &judged);
-    let (noise_findings, noise_stage) =
-        noise::stage(ctx, &r, &base_stats, &stand_in_terms, progress)?;
+    let (noise, noise_stage) = noise::stage(ctx, &r, &base_stats, &stand_in_terms, progress)?;
     let noise_pass = noise_stage.as_ref().map(|x| &x.0);
     // the extended pass is the last one run (the baseline itself when nothing was found)
     let last_pass = noise_pass.unwrap_or(&r.pass);
     // the share of the baseline's excess the extended model leaves
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
-    keep_stand_ins(ctx, &r, &mut findings, judged, rivals, misfit_unexplained);
+    keep_stand_ins(ctx, &r, &mut findings, judged, &rivals, misfit_unexplained);
     mark_passed_over(&mut findings, &stand_ins, &passed_over);
-    let offset_in_place = judge_final(ctx, &r, &tests, &mut findings, &cands, progress)?;
-    findings.extend(noise_findings);
+    let in_place = judge_final(
+        ctx,
+        &r,
+        &tests,
+        (&mut findings, noise),
+        (&cands, &rivals),
+        progress,
+    )?;
     let held_by_noise = match &noise_stage {
         Some(noise) => held_only_by_the_stated_noise(ctx, &r, noise, &mut findings, progress)?,
         None => false,
     };
     // a term these rules unname leaves the extended model: its pass is run again without it
     let unnamed = small_beside_the_unexplained(&mut findings, opts) | held_by_noise;
-    let (model_name, rerun) = if unnamed | offset_in_place {
+    let (model_name, rerun) = if unnamed | in_place {
         let applied = noise_stage.as_ref().map_or(&[][..], |x| &x.1[..]);
         causes_only_pass(ctx, &r, &findings, applied, progress)?
     } else {
@@ -711,65 +711,29 @@ fn value_not_fixed(findings: &mut [Finding]) {
 }
 
 /// The rules that judge the findings of the rounds `r` once their values are final (`tests`:
-/// the candidates' tests; `cands`: the candidates): a companion that moves, an aiding term
-/// confounded with a sensor term, a value not fixed, a GNSS cause beside an offset that is none.
-/// Returns whether the last unnamed a cause (its term then leaves the extended model).
+/// the candidates' tests; `cands`: the candidates; `rivals`: the rivals that took the judged
+/// stand-ins' places): a companion that moves, an aiding term confounded with a sensor term, a
+/// value not fixed, a GNSS cause beside an offset that is none, a value that leans on a
+/// stand-in; then the noise findings `noise` join, none named beside an offset left to a
+/// stand-in. Returns whether the last two unnamed a cause (its term then leaves the extended
+/// model).
 fn judge_final(
     ctx: &Context,
     r: &Rounds,
     tests: &[CandidateTest],
-    findings: &mut [Finding],
-    cands: &[usize],
+    (findings, noise): (&mut Vec<Finding>, Vec<Finding>),
+    (cands, rivals): (&[usize], &[Option<rivals::Rival>]),
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<bool> {
     companions_move(ctx, r, tests, findings, progress)?;
     aiding_and_sensor_confounded(ctx, r, findings, progress)?;
     value_not_fixed(findings);
-    offset_stand_ins(ctx, r, findings, cands, progress)
-}
-
-/// Each GNSS cause among `findings` (final, of the rounds `r`) beside which the time offset is
-/// no cause (not named, its value not fixed, or no candidate) is tried with the offset in its
-/// place, fitted to every order on the fixes re-stamped by it: a lever arm along the track
-/// moves the fixes as speed × an offset does, and the rounds may name it first. When the
-/// offset fits the data as well, the finding stands in for it. Returns whether any did.
-fn offset_stand_ins(
-    ctx: &Context,
-    r: &Rounds,
-    findings: &mut [Finding],
-    cands: &[usize],
-    progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<bool> {
-    let term = |name: &str| common::TERMS.iter().position(|t| t.name == name);
-    let Some(w) = term("dt_gnss") else {
-        return Ok(false);
-    };
-    if findings.iter().any(|f| f.term == "dt_gnss" && f.is_cause()) {
-        return Ok(false);
-    }
-    let others: Vec<usize> = findings
-        .iter()
-        .filter(|f| !f.is_cause() && f.term != "dt_gnss")
-        .filter_map(|f| term(&f.term))
-        .collect();
-    let mut any = false;
-    for f in findings.iter_mut().filter(|f| f.is_cause()) {
-        let Some(t) = term(&f.term).filter(|&t| t != w && common::TERMS[t].sensor.enters_h())
-        else {
-            continue;
-        };
-        let Some(rival) = offset_in_place(ctx, r, t, w, &others, cands, progress)? else {
-            continue;
-        };
-        f.stand_in = Some(rival.why);
-        f.offset_in_place = rival.offset;
-        f.suggested_prior = None;
-        let info = &common::TERMS[t];
-        (f.headline, f.words) =
-            finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
-        any = true;
-    }
-    Ok(any)
+    let late = rivals::offset_stand_ins(ctx, r, findings, cands, progress)?;
+    let leaning = rivals::leaning_on_stand_ins(findings, rivals)
+        | rivals::leaning_on_stand_ins(findings, &late);
+    findings.extend(noise);
+    rivals::noise_beside_an_offset(findings, rivals.iter().chain(&late));
+    Ok(!late.is_empty() | leaning)
 }
 
 /// Each finding that was judged no cause (`judged`, one per named term of `r`, in order) keeps
@@ -780,7 +744,7 @@ fn keep_stand_ins(
     r: &Rounds,
     findings: &mut [Finding],
     judged: Vec<Finding>,
-    rivals: Vec<Option<Rival>>,
+    rivals: &[Option<rivals::Rival>],
     unexplained: Option<f64>,
 ) {
     for (((f, j), n), rival) in findings.iter_mut().zip(judged).zip(&r.named).zip(rivals) {
@@ -795,7 +759,7 @@ fn keep_stand_ins(
             .flatten();
         f.stand_in = f.stand_in.as_ref().and(joined(
             stand_in_reason(f, unexplained, ctx.opts),
-            rival.map(|r| r.why),
+            rival.as_ref().map(|r| r.why.clone()),
         ));
         let info = &common::TERMS[n.term];
         (f.headline, f.words) =
@@ -1129,203 +1093,6 @@ fn joined(a: Option<String>, b: Option<String>) -> Option<String> {
         (Some(a), Some(b)) => Some(format!("{a}; {b}")),
         (a, b) => a.or(b),
     }
-}
-
-/// For each GNSS finding among `judged` (one per named term of `r`; a cause or a stand-in, not
-/// an unattributed class), the GNSS library terms withheld from the candidates `cands` are
-/// tried in its place, one filter pass each, and so is a time offset that is no cause here:
-/// when one fits the data as well (log-likelihood within 2 of the rounds' model), the finding
-/// may stand in for it (a body-x lever arm moves the fixes in turns as speed × a time offset
-/// does, an accelerometer delay beside it takes the rest), and its reason says which, with the
-/// value. None where no rival fits.
-fn withheld_rivals(
-    ctx: &Context,
-    r: &Rounds,
-    judged: &[Finding],
-    cands: &[usize],
-    progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<Vec<Option<Rival>>> {
-    let offset = common::TERMS.iter().position(|t| t.name == "dt_gnss");
-    let offset_is_cause = judged.iter().any(|f| f.term == "dt_gnss" && f.is_cause());
-    let stand_ins: Vec<usize> = judged
-        .iter()
-        .zip(&r.named)
-        .filter(|(f, _)| f.stand_in.is_some())
-        .map(|(_, n)| n.term)
-        .collect();
-    let mut out = vec![None; judged.len()];
-    for (k, (f, n)) in judged.iter().zip(&r.named).enumerate() {
-        let info = &common::TERMS[n.term];
-        // (a stand-in too: its words should name the rival that may take its place)
-        if f.not_attributed.is_some() || !info.sensor.enters_h() {
-            continue;
-        }
-        let rivals = (0..common::TERMS.len()).filter(|&w| {
-            let withheld = !cands.contains(&w) && !r.model.states.contains(&StateRef::Term(w));
-            common::TERMS[w].sensor == info.sensor
-                && w != n.term
-                && (withheld || (Some(w) == offset && !offset_is_cause))
-        });
-        for w in rivals {
-            let rival = if Some(w) == offset {
-                offset_in_place(ctx, r, n.term, w, &stand_ins, cands, progress)?
-            } else {
-                term_in_place(ctx, r, n.term, w, progress)?.map(|why| Rival { why, offset: None })
-            };
-            if rival.is_some() {
-                out[k] = rival;
-                break;
-            }
-        }
-    }
-    Ok(out)
-}
-
-/// Why the finding of term `t` may stand in for `w` (a GNSS term withheld from the candidates)
-/// when the rounds' model with `w` in its place fits the data as well, else None.
-fn term_in_place(
-    ctx: &Context,
-    r: &Rounds,
-    t: usize,
-    w: usize,
-    progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<Option<String>> {
-    let rival = &common::TERMS[w];
-    // the rounds' terms beyond the baseline, the finding's replaced by the rival
-    let terms = extra_terms(ctx, r).map(|x| if x == t { w } else { x });
-    let m = model_with(&ctx.baseline.name, terms)?;
-    let cfg = ctx.extended_config(&m, &r.widened)?;
-    let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
-    let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {
-        return Ok(None);
-    };
-    Ok(rival_words(
-        rival,
-        true,
-        last.x[i],
-        "",
-        p.stats.loglik,
-        r.pass.stats.loglik,
-    ))
-}
-
-/// Why the finding of term `t` may stand in for a time offset (term `w`, no cause here) when
-/// the offset fits the data as well in its place, fitted to every order on the fixes re-stamped
-/// by it: first with the rounds' other terms but the stand-ins `stand_ins` (an accelerometer
-/// delay takes the along-track part of an offset), then, when that falls short and other terms
-/// are left, alone (a delay named a cause beside the lever arm takes that part too); else None.
-fn offset_in_place(
-    ctx: &Context,
-    r: &Rounds,
-    t: usize,
-    w: usize,
-    stand_ins: &[usize],
-    cands: &[usize],
-    progress: &mut dyn FnMut(usize, f64),
-) -> anyhow::Result<Option<Rival>> {
-    let rival = &common::TERMS[w];
-    let others: Vec<usize> = extra_terms(ctx, r)
-        .filter(|x| *x != t && *x != w && !stand_ins.contains(x))
-        .collect();
-    let dropped: Vec<&str> = extra_terms(ctx, r)
-        .filter(|x| *x != t && *x != w && stand_ins.contains(x))
-        .map(|x| common::TERMS[x].name)
-        .collect();
-    let all: Vec<&str> = extra_terms(ctx, r)
-        .filter(|x| *x != t && *x != w)
-        .map(|x| common::TERMS[x].name)
-        .collect();
-    let tries = [
-        (&others[..], dropped),
-        (&[][..], if others.is_empty() { vec![] } else { all }),
-    ];
-    for (k, (keep, without)) in tries.into_iter().enumerate() {
-        if k == 1 && without.is_empty() {
-            break;
-        }
-        let m = model_with(&ctx.baseline.name, keep.iter().copied().chain([w]))?;
-        let cfg = ctx.extended_config(&m, &r.widened)?;
-        let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
-        let Some(i) = m.index_of(rival.name) else {
-            return Ok(None);
-        };
-        let Some(o) = restamp::rival_offset(ctx.data, &m, i, &cfg, &p, &r.pass, &mut |x| {
-            progress(r.rounds + 1, x)
-        })?
-        else {
-            return Ok(None);
-        };
-        let how = format!(
-            " (± {} {}, fitted to every order on the fixes re-stamped by it{}; log-likelihoods over the fixes both runs take)",
-            sig3(o.sigma_s / rival.display_to_si),
-            rival.display,
-            if without.is_empty() {
-                String::new()
-            } else {
-                format!(", without {}", without.join(", "))
-            }
-        );
-        let withheld = !cands.contains(&w);
-        let unit = 1.0 / rival.display_to_si;
-        let words = rival_words(rival, withheld, o.offset_s, &how, o.loglik, o.loglik_named);
-        if let Some(why) = words {
-            return Ok(Some(Rival {
-                why,
-                offset: Some([o.offset_s * unit, o.sigma_s * unit]),
-            }));
-        }
-    }
-    Ok(None)
-}
-
-/// A term that fits the data as well in a finding's place.
-#[derive(Clone)]
-struct Rival {
-    /// Why the finding may stand in for it.
-    why: String,
-    /// For a time offset: its value and σ (display unit, ms).
-    offset: Option<[f64; 2]>,
-}
-
-/// The terms of the rounds' model beyond the baseline.
-fn extra_terms<'a>(ctx: &'a Context, r: &'a Rounds) -> impl Iterator<Item = usize> + 'a {
-    r.model.states.iter().filter_map(|s| match *s {
-        StateRef::Term(t) if !ctx.baseline.states.contains(s) => Some(t),
-        _ => None,
-    })
-}
-
-/// The words of a rival that fits the data as well as the finding (log-likelihood `l_rival`
-/// at least `l_named` − 2) at `value` (SI; `how`: how it was fitted), else None; `withheld`:
-/// it was no candidate.
-fn rival_words(
-    rival: &crate::model::catalog::TermInfo,
-    withheld: bool,
-    value: f64,
-    how: &str,
-    l_rival: f64,
-    l_named: f64,
-) -> Option<String> {
-    (l_rival >= l_named - 2.0).then(|| {
-        format!(
-            "{} ({}; {}) in its place fits the data {}: {} = {} {}{} gives a log-likelihood {} against {}; {}",
-            rival.name,
-            rival.doc,
-            if withheld { "not a candidate here" } else { "a candidate that was not named" },
-            if l_rival > l_named + 2.0 { "better" } else { "as well" },
-            rival.name,
-            sig3(value / rival.display_to_si),
-            rival.display,
-            how,
-            sig3(l_rival),
-            sig3(l_named),
-            if withheld {
-                "offer it as a candidate to tell them apart"
-            } else {
-                "the data do not tell them apart"
-            }
-        )
-    })
 }
 
 /// The instrument terms of `baseline` whose final estimate in `run` (a pass of `model`, the

@@ -462,10 +462,10 @@ pub(super) struct RivalOffset {
     pub(super) offset_s: f64,
     /// Its σ [s] (the last pass's).
     pub(super) sigma_s: f64,
-    /// The re-stamped passes' log-likelihood over the fixes both runs take.
-    pub(super) loglik: f64,
-    /// The named model's over the same fixes.
-    pub(super) loglik_named: f64,
+    /// The last pass against the named model's, over the fixes both take.
+    pub(super) fit: super::rivals::Comparison,
+    /// The last pass's final estimate and σ of each state (SI).
+    pub(super) states: Vec<(f64, f64)>,
 }
 
 /// dt_gnss (state `i` of `m`, the rounds' model with it in a finding's place) fitted to every
@@ -505,35 +505,14 @@ pub(super) fn rival_offset(
     }
     let p = last.as_ref().unwrap_or(first);
     let shift_of = if last.is_some() { shift } else { 0.0 };
-    // the fixes both runs take: stamps inside the given ones by the re-stamp on either side
-    let stamps = || {
-        data.aid
-            .iter()
-            .filter(|e| e.pos.is_some() || e.vel.is_some())
-    };
-    let (Some(lo), Some(hi)) = (stamps().next(), stamps().next_back()) else {
-        return Ok(None);
-    };
-    let (lo, hi) = (
-        lo.t.max(data.start.t) + shift_of.abs(),
-        hi.t - shift_of.abs(),
-    );
-    // a fix's stamp (the GNSS measurements moved by the re-stamp, the references did not)
-    let stamp = |n: &crate::estimate::filter::Innovation, by: f64| match n.meas {
-        "vel_body" | "att_ref" => n.t,
-        _ => n.t - by,
-    };
-    let over = |run: &crate::estimate::filter::FilterRun, by: f64| {
-        run.innovations
-            .iter()
-            .filter(|n| stamp(n, by) > lo && stamp(n, by) <= hi)
-            .map(super::diagnostics::loglik_of)
-            .sum::<f64>()
-    };
-    Ok(Some(RivalOffset {
-        offset_s: shift_of + d,
-        sigma_s: s,
-        loglik: over(&p.run, shift_of),
-        loglik_named: over(&named.run, 0.0),
-    }))
+    Ok(
+        super::rivals::compare(data, &named.run, &p.run, shift_of).map(|fit| RivalOffset {
+            offset_s: shift_of + d,
+            sigma_s: s,
+            fit,
+            states: p.run.records.last().map_or(Vec::new(), |r| {
+                r.x.iter().copied().zip(r.sigma.iter().copied()).collect()
+            }),
+        }),
+    )
 }

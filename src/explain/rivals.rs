@@ -1,0 +1,430 @@
+//! Rivals of a GNSS finding: the aiding terms withheld from the candidates, and an IMU–GNSS
+//! time offset that is no cause, each tried in the finding's place. A lever arm along the track
+//! moves the fixes in turns as speed × an offset does; when a rival fits the data as well, the
+//! finding may stand in for it and says so.
+
+use super::diagnostics::loglik_of;
+use super::findings::Finding;
+use super::restamp;
+use super::words::{finding_words, sig3};
+use super::{model_with, prior_sigma, run_pass, Context, Rounds};
+use crate::estimate::filter::FilterRun;
+use crate::model::catalog::StateRef;
+use crate::model::generated::common;
+
+/// Each GNSS cause among `findings` (final, of the rounds `r`) beside which the time offset is
+/// no cause (not named, its value not fixed, or no candidate) is tried with the offset in its
+/// place, fitted to every order on the fixes re-stamped by it: a lever arm along the track
+/// moves the fixes as speed × an offset does, and the rounds may name it first. When the
+/// offset fits the data as well, the finding stands in for it. Returns those rivals.
+pub(super) fn offset_stand_ins(
+    ctx: &Context,
+    r: &Rounds,
+    findings: &mut [Finding],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Vec<Option<Rival>>> {
+    let term = |name: &str| common::TERMS.iter().position(|t| t.name == name);
+    let Some(w) = term("dt_gnss") else {
+        return Ok(Vec::new());
+    };
+    if findings.iter().any(|f| f.term == "dt_gnss" && f.is_cause()) {
+        return Ok(Vec::new());
+    }
+    let others: Vec<usize> = findings
+        .iter()
+        .filter(|f| !f.is_cause() && f.term != "dt_gnss")
+        .filter_map(|f| term(&f.term))
+        .collect();
+    let mut out = Vec::new();
+    for f in findings.iter_mut().filter(|f| f.is_cause()) {
+        let Some(t) = term(&f.term).filter(|&t| t != w && common::TERMS[t].sensor.enters_h())
+        else {
+            continue;
+        };
+        let Some(rival) = offset_in_place(ctx, r, t, w, &others, cands, progress)? else {
+            continue;
+        };
+        f.stand_in = Some(rival.why.clone());
+        f.offset_in_place = rival.offset;
+        f.suggested_prior = None;
+        let info = &common::TERMS[t];
+        (f.headline, f.words) =
+            finding_words(f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
+        out.push(Some(rival));
+    }
+    Ok(out)
+}
+
+/// For each GNSS finding among `judged` (one per named term of `r`; a cause or a stand-in, not
+/// an unattributed class), the GNSS library terms withheld from the candidates `cands` are
+/// tried in its place, one filter pass each, and so is a time offset that is no cause here:
+/// when one fits the data as well ([`Comparison::as_well`]) at a value beyond 3σ, the finding
+/// may stand in for it (a body-x lever arm moves the fixes in turns as speed × a time offset
+/// does, an accelerometer delay beside it takes the rest): its stand-in reason says which, with
+/// the value. Returns the rival of each finding (None where none fits).
+pub(super) fn withheld_rivals(
+    ctx: &Context,
+    r: &Rounds,
+    judged: &mut [Finding],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Vec<Option<Rival>>> {
+    let offset = common::TERMS.iter().position(|t| t.name == "dt_gnss");
+    let offset_is_cause = judged.iter().any(|f| f.term == "dt_gnss" && f.is_cause());
+    let stand_ins: Vec<usize> = judged
+        .iter()
+        .zip(&r.named)
+        .filter(|(f, _)| f.stand_in.is_some())
+        .map(|(_, n)| n.term)
+        .collect();
+    let mut out = vec![None; judged.len()];
+    for (k, (f, n)) in judged.iter().zip(&r.named).enumerate() {
+        let info = &common::TERMS[n.term];
+        // (a stand-in too: its words should name the rival that may take its place)
+        if f.not_attributed.is_some() || !info.sensor.enters_h() {
+            continue;
+        }
+        let rivals = (0..common::TERMS.len()).filter(|&w| {
+            let withheld = !cands.contains(&w) && !r.model.states.contains(&StateRef::Term(w));
+            common::TERMS[w].sensor == info.sensor
+                && w != n.term
+                && (withheld || (Some(w) == offset && !offset_is_cause))
+        });
+        for w in rivals {
+            let rival = if Some(w) == offset {
+                offset_in_place(ctx, r, n.term, w, &stand_ins, cands, progress)?
+            } else {
+                term_in_place(ctx, r, n.term, w, progress)?.map(|why| Rival {
+                    why,
+                    offset: None,
+                    beside: Vec::new(),
+                })
+            };
+            if rival.is_some() {
+                out[k] = rival;
+                break;
+            }
+        }
+    }
+    for (f, rival) in judged.iter_mut().zip(&out) {
+        if let Some(rival) = rival {
+            f.stand_in = super::joined(f.stand_in.take(), Some(rival.why.clone()));
+            f.offset_in_place = rival.offset;
+        }
+    }
+    Ok(out)
+}
+
+/// Why the finding of term `t` may stand in for `w` (a GNSS term withheld from the candidates)
+/// when the rounds' model with `w` in its place fits the data as well, else None.
+fn term_in_place(
+    ctx: &Context,
+    r: &Rounds,
+    t: usize,
+    w: usize,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Option<String>> {
+    let rival = &common::TERMS[w];
+    // the rounds' terms beyond the baseline, the finding's replaced by the rival
+    let terms = extra_terms(ctx, r).map(|x| if x == t { w } else { x });
+    let m = model_with(&ctx.baseline.name, terms)?;
+    let cfg = ctx.extended_config(&m, &r.widened)?;
+    let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
+    let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {
+        return Ok(None);
+    };
+    let fit = compare(ctx.data, &r.pass.run, &p.run, 0.0);
+    let (value, sigma) = (last.x[i], last.sigma[i]);
+    Ok(fit.and_then(|fit| rival_words(rival, true, (value, sigma), "", &fit)))
+}
+
+/// Why the finding of term `t` may stand in for a time offset (term `w`, no cause here) when
+/// the offset fits the data as well in its place, fitted to every order on the fixes re-stamped
+/// by it: first with the rounds' other terms but the stand-ins `stand_ins` (an accelerometer
+/// delay takes the along-track part of an offset), then, when that falls short and other terms
+/// are left, alone (a delay named a cause beside the lever arm takes that part too); else None.
+fn offset_in_place(
+    ctx: &Context,
+    r: &Rounds,
+    t: usize,
+    w: usize,
+    stand_ins: &[usize],
+    cands: &[usize],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<Option<Rival>> {
+    let rival = &common::TERMS[w];
+    let others: Vec<usize> = extra_terms(ctx, r)
+        .filter(|x| *x != t && *x != w && !stand_ins.contains(x))
+        .collect();
+    let dropped: Vec<&str> = extra_terms(ctx, r)
+        .filter(|x| *x != t && *x != w && stand_ins.contains(x))
+        .map(|x| common::TERMS[x].name)
+        .collect();
+    let all: Vec<&str> = extra_terms(ctx, r)
+        .filter(|x| *x != t && *x != w)
+        .map(|x| common::TERMS[x].name)
+        .collect();
+    let tries = [
+        (&others[..], dropped),
+        (&[][..], if others.is_empty() { vec![] } else { all }),
+    ];
+    for (k, (keep, without)) in tries.into_iter().enumerate() {
+        if k == 1 && without.is_empty() {
+            break;
+        }
+        let m = model_with(&ctx.baseline.name, keep.iter().copied().chain([w]))?;
+        let cfg = ctx.extended_config(&m, &r.widened)?;
+        let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
+        let Some(i) = m.index_of(rival.name) else {
+            return Ok(None);
+        };
+        let Some(o) = restamp::rival_offset(ctx.data, &m, i, &cfg, &p, &r.pass, &mut |x| {
+            progress(r.rounds + 1, x)
+        })?
+        else {
+            return Ok(None);
+        };
+        let how = format!(
+            " (± {} {}, fitted to every order on the fixes re-stamped by it{}; log-likelihoods over the fixes both runs take)",
+            sig3(o.sigma_s / rival.display_to_si),
+            rival.display,
+            if without.is_empty() {
+                String::new()
+            } else {
+                format!(", without {}", without.join(", "))
+            }
+        );
+        let withheld = !cands.contains(&w);
+        let unit = 1.0 / rival.display_to_si;
+        let words = rival_words(rival, withheld, (o.offset_s, o.sigma_s), &how, &o.fit);
+        if let Some(why) = words {
+            let beside = keep
+                .iter()
+                .filter_map(|&x| {
+                    let j = m.index_of(common::TERMS[x].name)?;
+                    o.states.get(j).map(|&(v, sd)| (x, v, sd))
+                })
+                .collect();
+            return Ok(Some(Rival {
+                why,
+                offset: Some([o.offset_s * unit, o.sigma_s * unit]),
+                beside,
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// A term that fits the data as well in a finding's place.
+#[derive(Clone)]
+pub(super) struct Rival {
+    /// Why the finding may stand in for it.
+    pub(super) why: String,
+    /// For a time offset: its value and σ (display unit, ms).
+    pub(super) offset: Option<[f64; 2]>,
+    /// The rounds' other terms as fitted with the rival in the finding's place: (term, value,
+    /// σ; SI).
+    pub(super) beside: Vec<(usize, f64, f64)>,
+}
+
+/// Each noise level among `findings` named a cause while a finding stands in for a time offset
+/// (`rivals`: those that took the stand-ins' places) is not named: the model it was fitted in
+/// leaves the offset to the stand-in (or, without it, to nothing), and a white-noise level or an
+/// aiding σ takes up part of what the offset does.
+pub(super) fn noise_beside_an_offset<'a>(
+    findings: &mut [Finding],
+    rivals: impl Iterator<Item = &'a Option<Rival>>,
+) {
+    let Some([d, sd]) = rivals.flatten().find_map(|r| r.offset) else {
+        return;
+    };
+    for f in findings
+        .iter_mut()
+        .filter(|f| f.kind == "noise" && f.is_cause())
+    {
+        let why = format!(
+            "it was fitted while a finding stands in for an IMU–GNSS time offset of {} ± {} ms the model does not hold, and a noise level fitted beside an effect left out takes part of it: fit the offset (offer dt_gnss as a candidate, or give --gnss-delay) and run again",
+            sig3(d),
+            sig3(sd)
+        );
+        super::not_named(f, why);
+    }
+}
+
+/// Each cause among `findings` whose value moves when a rival takes a stand-in's place
+/// (`rivals`, one per named term of the rounds): fitted with the rival, it differs from the
+/// finding's by more than 3σ of the two, or is no longer beyond 3σ. Its value leaned on the
+/// stand-in (the causes beside a lever arm that stands in for a withheld time offset took part
+/// of the offset), so it is not named. Returns whether any was unnamed.
+pub(super) fn leaning_on_stand_ins(findings: &mut [Finding], rivals: &[Option<Rival>]) -> bool {
+    let mut any = false;
+    for rival in rivals.iter().flatten() {
+        for &(t, v, sd) in &rival.beside {
+            let info = &common::TERMS[t];
+            let Some(f) = findings
+                .iter_mut()
+                .find(|f| f.term == info.name && f.is_cause())
+            else {
+                continue;
+            };
+            let (v, sd) = (v / info.display_to_si, sd / info.display_to_si);
+            let moved = (f.estimate - v).abs() > 3.0 * f.sigma.hypot(sd);
+            if !(moved || v.abs() <= 3.0 * sd) {
+                continue;
+            }
+            let stand_in = rival.why.split(" (").next().unwrap_or_default();
+            let why = format!(
+                "with {stand_in} in a stand-in's place it comes out {} ± {} {}: its value here leans on the stand-in",
+                sig3(v),
+                sig3(sd),
+                f.unit
+            );
+            super::not_named(f, why);
+            any = true;
+        }
+    }
+    any
+}
+
+/// The terms of the rounds' model beyond the baseline.
+fn extra_terms<'a>(ctx: &'a Context, r: &'a Rounds) -> impl Iterator<Item = usize> + 'a {
+    r.model.states.iter().filter_map(|s| match *s {
+        StateRef::Term(t) if !ctx.baseline.states.contains(s) => Some(t),
+        _ => None,
+    })
+}
+
+/// The words of a rival that fits the data as well as the finding (`fit`) at a value beyond 3σ
+/// (`value`, σ: SI; `how`: how it was fitted), else None (a rival at nothing fits as well only
+/// where the finding barely fits at all); `withheld`: it was no candidate.
+fn rival_words(
+    rival: &crate::model::catalog::TermInfo,
+    withheld: bool,
+    (value, sigma): (f64, f64),
+    how: &str,
+    fit: &Comparison,
+) -> Option<String> {
+    (fit.as_well() && value.abs() > 3.0 * sigma).then(|| {
+        let by = fit.z.map_or(String::new(), |z| {
+            format!(" (the difference {} of its σ over {BLOCKS} blocks of fixes)", sig3(z))
+        });
+        format!(
+            "{} ({}; {}) in its place fits the data {}: {} = {} {}{} gives a log-likelihood {} against {}{by}; {}",
+            rival.name,
+            rival.doc,
+            if withheld { "not a candidate here" } else { "a candidate that was not named" },
+            if fit.better() { "better" } else { "as well" },
+            rival.name,
+            sig3(value / rival.display_to_si),
+            rival.display,
+            how,
+            sig3(fit.loglik),
+            sig3(fit.loglik_named),
+            if withheld {
+                "offer it as a candidate to tell them apart"
+            } else {
+                "the data do not tell them apart"
+            }
+        )
+    })
+}
+
+/// Blocks of consecutive fixes the log-likelihood difference of two fits is summed over: their
+/// spread gives the difference's σ with the innovations' correlation in time inside a block.
+const BLOCKS: usize = 20;
+/// Fewest fixes for the block test (two per block); below, two fits are told apart by a
+/// log-likelihood of 2.
+const MIN_FIXES: usize = 2 * BLOCKS;
+/// Student's t at 0.975 on `BLOCKS` − 1 = 19 degrees of freedom.
+const T_19: f64 = 2.093;
+
+/// A rival's fit against the named model's over the fixes both runs take.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Comparison {
+    /// The rival's log-likelihood.
+    pub(super) loglik: f64,
+    /// The named model's.
+    pub(super) loglik_named: f64,
+    /// Their difference in its σ (from the spread of [`BLOCKS`] blocks of consecutive fixes);
+    /// `None` with fewer than [`MIN_FIXES`] fixes.
+    pub(super) z: Option<f64>,
+}
+
+impl Comparison {
+    /// The rival fits the data as well: not worse beyond chance (t < −2.09 on 19 degrees of
+    /// freedom; a log-likelihood within 2 without the block test).
+    fn as_well(&self) -> bool {
+        self.z
+            .map_or(self.loglik >= self.loglik_named - 2.0, |z| z >= -T_19)
+    }
+
+    /// The rival fits better beyond chance.
+    fn better(&self) -> bool {
+        self.z
+            .map_or(self.loglik > self.loglik_named + 2.0, |z| z > T_19)
+    }
+}
+
+/// How run `rival` (its GNSS fixes re-stamped by `shift` [s]) fits against `named` (the fixes as
+/// given) over the fixes both take: stamps inside the given ones by the re-stamp on either side,
+/// paired by stamp; None without fixes.
+pub(super) fn compare(
+    data: &super::ExplainData,
+    named: &FilterRun,
+    rival: &FilterRun,
+    shift: f64,
+) -> Option<Comparison> {
+    let stamps = || {
+        data.aid
+            .iter()
+            .filter(|e| e.pos.is_some() || e.vel.is_some())
+    };
+    let (lo, hi) = (stamps().next()?, stamps().next_back()?);
+    let (lo, hi) = (lo.t.max(data.start.t) + shift.abs(), hi.t - shift.abs());
+    // a fix's stamp (the GNSS measurements moved by the re-stamp, the references did not), in µs
+    let per_fix = |run: &FilterRun, by: f64| {
+        let mut m = std::collections::BTreeMap::<i64, f64>::new();
+        for n in &run.innovations {
+            let t = match n.meas {
+                "vel_body" | "att_ref" => n.t,
+                _ => n.t - by,
+            };
+            if t > lo && t <= hi {
+                *m.entry((t * 1e6).round() as i64).or_default() += loglik_of(n);
+            }
+        }
+        m
+    };
+    let (a, b) = (per_fix(rival, shift), per_fix(named, 0.0));
+    let pairs: Vec<(f64, f64)> = a
+        .iter()
+        .filter_map(|(k, x)| b.get(k).map(|y| (*x, *y)))
+        .collect();
+    let loglik: f64 = pairs.iter().map(|p| p.0).sum();
+    let loglik_named: f64 = pairs.iter().map(|p| p.1).sum();
+    let z = (pairs.len() >= MIN_FIXES).then(|| {
+        let sums: Vec<f64> = (0..BLOCKS)
+            .map(|k| {
+                let (i, j) = (k * pairs.len() / BLOCKS, (k + 1) * pairs.len() / BLOCKS);
+                pairs[i..j].iter().map(|p| p.0 - p.1).sum()
+            })
+            .collect();
+        let mean = sums.iter().sum::<f64>() / BLOCKS as f64;
+        let var = sums.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (BLOCKS - 1) as f64;
+        // the total's σ: √(blocks × the blocks' variance); a difference of nothing is 0 σ
+        let (sd, diff) = ((BLOCKS as f64 * var).sqrt(), loglik - loglik_named);
+        if sd > 0.0 {
+            diff / sd
+        } else if diff == 0.0 {
+            0.0
+        } else {
+            diff.signum() * f64::INFINITY
+        }
+    });
+    Some(Comparison {
+        loglik,
+        loglik_named,
+        z,
+    })
+}
