@@ -1116,9 +1116,39 @@ fn late_fixes(sim: &Path, late: f64) -> PathBuf {
     aid
 }
 
+/// explain (`explain_drive`) on the simulated drive in a new directory `name` with its fixes
+/// stamped `late` [s] late and the options `extra`, into its `explain`; returns the directory,
+/// explain.json and stderr.
+fn explained_late(name: &str, late: f64, extra: &[&str]) -> (PathBuf, serde_json::Value, String) {
+    let dir = tmp(name);
+    let sim = simulated_drive(&dir, 1.0);
+    let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, late), &dir.join("explain"), extra);
+    (dir, v, stderr)
+}
+
+/// A finding's estimate and σ (display unit).
+fn value(f: &serde_json::Value) -> (f64, f64) {
+    (
+        f["estimate"].as_f64().unwrap(),
+        f["sigma"].as_f64().unwrap(),
+    )
+}
+
 /// Whether finding `f` (explain.json) is named as a cause.
 fn is_cause(f: &serde_json::Value) -> bool {
     f["stand_in"].is_null() && f["not_attributed"].is_null()
+}
+
+/// Asserts that no finding among `findings` but the term `but` is named a cause, the noise
+/// levels too when `noise` (explain's `stderr` in the panic).
+fn none_named_but(findings: &[serde_json::Value], but: &str, noise: bool, stderr: &str) {
+    for f in findings.iter().filter(|f| noise || f["kind"] != "noise") {
+        assert!(
+            f["term"] == but || !is_cause(f),
+            "{} named as a cause: {stderr}",
+            f["term"]
+        );
+    }
 }
 
 /// Stamps 0.2 s late with the time offset withheld from the candidates: a lever arm along the
@@ -1128,19 +1158,9 @@ fn is_cause(f: &serde_json::Value) -> bool {
 /// says so with its value.
 #[test]
 fn a_lever_arm_is_no_cause_where_a_withheld_offset_fits_as_well() {
-    let dir = tmp("late-withheld");
-    let sim = simulated_drive(&dir, 1.0);
-    let out = dir.join("explain");
-    let (v, stderr) = explain_drive(
-        &sim,
-        &late_fixes(&sim, 0.2),
-        &out,
-        &["--candidates", "!dt_gnss"],
-    );
+    let (dir, v, stderr) = explained_late("late-withheld", 0.2, &["--candidates", "!dt_gnss"]);
     let findings = v["findings"].as_array().unwrap();
-    for f in findings.iter().filter(|f| f["kind"] != "noise") {
-        assert!(!is_cause(f), "{} named as a cause: {stderr}", f["term"]);
-    }
+    none_named_but(findings, "", false, &stderr);
     let lever = findings
         .iter()
         .find(|f| f["term"] == "lever_x")
@@ -1160,16 +1180,10 @@ fn a_lever_arm_is_no_cause_where_a_withheld_offset_fits_as_well() {
 /// the fixes by it and names the offset, not the lever arm.
 #[test]
 fn an_offset_a_lever_arm_took_is_refitted_and_named() {
-    let dir = tmp("late-50ms");
-    let sim = simulated_drive(&dir, 1.0);
-    let out = dir.join("explain");
-    let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, 0.05), &out, &[]);
+    let (dir, v, stderr) = explained_late("late-50ms", 0.05, &[]);
     let findings = v["findings"].as_array().unwrap();
     let dt = time_offset(findings, &stderr);
-    let (ms, sigma) = (
-        dt["estimate"].as_f64().unwrap(),
-        dt["sigma"].as_f64().unwrap(),
-    );
+    let (ms, sigma) = value(dt);
     eprintln!(
         "stamps 50 ms late: dt_gnss {ms} ± {sigma} ms; runs {}",
         v["restamp"]
@@ -1179,16 +1193,7 @@ fn an_offset_a_lever_arm_took_is_refitted_and_named() {
         (ms + 50.0).abs() <= 3.0 * sigma,
         "dt_gnss {ms} ± {sigma} ms"
     );
-    for f in findings
-        .iter()
-        .filter(|f| f["term"] != "dt_gnss" && f["kind"] != "noise")
-    {
-        assert!(
-            !is_cause(f),
-            "{} named beside the offset: {stderr}",
-            f["term"]
-        );
-    }
+    none_named_but(findings, "dt_gnss", false, &stderr);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1203,45 +1208,24 @@ fn a_large_offset_is_refitted_or_names_nothing() {
     let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, -0.9), &dir.join("early"), &[]);
     let findings = v["findings"].as_array().unwrap();
     let dt = time_offset(findings, &stderr);
-    let (ms, sigma) = (
-        dt["estimate"].as_f64().unwrap(),
-        dt["sigma"].as_f64().unwrap(),
-    );
+    let (ms, sigma) = value(dt);
     eprintln!("stamps 0.9 s early: dt_gnss {ms} ± {sigma} ms");
     assert!(is_cause(dt) && (ms - 900.0).abs() <= 3.0 * sigma, "{dt}");
-    for f in findings.iter().filter(|f| f["term"] != "dt_gnss") {
-        assert!(
-            !is_cause(f),
-            "{} named beside the offset: {stderr}",
-            f["term"]
-        );
-    }
+    none_named_but(findings, "dt_gnss", true, &stderr);
     let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, 1.5), &dir.join("late"), &[]);
-    for f in v["findings"].as_array().unwrap() {
-        assert!(
-            !is_cause(f),
-            "{} named beside a 1.5-s offset: {stderr}",
-            f["term"]
-        );
-    }
+    none_named_but(v["findings"].as_array().unwrap(), "", true, &stderr);
     assert!(stderr.contains("beyond ±1 s"), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn a_late_gnss_stamp_is_refitted_to_every_order() {
-    let dir = tmp("late-stamps");
-    let sim = simulated_drive(&dir, 1.0);
     // the receiver's stamps 0.2 s late: the fix stamped t is the trajectory at t − 0.2 s
-    let aid = late_fixes(&sim, 0.2);
+    let (dir, v, stderr) = explained_late("late-stamps", 0.2, &[]);
     let out = dir.join("explain");
-    let (v, stderr) = explain_drive(&sim, &aid, &out, &[]);
     let findings = v["findings"].as_array().unwrap();
     let dt = time_offset(findings, &stderr);
-    let (ms, sigma) = (
-        dt["estimate"].as_f64().unwrap(),
-        dt["sigma"].as_f64().unwrap(),
-    );
+    let (ms, sigma) = value(dt);
     eprintln!(
         "stamps 200 ms late: dt_gnss {ms} ± {sigma} ms; runs {}",
         v["restamp"]
@@ -1325,15 +1309,7 @@ fn a_velocity_latency_of_its_own_is_no_time_offset() {
 /// offset in all is none, and explain says the given one is not borne out, naming no cause.
 #[test]
 fn a_wrong_known_offset_is_not_borne_out() {
-    let dir = tmp("wrong-delay");
-    let sim = simulated_drive(&dir, 1.0);
-    let out = dir.join("explain");
-    let (v, stderr) = explain_drive(
-        &sim,
-        &sim.join("gnss.txt"),
-        &out,
-        &["--gnss-delay", "200 ms"],
-    );
+    let (dir, v, stderr) = explained_late("wrong-delay", 0.0, &["--gnss-delay", "200 ms"]);
     let findings = v["findings"].as_array().unwrap();
     let dt = time_offset(findings, &stderr);
     let why = dt["not_attributed"]
