@@ -1037,6 +1037,11 @@ fn explain_keeps_about_what_filter_keeps_per_epoch() {
 /// rate `rate_hz` (positions σ 0.1 m, velocities σ 0.02 m/s); returns the simulation's
 /// directory (imu.txt, truth.txt, gnss.txt).
 fn simulated_drive(dir: &Path, rate_hz: f64) -> PathBuf {
+    simulated_drive_with(dir, rate_hz, "")
+}
+
+/// [`simulated_drive`] with the scenario's `[errors]` lines `errors` (e.g. `lever_x = "0.8 m"`).
+fn simulated_drive_with(dir: &Path, rate_hz: f64, errors: &str) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
     let mut sc = String::from(
         "name = \"late\"\nimu_rate_hz = 100.0\ntruth_rate_hz = 10.0\nseed = 7\n\
@@ -1052,6 +1057,7 @@ fn simulated_drive(dir: &Path, rate_hz: f64) -> PathBuf {
     sc.push_str(&format!(
         "[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = -1.5\n\
          [[segment]]\nkind = \"rest\"\nduration_s = 60.0\n\
+         [errors]\n{errors}\n\
          [noise]\narw = \"0.1 deg/sqrt(h)\"\nvrw = \"50 ug/sqrt(Hz)\"\n\
          [gnss]\nrate_hz = {rate_hz}\nsigma_ne = \"0.1 m\"\nsigma_d = \"0.2 m\"\nsigma_v = \"0.02 m/s\"\n"
     ));
@@ -1201,6 +1207,43 @@ fn an_offset_a_lever_arm_took_is_refitted_and_named() {
 /// 4× the stated was named the cause); refitted on re-stamped fixes it is the offset, and the
 /// noise level is no cause. Stamps 1.5 s late: the offset found is beyond the ±1 s explain
 /// re-stamps by, and nothing is named a cause.
+/// Stamps 50 ms late on a drive whose antenna sits 0.8 m ahead of the IMU: at the drive's one
+/// speed the lever arm cancels most of the offset's move of the fixes (15 m/s × 50 ms), and
+/// what is left is the offset's along-track acceleration, an accelerometer delay's signature
+/// (the first run named tau_x −52 ms alone). Tried with the offset and the lever arms in its
+/// place, the delay fits no better, so explain re-stamps by the offset and names it with the
+/// lever arm, not the delay.
+#[test]
+fn an_offset_a_lever_arm_cancels_is_no_accelerometer_delay() {
+    let dir = tmp("late-lever");
+    let sim = simulated_drive_with(&dir, 1.0, "lever_x = \"0.8 m\"");
+    let (v, stderr) = explain_drive(&sim, &late_fixes(&sim, 0.05), &dir.join("explain"), &[]);
+    let findings = v["findings"].as_array().unwrap();
+    let (ms, sigma) = value(time_offset(findings, &stderr));
+    let lever = findings
+        .iter()
+        .find(|f| f["term"] == "lever_x" && is_cause(f))
+        .unwrap_or_else(|| panic!("no lever arm named: {stderr}"));
+    let (m, m_sigma) = value(lever);
+    eprintln!("50 ms late, lever arm 0.8 m: dt_gnss {ms} ± {sigma} ms, lever_x {m} ± {m_sigma} m");
+    assert!(
+        (ms + 50.0).abs() <= 3.0 * sigma,
+        "dt_gnss {ms} ± {sigma} ms"
+    );
+    assert!(
+        (m - 0.8).abs() <= 3.0 * m_sigma,
+        "lever_x {m} ± {m_sigma} m"
+    );
+    for f in findings.iter().filter(|f| f["term"] != "dt_gnss") {
+        assert!(
+            f["term"] == "lever_x" || f["term"] == "lever_y" || !is_cause(f),
+            "{} named: {stderr}",
+            f["term"]
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_large_offset_is_refitted_or_names_nothing() {
     let dir = tmp("early-900ms");

@@ -83,9 +83,10 @@ fn offset_fitted(e: &Explanation) -> Option<(f64, f64)> {
 }
 
 /// What run `e` (on fixes shifted by `shift_ms`) leaves of the offset: its dt_gnss cause, else
-/// its candidate test alone, which the run's other GNSS causes may take up.
+/// the offset a finding stands in for, else its candidate test alone, which the run's other
+/// GNSS causes may take up.
 fn left_by(e: &Explanation, shift_ms: f64) -> Pass {
-    if let Some((d, s)) = offset_cause(e) {
+    if let Some((d, s)) = offset_cause(e).or_else(|| offset_in_place(e)) {
         return Pass {
             shift_ms,
             estimate_ms: d,
@@ -462,25 +463,22 @@ pub(super) struct RivalOffset {
     pub(super) offset_s: f64,
     /// Its σ [s] (the last pass's).
     pub(super) sigma_s: f64,
-    /// The last pass against the named model's, over the fixes both take.
-    pub(super) fit: super::rivals::Comparison,
-    /// The last pass's final estimate and σ of each state (SI).
-    pub(super) states: Vec<(f64, f64)>,
+    /// The re-stamp of the last pass's fixes [s] (0: the fixes as given).
+    pub(super) shift_s: f64,
+    /// The last pass (None: the first, on the fixes as given).
+    pub(super) pass: Option<super::Pass>,
 }
 
 /// dt_gnss (state `i` of `m`, the rounds' model with it in a finding's place) fitted to every
 /// order: `first` is `m`'s pass on the fixes as given (its dt_gnss first order); while what it
 /// leaves is at least [`RESTAMP_MIN_S`] and beyond 3σ (at most [`MAX_RESTAMPS`] times, within
-/// ±1 s in all), `m` runs again on the fixes re-stamped by the offset so far. The
-/// log-likelihoods compare the last pass with `named` (the rounds' pass on the fixes as given)
-/// over the fixes whose stamps lie inside both runs (the re-stamp's margin off either end).
+/// ±1 s in all), `m` runs again on the fixes re-stamped by the offset so far.
 pub(super) fn rival_offset(
     data: &super::ExplainData,
     m: &crate::model::Model,
     i: usize,
     cfg: &crate::estimate::filter::FilterConfig,
     first: &super::Pass,
-    named: &super::Pass,
     progress: &mut dyn FnMut(f64),
 ) -> anyhow::Result<Option<RivalOffset>> {
     let fitted = |p: &super::Pass| p.run.records.last().map(|r| (r.x[i], r.sigma[i]));
@@ -503,16 +501,11 @@ pub(super) fn rival_offset(
         (d, s) = x;
         last = Some(p);
     }
-    let p = last.as_ref().unwrap_or(first);
-    let shift_of = if last.is_some() { shift } else { 0.0 };
-    Ok(
-        super::rivals::compare(data, &named.run, &p.run, shift_of).map(|fit| RivalOffset {
-            offset_s: shift_of + d,
-            sigma_s: s,
-            fit,
-            states: p.run.records.last().map_or(Vec::new(), |r| {
-                r.x.iter().copied().zip(r.sigma.iter().copied()).collect()
-            }),
-        }),
-    )
+    let shift_s = if last.is_some() { shift } else { 0.0 };
+    Ok(Some(RivalOffset {
+        offset_s: shift_s + d,
+        sigma_s: s,
+        shift_s,
+        pass: last,
+    }))
 }

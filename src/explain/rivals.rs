@@ -8,15 +8,19 @@ use super::findings::Finding;
 use super::restamp;
 use super::words::{finding_words, sig3};
 use super::{model_with, prior_sigma, run_pass, Context, Rounds};
-use crate::estimate::filter::FilterRun;
+use crate::estimate::filter::{FilterConfig, FilterRun};
 use crate::model::catalog::StateRef;
 use crate::model::generated::common;
+use crate::model::Model;
 
 /// Each GNSS cause among `findings` (final, of the rounds `r`) beside which the time offset is
 /// no cause (not named, its value not fixed, or no candidate) is tried with the offset in its
 /// place, fitted to every order on the fixes re-stamped by it: a lever arm along the track
-/// moves the fixes as speed × an offset does, and the rounds may name it first. When the
-/// offset fits the data as well, the finding stands in for it. Returns those rivals.
+/// moves the fixes as speed × an offset does, and the rounds may name it first. So is each
+/// accelerometer delay, with the offset and the horizontal lever arms in its place: where a
+/// forward lever arm cancels the offset's position (a car at one speed), what is left of the
+/// offset is its along-track acceleration, an accelerometer delay's signature. When the rival
+/// fits the data as well, the finding stands in for it. Returns those rivals.
 pub(super) fn offset_stand_ins(
     ctx: &Context,
     r: &Rounds,
@@ -36,13 +40,21 @@ pub(super) fn offset_stand_ins(
         .filter(|f| !f.is_cause() && f.term != "dt_gnss")
         .filter_map(|f| term(&f.term))
         .collect();
+    let levers: Vec<usize> = ["lever_x", "lever_y"]
+        .iter()
+        .filter_map(|n| term(n))
+        .collect();
     let mut out = Vec::new();
     for f in findings.iter_mut().filter(|f| f.is_cause()) {
-        let Some(t) = term(&f.term).filter(|&t| t != w && common::TERMS[t].sensor.enters_h())
-        else {
+        let Some(t) = term(&f.term).filter(|&t| t != w) else {
             continue;
         };
-        let Some(rival) = offset_in_place(ctx, r, t, w, &others, cands, progress)? else {
+        let with = match common::TERMS[t] {
+            info if info.sensor.enters_h() => &[][..],
+            info if info.group == "accelerometer delay" => &levers[..],
+            _ => continue,
+        };
+        let Some(rival) = offset_in_place(ctx, r, t, (w, with), &others, cands, progress)? else {
             continue;
         };
         f.stand_in = Some(rival.why.clone());
@@ -93,7 +105,7 @@ pub(super) fn withheld_rivals(
         });
         for w in rivals {
             let rival = if Some(w) == offset {
-                offset_in_place(ctx, r, n.term, w, &stand_ins, cands, progress)?
+                offset_in_place(ctx, r, n.term, (w, &[]), &stand_ins, cands, progress)?
             } else {
                 term_in_place(ctx, r, n.term, w, progress)?.map(|why| Rival {
                     why,
@@ -134,21 +146,23 @@ fn term_in_place(
     let (Some(i), Some(last)) = (m.index_of(rival.name), p.run.records.last()) else {
         return Ok(None);
     };
-    let fit = compare(ctx.data, &r.pass.run, &p.run, 0.0);
+    let occam = occam(ctx, &m, &cfg, &last.sigma) - named_occam(ctx, r)?;
+    let fit = compare(ctx.data, &r.pass.run, &p.run, (0.0, occam));
     let (value, sigma) = (last.x[i], last.sigma[i]);
     Ok(fit.and_then(|fit| rival_words(rival, true, (value, sigma), "", &fit)))
 }
 
-/// Why the finding of term `t` may stand in for a time offset (term `w`, no cause here) when
-/// the offset fits the data as well in its place, fitted to every order on the fixes re-stamped
-/// by it: first with the rounds' other terms but the stand-ins `stand_ins` (an accelerometer
-/// delay takes the along-track part of an offset), then, when that falls short and other terms
-/// are left, alone (a delay named a cause beside the lever arm takes that part too); else None.
+/// Why the finding of term `t` may stand in for a time offset (term `w`, no cause here; with the
+/// terms `with` beside it) when the offset fits the data as well in its place, fitted to every
+/// order on the fixes re-stamped by it: first with the rounds' other terms but the stand-ins
+/// `stand_ins` (an accelerometer delay takes the along-track part of an offset), then, when that
+/// falls short and other terms are left, alone (a delay named a cause beside the lever arm
+/// takes that part too); else None.
 fn offset_in_place(
     ctx: &Context,
     r: &Rounds,
     t: usize,
-    w: usize,
+    (w, with): (usize, &[usize]),
     stand_ins: &[usize],
     cands: &[usize],
     progress: &mut dyn FnMut(usize, f64),
@@ -165,6 +179,7 @@ fn offset_in_place(
         .filter(|x| *x != t && *x != w)
         .map(|x| common::TERMS[x].name)
         .collect();
+    let with_names: Vec<&str> = with.iter().map(|x| common::TERMS[*x].name).collect();
     let tries = [
         (&others[..], dropped),
         (&[][..], if others.is_empty() { vec![] } else { all }),
@@ -173,37 +188,52 @@ fn offset_in_place(
         if k == 1 && without.is_empty() {
             break;
         }
-        let m = model_with(&ctx.baseline.name, keep.iter().copied().chain([w]))?;
+        let added = with
+            .iter()
+            .copied()
+            .filter(|x| *x != t && !keep.contains(x));
+        let m = model_with(
+            &ctx.baseline.name,
+            keep.iter().copied().chain(added).chain([w]),
+        )?;
         let cfg = ctx.extended_config(&m, &r.widened)?;
         let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(r.rounds + 1, x))?;
         let Some(i) = m.index_of(rival.name) else {
             return Ok(None);
         };
-        let Some(o) = restamp::rival_offset(ctx.data, &m, i, &cfg, &p, &r.pass, &mut |x| {
+        let Some(o) = restamp::rival_offset(ctx.data, &m, i, &cfg, &p, &mut |x| {
             progress(r.rounds + 1, x)
         })?
         else {
+            return Ok(None);
+        };
+        let last = o.pass.as_ref().unwrap_or(&p);
+        let Some(end) = last.run.records.last() else {
+            return Ok(None);
+        };
+        let occam = occam(ctx, &m, &cfg, &end.sigma) - named_occam(ctx, r)?;
+        let Some(fit) = compare(ctx.data, &r.pass.run, &last.run, (o.shift_s, occam)) else {
             return Ok(None);
         };
         let how = format!(
             " (± {} {}, fitted to every order on the fixes re-stamped by it{}; log-likelihoods over the fixes both runs take)",
             sig3(o.sigma_s / rival.display_to_si),
             rival.display,
-            if without.is_empty() {
-                String::new()
-            } else {
-                format!(", without {}", without.join(", "))
-            }
+            [("with", with_names.clone()), ("without", without)]
+                .iter()
+                .filter(|(_, n)| !n.is_empty())
+                .map(|(w, n)| format!(", {w} {}", n.join(", ")))
+                .collect::<String>()
         );
         let withheld = !cands.contains(&w);
         let unit = 1.0 / rival.display_to_si;
-        let words = rival_words(rival, withheld, (o.offset_s, o.sigma_s), &how, &o.fit);
+        let words = rival_words(rival, withheld, (o.offset_s, o.sigma_s), &how, &fit);
         if let Some(why) = words {
             let beside = keep
                 .iter()
                 .filter_map(|&x| {
                     let j = m.index_of(common::TERMS[x].name)?;
-                    o.states.get(j).map(|&(v, sd)| (x, v, sd))
+                    Some((x, end.x[j], end.sigma[j]))
                 })
                 .collect();
             return Ok(Some(Rival {
@@ -346,7 +376,10 @@ pub(super) struct Comparison {
     pub(super) loglik: f64,
     /// The named model's.
     pub(super) loglik_named: f64,
-    /// Their difference in its σ (from the spread of [`BLOCKS`] blocks of consecutive fixes);
+    /// The rival's Occam factor less the named model's ([`occam`]), added to the difference:
+    /// the filter's log-likelihood is a marginal one, lower by it for each fitted term.
+    pub(super) occam: f64,
+    /// Their difference (with `occam`) in its σ (from the spread of [`BLOCKS`] blocks of consecutive fixes);
     /// `None` with fewer than [`MIN_FIXES`] fixes.
     pub(super) z: Option<f64>,
 }
@@ -355,14 +388,14 @@ impl Comparison {
     /// The rival fits the data as well: not worse beyond chance (t < −2.09 on 19 degrees of
     /// freedom; a log-likelihood within 2 without the block test).
     fn as_well(&self) -> bool {
-        self.z
-            .map_or(self.loglik >= self.loglik_named - 2.0, |z| z >= -T_19)
+        let diff = self.loglik - self.loglik_named + self.occam;
+        self.z.map_or(diff >= -2.0, |z| z >= -T_19)
     }
 
     /// The rival fits better beyond chance.
     fn better(&self) -> bool {
-        self.z
-            .map_or(self.loglik > self.loglik_named + 2.0, |z| z > T_19)
+        let diff = self.loglik - self.loglik_named + self.occam;
+        self.z.map_or(diff > 2.0, |z| z > T_19)
     }
 }
 
@@ -373,7 +406,7 @@ pub(super) fn compare(
     data: &super::ExplainData,
     named: &FilterRun,
     rival: &FilterRun,
-    shift: f64,
+    (shift, occam): (f64, f64),
 ) -> Option<Comparison> {
     let stamps = || {
         data.aid
@@ -413,7 +446,7 @@ pub(super) fn compare(
         let mean = sums.iter().sum::<f64>() / BLOCKS as f64;
         let var = sums.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (BLOCKS - 1) as f64;
         // the total's σ: √(blocks × the blocks' variance); a difference of nothing is 0 σ
-        let (sd, diff) = ((BLOCKS as f64 * var).sqrt(), loglik - loglik_named);
+        let (sd, diff) = ((BLOCKS as f64 * var).sqrt(), loglik - loglik_named + occam);
         if sd > 0.0 {
             diff / sd
         } else if diff == 0.0 {
@@ -425,6 +458,34 @@ pub(super) fn compare(
     Some(Comparison {
         loglik,
         loglik_named,
+        occam,
         z,
     })
+}
+
+/// The Occam factor of `model`'s terms beyond the baseline, fitted with the priors of `cfg` to
+/// the final σ `sigma` (SI): Σ ln(prior / σ). A filter's log-likelihood is the data's marginal
+/// likelihood, lower by about this than the best fit's (Laplace's approximation), so two models
+/// with different numbers of terms are compared with it taken out.
+pub(super) fn occam(ctx: &Context, model: &Model, cfg: &FilterConfig, sigma: &[f64]) -> f64 {
+    model
+        .states
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s, StateRef::Term(_)) && !ctx.baseline.states.contains(s))
+        .filter_map(|(i, _)| {
+            let (prior, post) = (cfg.prior_sigma[i], *sigma.get(i)?);
+            (post > 0.0 && prior > post).then(|| (prior / post).ln())
+        })
+        .sum()
+}
+
+/// [`occam`] of the rounds' model `r` (its pass's final σ).
+fn named_occam(ctx: &Context, r: &Rounds) -> anyhow::Result<f64> {
+    let cfg = ctx.extended_config(&r.model, &r.widened)?;
+    Ok(r.pass
+        .run
+        .records
+        .last()
+        .map_or(0.0, |last| occam(ctx, &r.model, &cfg, &last.sigma)))
 }

@@ -690,16 +690,16 @@ fn left_over_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
         ) {
             *last = if e.stand_ins_left_out {
                 format!(
-                    "Left unexplained by the causes found: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter). Fits that are not causes (\"Fitted, but not a cause\" above) take up {} % of it; they are left out of the extended model.",
+                    "Left unexplained by the causes found: {} % of the baseline's excess misfit (mean NIS {} against 1 for a consistent filter). Fits that are not causes (\"Fitted, but not a cause\" above) take up {}; they are left out of the extended model.",
                     sig3(100.0 * left.max(0.0)),
                     nis_text(e.extended.nis_mean),
-                    sig3(100.0 * taken),
+                    shares_text(taken),
                 )
             } else {
                 format!(
-                    "Left unexplained by the causes found: {} % of the baseline's excess misfit. Fits that are not causes (\"Fitted, but not a cause\" above) take up {} % of it; with them the extended model leaves {} % (mean NIS {} against 1 for a consistent filter), which is no explanation.",
+                    "Left unexplained by the causes found: {} % of the baseline's excess misfit. Fits that are not causes (\"Fitted, but not a cause\" above) take up {}; with them the extended model leaves {} % (mean NIS {} against 1 for a consistent filter), which is no explanation.",
                     sig3(100.0 * by_causes),
-                    sig3(100.0 * taken),
+                    shares_text(taken),
                     sig3(100.0 * left.max(0.0)),
                     nis_text(e.extended.nis_mean),
                 )
@@ -795,6 +795,20 @@ fn not_named_words(e: &Explanation, out: &mut Vec<String>) {
             "Not testable on these data (no information): {}.",
             e.not_testable.join(", ")
         ));
+    }
+}
+
+/// The share `taken` (a fraction; the stand-ins' shares summed) of the misfit in words: above
+/// all of it, the shares (each from the round that added its fit) overlap, and the words say so.
+fn shares_text(taken: f64) -> String {
+    // (above 100 % as said: 100.4 % reads as 100 %)
+    if taken >= 1.005 {
+        format!(
+            "{} % of it (each share from the round that added the fit: they overlap, and together come to more than all of it)",
+            sig3(100.0 * taken)
+        )
+    } else {
+        format!("{} % of it", sig3(100.0 * taken))
     }
 }
 
