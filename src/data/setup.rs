@@ -72,7 +72,7 @@ impl DataOptions {
         if dt.abs() < 1e-3 {
             bail!(
                 "--gnss-delay `{text}`: {} ms is below 1 ms, far under an IMU sample period: it changes nothing measurable (s read as ms? `0.179 s` is 179 ms); leave the option out for none",
-                dt * 1e3
+                crate::io::units::sig3(dt * 1e3)
             );
         }
         Ok(Some(dt))

@@ -37,8 +37,14 @@ pub fn known_gnss(known: &[(usize, f64)]) -> Option<String> {
             )
         })
         .collect();
+    // a time offset is refitted in all (the fixes re-stamped), so its finding is said in all
+    let offset = if known.iter().any(|k| k.starts_with("dt_gnss ")) {
+        " (a time offset refitted on re-stamped fixes is said in all, the given one included)"
+    } else {
+        ""
+    };
     Some(format!(
-        "Known aiding values applied in every pass (--gnss-delay, --lever-arm, --mounting): {}; a GNSS or reference finding is what the data show on top of them.",
+        "Known aiding values applied in every pass (--gnss-delay, --lever-arm, --mounting): {}; a GNSS or reference finding is what the data show on top of them{offset}.",
         known.join(", ")
     ))
 }
