@@ -35,6 +35,10 @@ pub(super) fn offset_stand_ins(
     if findings.iter().any(|f| f.term == "dt_gnss" && f.is_cause()) {
         return Ok(Vec::new());
     }
+    // no receiver, no offset (a turntable's static aiding): the run refuses GNSS terms
+    if (ctx.config_for)(&model_with(&ctx.baseline.name, [w])?).is_err() {
+        return Ok(Vec::new());
+    }
     let others: Vec<usize> = findings
         .iter()
         .filter(|f| !f.is_cause() && f.term != "dt_gnss")
