@@ -54,7 +54,8 @@ pub(super) fn offset_stand_ins(
             continue;
         };
         let with = match common::TERMS[t] {
-            info if info.sensor.enters_h() => &[][..],
+            // (the receiver's terms: a reference's time offset or mounting is no GNSS term)
+            info if info.sensor == common::TERMS[w].sensor => &[][..],
             info if info.group == "accelerometer delay" => &levers[..],
             _ => continue,
         };
