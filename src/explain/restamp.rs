@@ -337,9 +337,8 @@ fn offset_finding(e: &Explanation) -> Finding {
         .iter()
         .find(|f| f.offset_in_place.is_some())
         .expect("the first run named the offset, or a finding standing in for it");
-    let info = crate::model::generated::common::TERMS
-        .iter()
-        .find(|t| t.name == "dt_gnss")
+    let info = super::term_index("dt_gnss")
+        .map(|t| &crate::model::generated::common::TERMS[t])
         .expect("the spec declares dt_gnss");
     let test = e.candidates.iter().find(|c| c.term == "dt_gnss");
     let of = |x: fn(&super::findings::CandidateTest) -> f64| test.map_or(f64::NAN, x);

@@ -28,7 +28,7 @@ pub(super) fn offset_stand_ins(
     cands: &[usize],
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Vec<Option<Rival>>> {
-    let term = |name: &str| common::TERMS.iter().position(|t| t.name == name);
+    let term = super::term_index;
     let Some(w) = term("dt_gnss") else {
         return Ok(Vec::new());
     };
@@ -87,7 +87,7 @@ pub(super) fn withheld_rivals(
     cands: &[usize],
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Vec<Option<Rival>>> {
-    let offset = common::TERMS.iter().position(|t| t.name == "dt_gnss");
+    let offset = super::term_index("dt_gnss");
     let offset_is_cause = judged.iter().any(|f| f.term == "dt_gnss" && f.is_cause());
     let stand_ins: Vec<usize> = judged
         .iter()
