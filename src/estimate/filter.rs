@@ -420,7 +420,7 @@ impl Observer for Tee<'_> {
 
 enum Kernel {
     Preset(crate::model::catalog::PropagateFn),
-    Runtime(SparsePropagator),
+    Runtime(Box<SparsePropagator>),
     Dense,
 }
 
@@ -568,7 +568,7 @@ impl<'a> Engine<'a> {
         let kernel = match model.preset {
             _ if cfg.dense_reference => Kernel::Dense,
             Some(k) => Kernel::Preset(k.propagate),
-            None => Kernel::Runtime(SparsePropagator::new(n, model.a_pattern())),
+            None => Kernel::Runtime(Box::new(SparsePropagator::new(n, model.a_pattern()))),
         };
         let terms = model
             .states
