@@ -30,6 +30,13 @@ pub struct SparsePropagator {
     v: Vec<f64>,
     /// Whether this CPU has AVX2 (B P Bᵀ four dot products at a time).
     avx2: bool,
+    /// Whether this CPU has AVX-512 (A² and B P three rows at a time, eight columns a vector),
+    /// used for models of up to 64 states.
+    avx512: bool,
+    /// The dynamic rows three at a time for A² (k: A's non-zeros in any of the three rows).
+    a2_groups: Vec<RowGroup>,
+    /// The dynamic rows three at a time for M = B P (k: B's non-zeros in any of the three).
+    m_groups: Vec<RowGroup>,
     /// Scratch: B x (nd).
     dx: Vec<f64>,
 }
@@ -77,6 +84,24 @@ impl SparsePropagator {
         let nd = dyn_rows.len();
         let a_cols: Vec<Vec<usize>> = dyn_rows.iter().map(|&i| a_rows[i].clone()).collect();
         let a2_products = a_cols.iter().flatten().map(|&k| a_rows[k].len()).sum();
+        let group = |cols: &[Vec<usize>], coef: &dyn Fn(usize) -> usize| -> Vec<RowGroup> {
+            (0..nd)
+                .step_by(3)
+                .map(|r0| {
+                    let rows = r0..(r0 + 3).min(nd);
+                    let mut ks: Vec<usize> = rows.flat_map(|r| cols[r].clone()).collect();
+                    ks.sort_unstable();
+                    ks.dedup();
+                    let at = |q: usize| (r0 + q < nd).then(|| (coef(r0 + q), (r0 + q) * n));
+                    RowGroup {
+                        ks,
+                        rows: [at(0), at(1), at(2)],
+                    }
+                })
+                .collect()
+        };
+        let a2_groups = group(&a_cols, &|r| dyn_rows[r] * n);
+        let m_groups = group(&b_cols, &|r| r * n);
         SparsePropagator {
             n,
             dyn_rows,
@@ -88,6 +113,9 @@ impl SparsePropagator {
             m: vec![0.0; nd * n],
             v: vec![0.0; nd * nd.div_ceil(4) * 4],
             avx2: has_avx2(),
+            avx512: has_avx512() && n <= 64,
+            a2_groups,
+            m_groups,
             dx: vec![0.0; nd],
         }
     }
@@ -210,6 +238,15 @@ impl SparsePropagator {
     fn fill_b<const W: usize>(&mut self, a: &[f64], dt: f64) {
         let n = self.width::<W>();
         let half_dt2 = 0.5 * dt * dt;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx512 {
+            // SAFETY: `avx512` is set only where the CPU has AVX-512F.
+            unsafe {
+                rows_avx512::<W>(n, &self.a2_groups, a, a, &mut self.b, Some((dt, half_dt2)));
+            }
+            self.fill_b_tail(n);
+            return;
+        }
         for (r, &i) in self.dyn_rows.iter().enumerate() {
             let ai = &a[i * n..(i + 1) * n];
             let br = &mut self.b[r * n..(r + 1) * n];
@@ -238,6 +275,12 @@ impl SparsePropagator {
                 *bj = aij * dt + half_dt2 * *bj;
             }
         }
+        self.fill_b_tail(n);
+    }
+
+    /// B's last n mod 4 columns into `b_tail`, transposed.
+    #[inline(always)]
+    fn fill_b_tail(&mut self, n: usize) {
         let (n4, ndp) = (n - n % 4, self.v.len() / self.dyn_rows.len().max(1));
         for (t, col) in self.b_tail.chunks_exact_mut(ndp).enumerate() {
             for (r, c) in col.iter_mut().enumerate().take(self.dyn_rows.len()) {
@@ -250,6 +293,12 @@ impl SparsePropagator {
     #[inline(always)]
     fn b_times<const W: usize>(&mut self, p: &[f64]) {
         let n = self.width::<W>();
+        #[cfg(target_arch = "x86_64")]
+        if self.avx512 {
+            // SAFETY: `avx512` is set only where the CPU has AVX-512F.
+            unsafe { rows_avx512::<W>(n, &self.m_groups, &self.b, p, &mut self.m, None) };
+            return;
+        }
         let (b, m) = (&self.b, &mut self.m);
         for (r, cols) in self.b_cols.iter().enumerate() {
             let mr = &mut m[r * n..(r + 1) * n];
@@ -315,7 +364,16 @@ impl SparsePropagator {
         {
             if self.avx2 {
                 // SAFETY: `avx2` is set only where the CPU has AVX2.
-                unsafe { dots_avx2::<W>(n, &self.m, &self.b, &self.b_tail, &mut self.v) };
+                unsafe {
+                    dots_avx2::<W>(
+                        n,
+                        self.dyn_rows.len(),
+                        &self.m,
+                        &self.b,
+                        &self.b_tail,
+                        &mut self.v,
+                    )
+                };
                 return;
             }
         }
@@ -431,20 +489,116 @@ fn has_avx2() -> bool {
     }
 }
 
+/// Whether this CPU has AVX-512F.
+fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Up to three rows of a product out = C · S computed together: the k they sum over (the
+/// union of their non-zeros, in order), and per row its offsets in C and in `out` (None past
+/// the last row).
+#[derive(Debug, Clone)]
+struct RowGroup {
+    ks: Vec<usize>,
+    rows: [Option<(usize, usize)>; 3],
+}
+
+/// out[row] = Σ_k C[row][k] · S[k] (rows of n, k in each group's order) for every row of
+/// `groups`, with AVX-512: three rows at a time, so three times as many independent sums as
+/// one row has. A k outside a row's own non-zeros multiplies a zero of C and adds ±0, which
+/// leaves the sum's bits as they are: every row is the one-row sum. With `fill` = (dt,
+/// dt²/2), out[row] = C[row]·dt + dt²/2 · Σ instead (B from A: C = S = A). n ≤ 64.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn rows_avx512<const W: usize>(
+    n: usize,
+    groups: &[RowGroup],
+    c: &[f64],
+    s: &[f64],
+    out: &mut [f64],
+    fill: Option<(f64, f64)>,
+) {
+    use std::arch::x86_64::{
+        __m512d, __mmask8, _mm512_add_pd, _mm512_mask_storeu_pd, _mm512_maskz_loadu_pd,
+        _mm512_mul_pd, _mm512_set1_pd, _mm512_setzero_pd,
+    };
+    let n = if W == 0 { n } else { W };
+    assert!(n <= 64, "rows of at most 64");
+    let chunks = n.div_ceil(8);
+    let mask = |q: usize| -> __mmask8 {
+        let left = n - 8 * q;
+        if left >= 8 {
+            0xff
+        } else {
+            (1u8 << left) - 1
+        }
+    };
+    let load = |row: &[f64], q: usize| -> __m512d {
+        let row = &row[..n];
+        // SAFETY: the lanes the mask loads are within `row` (8q < n, checked by the slice).
+        unsafe { _mm512_maskz_loadu_pd(mask(q), row[8 * q..].as_ptr()) }
+    };
+    for g in groups {
+        let mut acc = [[_mm512_setzero_pd(); 8]; 3];
+        for &k in &g.ks {
+            let sk = &s[k * n..(k + 1) * n];
+            let mut row = [_mm512_setzero_pd(); 8];
+            for (q, v) in row.iter_mut().enumerate().take(chunks) {
+                *v = load(sk, q);
+            }
+            for (a, rows) in acc.iter_mut().zip(&g.rows) {
+                let Some((ci, _)) = *rows else { continue };
+                let x = _mm512_set1_pd(c[ci + k]);
+                for (aq, rq) in a.iter_mut().zip(&row).take(chunks) {
+                    *aq = _mm512_add_pd(*aq, _mm512_mul_pd(x, *rq));
+                }
+            }
+        }
+        for (a, rows) in acc.iter().zip(&g.rows) {
+            let Some((ci, oi)) = *rows else { continue };
+            let dst = &mut out[oi..oi + n];
+            for (q, &aq) in a.iter().enumerate().take(chunks) {
+                let v = match fill {
+                    Some((dt, half_dt2)) => _mm512_add_pd(
+                        _mm512_mul_pd(load(&c[ci..], q), _mm512_set1_pd(dt)),
+                        _mm512_mul_pd(_mm512_set1_pd(half_dt2), aq),
+                    ),
+                    None => aq,
+                };
+                // SAFETY: the lanes the mask stores are within `dst` (8q < n = dst.len()).
+                unsafe { _mm512_mask_storeu_pd(dst[8 * q..].as_mut_ptr(), mask(q), v) };
+            }
+        }
+    }
+}
+
 /// [`SparsePropagator::dots`] with AVX2: four dot products (four rows of B) at a time, one
 /// vector of four partial sums each, added pairwise across the four by two horizontal adds.
 /// Every sum is the scalar order's, so the bits are the same. `m` is nd × n, `b` padded to
 /// whole blocks of four rows, `b_tail` B's last n mod 4 columns transposed, `v` nd × ndp.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn dots_avx2<const W: usize>(n: usize, m: &[f64], b: &[f64], b_tail: &[f64], v: &mut [f64]) {
+fn dots_avx2<const W: usize>(
+    n: usize,
+    nd: usize,
+    m: &[f64],
+    b: &[f64],
+    b_tail: &[f64],
+    v: &mut [f64],
+) {
     use std::arch::x86_64::{
         _mm256_add_pd, _mm256_hadd_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_permute2f128_pd,
         _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
     };
     let n = if W == 0 { n } else { W };
     let n4 = n - n % 4;
-    let nd = m.len() / n.max(1);
     let ndp = v.len() / nd.max(1);
     let load = |x: &[f64]| -> std::arch::x86_64::__m256d {
         let x: &[f64; 4] = x[..4].try_into().expect("four");
@@ -582,23 +736,26 @@ mod tests {
     }
 
     #[test]
-    fn the_vector_dot_products_give_the_scalar_bits() {
+    fn the_vector_paths_give_the_scalar_bits() {
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for (n, nd) in [(5, 3), (8, 4), (21, 9), (33, 12), (70, 21)] {
             let (pattern, a, p0, x0) = case(n, nd, 100 + n as u64);
             let q: Vec<f64> = (0..n).map(|i| 1e-4 * (i + 1) as f64).collect();
-            let mut fast = SparsePropagator::new(n, &pattern);
-            let mut scalar = fast.clone();
+            let fast = SparsePropagator::new(n, &pattern);
+            let mut avx2 = fast.clone();
+            avx2.avx512 = false;
+            let mut scalar = avx2.clone();
             scalar.avx2 = false;
-            let (mut p_f, mut x_f, mut p_s, mut x_s) = (p0.clone(), x0.clone(), p0, x0);
-            for _ in 0..3 {
-                fast.propagate_with_state(&a, 0.01, &q, &mut p_f, Some(&mut x_f));
-                scalar.propagate_with_state(&a, 0.01, &q, &mut p_s, Some(&mut x_s));
-            }
-            assert!(
-                bits(&p_f) == bits(&p_s) && bits(&x_f) == bits(&x_s),
-                "n = {n}"
-            );
+            let run = |mut sp: SparsePropagator| {
+                let (mut p, mut x) = (p0.clone(), x0.clone());
+                for _ in 0..3 {
+                    sp.propagate_with_state(&a, 0.01, &q, &mut p, Some(&mut x));
+                }
+                (bits(&p), bits(&x))
+            };
+            let want = run(scalar);
+            assert!(run(avx2) == want, "n = {n}: AVX2");
+            assert!(run(fast) == want, "n = {n}: AVX-512");
         }
     }
 
