@@ -67,6 +67,10 @@ const NOT_RUN: &[(&str, &str)] = &[
         "tools/bench-table",
         "it runs the benchmarks for minutes and rewrites the README's table",
     ),
+    (
+        "tools/kf-gins-compare",
+        "it needs a KF-GINS binary built from KF-GINS's own checkout; tools/test_kf_gins_compare.py runs it with a stand-in",
+    ),
 ];
 
 /// The commands of every ```sh block, continuations joined, comments dropped.

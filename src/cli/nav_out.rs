@@ -47,6 +47,9 @@ impl Thinned {
 const BATCH_ROWS: usize = 1024;
 /// Batches in flight between the filter and the writing thread (memory stays bounded).
 const BATCHES_IN_FLIGHT: usize = 4;
+/// Bytes of formatted rows the writing thread hands to the file at once (at least the atomic
+/// file's 1 MiB buffer, which then passes them through without a copy and stays untouched).
+const CHUNK_BYTES: usize = 1 << 20;
 
 /// One nav.txt row before formatting: the corrected state and the 1-σ columns the model has.
 struct NavRow {
@@ -70,21 +73,26 @@ impl RowWriter {
             .name("nav.txt".into())
             .spawn(move || {
                 let w = file.writer();
-                let mut line = Vec::with_capacity(200);
+                // rows are formatted straight into one large chunk, handed to the file whole
+                // (larger than the file's buffer, so not copied into it)
+                let mut chunk = Vec::with_capacity(CHUNK_BYTES + 512);
                 for batch in rx {
                     for r in &batch {
-                        line.clear();
                         // the truth layout (same digits), then the sigmas
-                        write_row(&mut line, &r.row).map_err(|e| e.to_string())?;
-                        line.pop(); // its newline
+                        write_row(&mut chunk, &r.row).map_err(|e| e.to_string())?;
+                        chunk.pop(); // its newline
                         for v in &r.sig[..r.n_sig as usize] {
-                            line.push(b' ');
-                            write_sci(&mut line, *v, 4).map_err(|e| e.to_string())?;
+                            chunk.push(b' ');
+                            write_sci(&mut chunk, *v, 4).map_err(|e| e.to_string())?;
                         }
-                        line.push(b'\n');
-                        w.write_all(&line).map_err(|e| e.to_string())?;
+                        chunk.push(b'\n');
+                        if chunk.len() >= CHUNK_BYTES {
+                            w.write_all(&chunk).map_err(|e| e.to_string())?;
+                            chunk.clear();
+                        }
                     }
                 }
+                w.write_all(&chunk).map_err(|e| e.to_string())?;
                 Ok(file)
             })?;
         Ok(RowWriter { tx, thread })

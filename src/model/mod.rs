@@ -42,13 +42,17 @@ pub struct Model {
     pub regressor_ids: Vec<usize>,
     /// The preset's generated kernels when the model is exactly a preset (optionally +vertical).
     pub preset: Option<&'static PresetKernels>,
-    nav_pos: [Option<usize>; common::NAV_COUNT],
     a_pattern: Vec<(usize, usize)>,
-    /// Run-time composition plan: (nav row, nav col, model row, model col) of the navigation block.
-    nav_map: Vec<(usize, usize, usize, usize)>,
-    /// Run-time composition plan: (model column, term, position of its regressor's mean).
-    term_cols: Vec<(usize, usize, Option<usize>)>,
+    /// Run-time composition plan: (index in the flat navigation block, index in the flat n×n
+    /// A) of each navigation entry the model has.
+    nav_map: Vec<(u32, u32)>,
+    /// Run-time composition plan: each term column.
+    term_cols: Vec<TermColumn>,
 }
+
+/// A term's column of A in a run-time composition: the term, the position of its regressor's
+/// mean, and (navigation row, index in the flat n×n A) of each of its rows the model has.
+type TermColumn = (usize, Option<usize>, Vec<(usize, usize)>);
 
 /// Default noise 1-σ (SI, per component) of spec measurement `name`.
 pub fn measurement_sigma(name: &str) -> Option<f64> {
@@ -224,9 +228,16 @@ impl Model {
             }
         }
         a_pattern.sort_unstable();
+        let n = states.len();
         let nav_map = common::NAV_PATTERN
             .iter()
-            .filter_map(|&(r, c)| Some((r, c, nav_pos[r]?, nav_pos[c]?)))
+            .filter_map(|&(r, c)| {
+                let flat = |x: usize| u32::try_from(x).expect("a model of under 65536 states");
+                Some((
+                    flat(r * common::NAV_COUNT + c),
+                    flat(nav_pos[r]? * n + nav_pos[c]?),
+                ))
+            })
             .collect();
         let term_cols = states
             .iter()
@@ -234,7 +245,11 @@ impl Model {
             .filter_map(|(j, s)| match *s {
                 StateRef::Term(t) => {
                     let reg = common::TERMS[t].regressor;
-                    Some((j, t, regressor_ids.iter().position(|&x| x == reg)))
+                    let rows = common::TERM_ROWS[t]
+                        .iter()
+                        .filter_map(|&row| Some((row, nav_pos[row]? * n + j)))
+                        .collect();
+                    Some((t, regressor_ids.iter().position(|&x| x == reg), rows))
                 }
                 StateRef::Nav(_) => None,
             })
@@ -246,7 +261,6 @@ impl Model {
             names,
             regressor_ids,
             preset,
-            nav_pos,
             a_pattern,
             nav_map,
             term_cols,
@@ -329,17 +343,17 @@ impl Model {
         let n = self.n();
         let mut block = [[0.0; common::NAV_COUNT]; common::NAV_COUNT];
         common::fill_nav_block(nav, &mut block);
-        for &(r_nav, c_nav, i, j) in &self.nav_map {
-            a[i * n + j] = block[r_nav][c_nav];
+        let block = block.as_flattened();
+        let a = &mut a[..n * n];
+        for &(from, to) in &self.nav_map {
+            a[to as usize] = block[from as usize];
         }
-        for &(j, t, k) in &self.term_cols {
+        for (t, k, rows) in &self.term_cols {
             let rv = k.map(|k| r[k]).unwrap_or(0.0);
             let mut col = [0.0; common::NAV_COUNT];
-            common::term_column(t, nav, rv, &mut col);
-            for &row in common::TERM_ROWS[t] {
-                if let Some(i) = self.nav_pos[row] {
-                    a[i * n + j] = col[row];
-                }
+            common::term_column(*t, nav, rv, &mut col);
+            for &(row, to) in rows {
+                a[to] = col[row];
             }
         }
     }
