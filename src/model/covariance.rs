@@ -133,7 +133,9 @@ impl SparsePropagator {
         self.a2_products + self.b_nnz() * self.n + self.dyn_rows.len() * self.b_nnz()
     }
 
-    /// P ← Φ P Φᵀ + diag(q)·dt; `a`, `p` n×n row-major, `q` [SI²/s], `dt` [s].
+    /// P ← Φ P Φᵀ + diag(q)·dt; `a`, `p` n×n row-major, `q` [SI²/s], `dt` [s]. `a` must be
+    /// zero off the pattern given to [`Self::new`]: the kernel multiplies some of those zeros
+    /// (whole rows at a time), which leaves the sums of finite values as the sparse order has them.
     pub fn propagate(&mut self, a: &[f64], dt: f64, q: &[f64], p: &mut [f64]) {
         self.propagate_with_state(a, dt, q, p, None)
     }
