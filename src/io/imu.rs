@@ -129,7 +129,9 @@ pub fn parse_numbers_into(
         if count > n {
             continue;
         }
-        let v: f64 = f.parse().map_err(|_| {
+        // the correctly rounded value, as str::parse gives it (fast-float2 is the algorithm the
+        // standard library adopted, without its per-call checks)
+        let v: f64 = fast_float2::parse(f.as_bytes()).map_err(|_| {
             anyhow::anyhow!(
                 "{file}:{lineno}: column {count}: `{}` is not a number",
                 shown(f)
