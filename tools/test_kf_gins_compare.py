@@ -39,6 +39,10 @@ if float(cfg["starttime"]) != float(imu[0].split()[0]):
 if cfg["imudatarate"] != "200" or cfg["imudatalen"] != "7":
     sys.exit("rate or row length")
 keep = len(imu) - 1 - {short}
+mark = os.path.join(cfg["outputpath"], "..", "called-once")
+if {once} and os.path.exists(mark):
+    sys.exit(0)  # a later run that writes nothing
+open(mark, "w").close()
 with open(os.path.join(cfg["outputpath"], "KF_GINS_Navresult.nav"), "w") as f:
     f.writelines(line + "\\n" for line in imu[1:1 + keep])
 """
@@ -51,16 +55,17 @@ class KfGinsCompare(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def stand_in(self, short):
-        path = os.path.join(self.tmp.name, f"kf-gins-{short}")
+    def stand_in(self, short, once=False):
+        path = os.path.join(self.tmp.name, f"kf-gins-{short}-{once}")
         with open(path, "w") as f:
-            f.write(STAND_IN.format(python=sys.executable, short=short))
+            f.write(STAND_IN.format(python=sys.executable, short=short, once=once))
         os.chmod(path, 0o755)
         return path
 
     def run_tool(self, kf, *extra):
+        sm = [] if "--sinsmodel" in extra else ["--sinsmodel", BIN]
         return subprocess.run(
-            [sys.executable, SCRIPT, "--kf-gins", kf, "--sinsmodel", BIN, "--seconds", "20",
+            [sys.executable, SCRIPT, "--kf-gins", kf, *sm, "--seconds", "20",
              "--runs", "1", "--dir", os.path.join(self.tmp.name, "w"), *extra],
             capture_output=True, text=True)
 
@@ -76,8 +81,28 @@ class KfGinsCompare(unittest.TestCase):
     def test_a_run_that_stopped_early_is_refused(self):
         r = self.run_tool(self.stand_in(100))
         self.assertNotEqual(r.returncode, 0)
-        self.assertIn("KF-GINS wrote", r.stderr)
+        self.assertIn("KF_GINS_Navresult.nav has 3899 rows (3999 expected)", r.stderr)
         self.assertNotIn("fastest runs", r.stdout)
+        # every run is checked, not the last one's files alone
+        r = self.run_tool(self.stand_in(0, once=True), "--runs", "2")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("KF-GINS wrote nothing", r.stderr)
+        self.assertNotIn("fastest runs", r.stdout)
+
+    def test_not_sinsmodel_and_a_foreign_directory_are_refused(self):
+        r = self.run_tool(self.stand_in(0), "--sinsmodel", "/bin/true")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("is --sinsmodel /bin/true sinsmodel?", r.stderr)
+        mine = os.path.join(self.tmp.name, "mine")
+        os.makedirs(mine)
+        with open(os.path.join(mine, "scenario.toml"), "w") as f:
+            f.write("mine\n")
+        r = subprocess.run([sys.executable, SCRIPT, "--kf-gins", self.stand_in(0), "--sinsmodel", BIN,
+                            "--seconds", "20", "--runs", "1", "--dir", mine], capture_output=True, text=True)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--dir", r.stderr)
+        with open(os.path.join(mine, "scenario.toml")) as f:
+            self.assertEqual(f.read(), "mine\n")
 
     def test_bad_arguments_are_refused(self):
         r = self.run_tool(os.path.join(self.tmp.name, "missing"))
