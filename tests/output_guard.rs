@@ -237,8 +237,15 @@ fn a_killed_runs_temporary_is_swept_and_a_users_file_of_its_name_form_is_not() {
             .stderr(std::process::Stdio::null())
             .spawn()
             .unwrap();
+        // rows being written: the temporary's nav.txt has bytes (an empty one is the moment
+        // before, or a run already removing it, where a kill leaves no nav.txt behind)
+        let rows_going = |d: &Path| {
+            writing(d).is_some_and(|n| {
+                std::fs::metadata(d.join(n).join("nav.txt")).is_ok_and(|m| m.len() > 0)
+            })
+        };
         let t0 = std::time::Instant::now();
-        while writing(d).is_none() && child.try_wait().unwrap().is_none() {
+        while !rows_going(d) && child.try_wait().unwrap().is_none() {
             assert!(
                 t0.elapsed().as_secs() < 60,
                 "navigate neither wrote nor ended"
