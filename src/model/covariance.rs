@@ -170,8 +170,8 @@ impl SparsePropagator {
     ) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2, checked just above.
+            if self.avx2 {
+                // SAFETY: `avx2` is set only where the CPU has AVX2 (detected once, in `new`).
                 unsafe { self.propagate_avx2::<W>(a, dt, q, p, x) };
                 return;
             }
@@ -430,8 +430,8 @@ impl SparsePropagator {
     ) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2, checked just above.
+            if self.avx2 {
+                // SAFETY: `avx2` is set only where the CPU has AVX2 (detected once, in `new`).
                 unsafe { self.accumulate_avx2::<W>(a, dt, q, g, psi) };
                 return;
             }
