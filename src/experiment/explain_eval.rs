@@ -167,18 +167,16 @@ pub fn run_case_explained(
     opts: &ExplainOptions,
 ) -> anyhow::Result<(CaseResult, crate::explain::Explanation)> {
     let t_start = std::time::Instant::now();
-    let Drawn {
-        case: drawn,
-        lambda: drawn_lambda,
-    } = draw(spec, index)?;
     let mut opts = opts.clone();
     opts.alpha = spec.alpha;
     let t_setup = std::time::Instant::now();
-    let (case, sim, aid) = if GROUPS.contains(&drawn.group.as_str()) {
-        put_in_increments(&drawn, drawn_lambda, index)?
-    } else {
-        put_in_simulation(&drawn, drawn_lambda, index)?
-    };
+    let (
+        Drawn {
+            case: drawn,
+            lambda: drawn_lambda,
+        },
+        (case, sim, aid),
+    ) = prepare(spec, index)?;
     let seconds_taken_setup = t_setup.elapsed().as_secs_f64();
     // (a case hides a term exactly when its draw gave a λ)
     let lambda = drawn_lambda.filter(|_| !case.hidden.is_empty());
@@ -259,9 +257,22 @@ pub fn run_case_explained(
     Ok((result, out.explanation))
 }
 
+/// Draws case `index` of campaign `spec` and puts its hidden terms in at the drawn λ: what
+/// [`run_case`] explains (a test may change the case, e.g. its declared priors, and run it with
+/// [`crate::experiment::hidden::run_hidden_on`]).
+pub fn prepare(spec: &EvalSpec, index: usize) -> anyhow::Result<(Drawn, Put)> {
+    let drawn = draw(spec, index)?;
+    let put = if GROUPS.contains(&drawn.case.group.as_str()) {
+        put_in_increments(&drawn.case, drawn.lambda, index)?
+    } else {
+        put_in_simulation(&drawn.case, drawn.lambda, index)?
+    };
+    Ok((drawn, put))
+}
+
 /// A case with its hidden terms put in at the drawn λ (its hidden values the ones put in), its
 /// simulated IMU and truth, and its aiding.
-type Put = (
+pub type Put = (
     crate::sim::hidden::HiddenCase,
     crate::sim::simulator::SimOutput,
     Vec<crate::estimate::filter::AidingEpoch>,

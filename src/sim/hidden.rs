@@ -796,6 +796,16 @@ fn assemble(
             .filter(|t| t.name.starts_with("kgf_"))
             .map(|t| (t.name.to_string(), sigma))
             .collect()
+    } else if group == "kgq" {
+        // likewise g²-sensitivities: the λ draw puts a 300-s case's kgq at up to 17 of the
+        // spec's laser-grade 0.01 deg/h/g², a tactical-grade gyro's size: the case declares
+        // 0.1 deg/h/g² (widened to hold the value put in, `hold_in_declared_prior`)
+        let sigma = 0.1 * std::f64::consts::PI / 180.0 / 3600.0 / (G0 * G0);
+        common::TERMS
+            .iter()
+            .filter(|t| t.name.starts_with("kgq_"))
+            .map(|t| (t.name.to_string(), sigma))
+            .collect()
     } else {
         Vec::new()
     };
