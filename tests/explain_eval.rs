@@ -838,3 +838,56 @@ fn aiding_sigma_scan() {
     }
     eprintln!("named {named} of {runs}; the 95 % interval holds the true 2× in {covered}");
 }
+
+/// How much of the put-in term the first test sees: `EVAL_CASES=…/cases.json [EVAL_GROUPS_ONLY=size,kas]
+/// cargo test --release --test explain_eval -- --ignored probe_efficiency --nocapture` runs
+/// each sensor case of a stored campaign twice, with the term put in and without (the same
+/// noise), and prints the first test's GLR estimate of the hidden term on each: their
+/// difference over the value put in is the share of the term the signature sees (1 when the
+/// linearised per-step signature is the effect's), and ((difference)/σ)² the first test's own
+/// noncentrality beside the λ drawn.
+#[test]
+#[ignore]
+fn probe_efficiency() {
+    use sinsmodel::experiment::explain_eval::{default_options, prepare, EvalSpec};
+    use sinsmodel::experiment::hidden::{run_hidden_on, simulate_case};
+    let var = |k: &str| std::env::var(k).ok();
+    let path = var("EVAL_CASES").expect("EVAL_CASES: a stored campaign's cases.json");
+    let stored: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let spec: EvalSpec = serde_json::from_value(stored["spec"].clone()).unwrap();
+    let only: Option<Vec<String>> =
+        var("EVAL_GROUPS_ONLY").map(|s| s.split(',').map(str::to_string).collect());
+    let mut opts = default_options();
+    opts.alpha = spec.alpha;
+    for c in stored["cases"].as_array().unwrap() {
+        let group = c["group"].as_str().unwrap().to_string();
+        if c["lambda"].is_null() || only.as_ref().is_some_and(|o| !o.contains(&group)) {
+            continue;
+        }
+        let index = c["index"].as_u64().unwrap() as usize;
+        let (drawn, (case, sim, aid)) = prepare(&spec, index).unwrap();
+        let (name, theta) = case.hidden[0].clone();
+        let glr = |sim: &sinsmodel::sim::simulator::SimOutput| {
+            let e = run_hidden_on(&case, sim, &aid, &opts).unwrap().explanation;
+            let t = e.candidates.iter().find(|t| t.term == name).cloned();
+            t.map_or((f64::NAN, f64::NAN, f64::NAN), |t| {
+                (t.glr_estimate, t.glr_sigma, t.llr)
+            })
+        };
+        let (g1, s1, l1) = glr(&sim);
+        let (sim0, _) = simulate_case(&case).unwrap();
+        let (g0, _, l0) = glr(&sim0);
+        let info = sinsmodel::model::generated::common::TERMS
+            .iter()
+            .find(|t| t.name == name)
+            .unwrap();
+        let truth = theta / info.display_to_si;
+        eprintln!(
+            "EFF {index} {group} {name} λ {:.1} share {:.3} λ_test {:.1} llr {l1:.1} (without {l0:.1}) truth {truth:.4} glr {g1:.4} without {g0:.4} σ {s1:.4}",
+            drawn.lambda.unwrap(),
+            (g1 - g0) / truth,
+            ((g1 - g0) / s1).powi(2),
+        );
+    }
+}
