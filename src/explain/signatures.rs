@@ -256,7 +256,96 @@ impl Signatures {
     }
 }
 
+/// A function whose loops run compiled for AVX-512F where the CPU has it, else as written: the
+/// same operations in the same order on wider vectors (Rust never fuses a multiply and an add),
+/// so the same bits.
+macro_rules! wide_fn {
+    ($(#[$doc:meta])* fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $body:block) => {
+        $(#[$doc])*
+        fn $name($($arg: $ty),*) {
+            #[inline(always)]
+            fn body($($arg: $ty),*) $body
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx512f")]
+            unsafe fn avx512($($arg: $ty),*) {
+                body($($arg),*)
+            }
+            #[cfg(target_arch = "x86_64")]
+            if crate::model::covariance::has_avx512() {
+                // SAFETY: the CPU has AVX-512F
+                return unsafe { avx512($($arg),*) };
+            }
+            body($($arg),*)
+        }
+    };
+}
+
+wide_fn! {
+    /// W = A D over A's pattern for the m signatures (state-major), in place of `w`.
+    fn mul_d(a: &[f64], n: usize, m: usize, pattern: &[(usize, usize)], d: &[f64], w: &mut [f64]) {
+        sparse_mul_block(a, n, m, pattern, d, w)
+    }
+}
+
+wide_fn! {
+    /// D ← D + dt (W + dt/2 A W), with `aw` as scratch.
+    #[allow(clippy::too_many_arguments)]
+    fn advance_d(
+        a: &[f64],
+        n: usize,
+        m: usize,
+        pattern: &[(usize, usize)],
+        w: &[f64],
+        aw: &mut [f64],
+        d: &mut [f64],
+        dt: f64,
+    ) {
+        sparse_mul_block(a, n, m, pattern, w, aw);
+        let h = 0.5 * dt;
+        for ((di, wi), awi) in d.iter_mut().zip(w).zip(aw.iter()) {
+            *di += dt * (wi + h * awi);
+        }
+    }
+}
+
+wide_fn! {
+    /// G += H D for one scalar measurement row `h`, then D ← D − K G.
+    fn update_d(h: &[f64], k: &[f64], n: usize, m: usize, g: &mut [f64], d: &mut [f64]) {
+        for (j, &hj) in h.iter().enumerate().take(n) {
+            if hj != 0.0 {
+                for (g, d) in g.iter_mut().zip(&d[j * m..(j + 1) * m]) {
+                    *g += hj * d;
+                }
+            }
+        }
+        for (i, &ki) in k.iter().enumerate().take(n) {
+            if ki != 0.0 {
+                for (d, g) in d[i * m..(i + 1) * m].iter_mut().zip(g.iter()) {
+                    *d -= ki * g;
+                }
+            }
+        }
+    }
+}
+
+wide_fn! {
+    /// J += g gᵀ / s and b += g ν / s for one scalar measurement (g: the m signatures' H D).
+    fn accumulate_info(info: &mut [f64], score: &mut [f64], g: &[f64], m: usize, inv_s: f64, nu: f64) {
+        for a in 0..m {
+            let ga = g[a] * inv_s;
+            if ga == 0.0 {
+                continue;
+            }
+            score[a] += ga * nu;
+            for (i, gb) in info[a * m..(a + 1) * m].iter_mut().zip(g) {
+                *i += ga * gb;
+            }
+        }
+    }
+}
+
 /// out = A · v for m column vectors stored state-major (v[j·m + c]), over A's pattern.
+#[inline(always)]
 pub(super) fn sparse_mul_block(
     a: &[f64],
     n: usize,
@@ -321,7 +410,7 @@ impl Observer for Signatures {
             return;
         }
         // W = A D + [a_c], then D ← D + dt (W + dt/2 A W)
-        sparse_mul_block(a, n, m, pattern, &self.d, &mut self.w);
+        mul_d(a, n, m, pattern, &self.d, &mut self.w);
         for c in 0..m {
             let t_c = self.cands[c];
             let rv = self.r_mean[self.cand_r[c]];
@@ -340,11 +429,7 @@ impl Observer for Signatures {
                 self.w[i * m + c] += col[row];
             }
         }
-        sparse_mul_block(a, n, m, pattern, &self.w, &mut self.aw);
-        let h = 0.5 * dt;
-        for ((di, wi), awi) in self.d.iter_mut().zip(&self.w).zip(&self.aw) {
-            *di += dt * (wi + h * awi);
-        }
+        advance_d(a, n, m, pattern, &self.w, &mut self.aw, &mut self.d, dt);
     }
 
     fn scalar_update(
@@ -383,22 +468,10 @@ impl Observer for Signatures {
                 }
             }
         }
-        for (j, &hj) in h.iter().enumerate().take(n) {
-            if hj != 0.0 {
-                for (g, d) in self.g.iter_mut().zip(&self.d[j * m..(j + 1) * m]) {
-                    *g += hj * d;
-                }
-            }
-        }
-        for (i, &ki) in k.iter().enumerate().take(n) {
-            if ki != 0.0 {
-                for (d, g) in self.d[i * m..(i + 1) * m].iter_mut().zip(&self.g) {
-                    *d -= ki * g;
-                }
-            }
-        }
+        update_d(h, k, n, m, &mut self.g, &mut self.d);
         let inv_s = 1.0 / s;
         let (speed, axis, manoeuvre) = (self.speed, self.last_axis, self.manoeuvre);
+        let g = &self.g;
         for acc in &mut self.splits {
             let k = match acc.split {
                 Split::Time(t_half) => usize::from(t >= t_half),
@@ -408,16 +481,7 @@ impl Observer for Signatures {
                 Split::Measurement => measurement_group(meas),
             };
             let (info, score) = (&mut acc.info[k], &mut acc.score[k]);
-            for a in 0..m {
-                let ga = self.g[a] * inv_s;
-                if ga == 0.0 {
-                    continue;
-                }
-                score[a] += ga * nu;
-                for b in 0..m {
-                    info[a * m + b] += ga * self.g[b];
-                }
-            }
+            accumulate_info(info, score, g, m, inv_s, nu);
         }
     }
 }

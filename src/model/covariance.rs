@@ -480,7 +480,7 @@ impl SparsePropagator {
 }
 
 /// Whether this CPU has AVX2.
-fn has_avx2() -> bool {
+pub(crate) fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2")
@@ -492,7 +492,7 @@ fn has_avx2() -> bool {
 }
 
 /// Whether this CPU has AVX-512F.
-fn has_avx512() -> bool {
+pub(crate) fn has_avx512() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx512f")

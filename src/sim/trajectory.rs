@@ -25,6 +25,12 @@ struct Linear {
     axis: usize,
     comps: Vec<(f64, f64, f64)>,
     windows: Vec<[f64; 3]>,
+    /// Per window and component (window-major): sin(ω t_start + φ) of a window that starts
+    /// after t = 0 (else 0), the velocity's base.
+    base: Vec<f64>,
+    /// Per window and component: (sin, cos)(ω t_end + φ) of a window that ends (else 0): the
+    /// frozen velocity after it.
+    end: Vec<(f64, f64)>,
     phasor: std::cell::RefCell<Phasor>,
 }
 
@@ -41,6 +47,36 @@ struct Phasor {
 }
 
 impl Linear {
+    /// The source Σ A_i cos(ω_i t + φ_i) (`comps`: (A_i, ω_i, φ_i)) along `axis` of `frame`,
+    /// switched by `windows`, with each window's constant phases computed once.
+    fn new(frame: Frame, axis: usize, comps: Vec<(f64, f64, f64)>, windows: Vec<[f64; 3]>) -> Self {
+        let mut base = Vec::with_capacity(windows.len() * comps.len());
+        let mut end = Vec::with_capacity(windows.len() * comps.len());
+        for w in &windows {
+            for &(_, om, ph) in &comps {
+                base.push(if w[0] <= 0.0 {
+                    0.0
+                } else {
+                    (om * w[0] + ph).sin()
+                });
+                end.push(if w[1].is_finite() {
+                    (om * w[1] + ph).sin_cos()
+                } else {
+                    (0.0, 0.0)
+                });
+            }
+        }
+        Linear {
+            frame,
+            axis,
+            comps,
+            windows,
+            base,
+            end,
+            phasor: Default::default(),
+        }
+    }
+
     /// Fast path for a source that is always on (one window from t = 0 to ∞): (v, a).
     fn eval_always_on(&self, t: f64) -> (f64, f64) {
         let mut ph = self.phasor.borrow_mut();
@@ -101,19 +137,20 @@ impl Linear {
             return self.eval_always_on(t);
         }
         let (mut v, mut a) = (0.0, 0.0);
-        for w in &self.windows {
+        let nc = self.comps.len();
+        for (k, w) in self.windows.iter().enumerate() {
             if t < w[0] {
                 continue;
             }
             let inside = t <= w[1];
-            let te = t.min(w[1]);
-            for &(amp, om, ph) in &self.comps {
-                let base = if w[0] <= 0.0 {
-                    0.0
+            for (i, &(amp, om, ph)) in self.comps.iter().enumerate() {
+                let base = self.base[k * nc + i];
+                // (at t = t_end, t itself; after the window, its end's)
+                let (s, c) = if inside {
+                    (om * t + ph).sin_cos()
                 } else {
-                    (om * w[0] + ph).sin()
+                    self.end[k * nc + i]
                 };
-                let (s, c) = (om * te + ph).sin_cos();
                 v += w[2] * amp / om * (s - base);
                 if inside {
                     a += w[2] * amp * c;
@@ -131,6 +168,8 @@ struct Angular {
     amp: f64,
     om: f64,
     ph: f64,
+    /// sin φ (computed once).
+    sin_ph: f64,
     windows: Vec<[f64; 3]>,
 }
 
@@ -142,7 +181,7 @@ impl Angular {
                 continue;
             }
             let x = self.om * (t - w[0]) + self.ph;
-            ang += w[2] * self.amp * (x.sin() - self.ph.sin());
+            ang += w[2] * self.amp * (x.sin() - self.sin_ph);
             rate += w[2] * self.amp * self.om * x.cos();
         }
         (ang, rate)
@@ -230,13 +269,12 @@ impl Trajectory {
                         units::parse_quantity_as(v.amplitude.as_deref().unwrap_or("0"), "m/s^2")
                             .unwrap_or(0.0);
                     max_freq = max_freq.max(v.freq_hz);
-                    linear.push(Linear {
-                        frame: if k < 3 { Frame::Ned } else { Frame::Body },
-                        axis: k % 3,
-                        comps: vec![(amp, 2.0 * PI * v.freq_hz, v.phase_deg * d)],
-                        windows: windows(&v.schedule),
-                        phasor: Default::default(),
-                    });
+                    linear.push(Linear::new(
+                        if k < 3 { Frame::Ned } else { Frame::Body },
+                        k % 3,
+                        vec![(amp, 2.0 * PI * v.freq_hz, v.phase_deg * d)],
+                        windows(&v.schedule),
+                    ));
                 }
                 "random" => {
                     let psd =
@@ -253,13 +291,12 @@ impl Trajectory {
                         })
                         .collect();
                     max_freq = max_freq.max(hi);
-                    linear.push(Linear {
-                        frame: if k < 3 { Frame::Ned } else { Frame::Body },
-                        axis: k % 3,
+                    linear.push(Linear::new(
+                        if k < 3 { Frame::Ned } else { Frame::Body },
+                        k % 3,
                         comps,
-                        windows: windows(&v.schedule),
-                        phasor: Default::default(),
-                    });
+                        windows(&v.schedule),
+                    ));
                 }
                 _ => {
                     let amp =
@@ -271,6 +308,7 @@ impl Trajectory {
                         amp,
                         om: 2.0 * PI * v.freq_hz,
                         ph: v.phase_deg * d,
+                        sin_ph: (v.phase_deg * d).sin(),
                         windows: windows(&v.schedule),
                     });
                 }
