@@ -56,6 +56,22 @@ class EvalTables(unittest.TestCase):
             self.assertNotIn("Traceback", r.stderr)
         self.assertFalse(os.path.exists(self.mark))
 
+    def test_from_disk_with_a_dry_run_or_campaigns_to_run_is_refused(self):
+        for args, says in ((("--from-disk", "--dry-run"), "give one"),
+                           (("--from-disk", "--only", "sensor-300"), "runs nothing")):
+            r = run(*args, "--bin", self.fake)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn(says, r.stderr)
+            self.assertNotIn("Traceback", r.stderr)
+        self.assertFalse(os.path.exists(self.mark))
+
+    def test_a_failed_campaign_leaves_no_directory_of_its_own_behind(self):
+        r = run("--only", "sensor-300", "--bin", self.fake)
+        self.assertNotEqual(r.returncode, 0)
+        left = [d for d in os.listdir(os.path.join(ROOT, "docs", "explain-eval"))
+                if "-running-" in d]
+        self.assertEqual(left, [], "a run that wrote nothing left its directory")
+
     def test_a_missing_binary_is_named(self):
         r = run("--only", "sensor-300", "--bin", os.path.join(self.tmp.name, "nope"))
         self.assertNotEqual(r.returncode, 0)
