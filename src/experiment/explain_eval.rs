@@ -6,7 +6,7 @@
 
 use crate::estimate::stats;
 use crate::experiment::hidden::{inject, run_hidden_on, simulate_case, stated_config};
-use crate::explain::{self, signature_information, ExplainData, ExplainOptions};
+use crate::explain::{self, ExplainData, ExplainOptions};
 use crate::model::generated::common;
 use crate::model::Model;
 use crate::sim::hidden::{all_groups, clear_effect, generate, CaseKind, GROUPS};
@@ -286,6 +286,19 @@ fn information(
     aid: &[crate::estimate::filter::AidingEpoch],
     name: &str,
 ) -> anyhow::Result<f64> {
+    Ok(conditional_information(case, sim, aid, &[name])?[0])
+}
+
+/// For each of the terms `names`, the information of its signature through `case`'s baseline
+/// filter with the other terms estimated beside it, 1 / (J⁻¹)_ii of their joint information J
+/// (one pass): λ_i = θ_i² / (J⁻¹)_ii is the noncentrality of the test that names term i beside
+/// the others (for one term, I itself).
+fn conditional_information(
+    case: &crate::sim::hidden::HiddenCase,
+    sim: &crate::sim::simulator::SimOutput,
+    aid: &[crate::estimate::filter::AidingEpoch],
+    names: &[&str],
+) -> anyhow::Result<Vec<f64>> {
     let baseline = Model::parse(&case.baseline)?;
     let data = ExplainData {
         imu: crate::explain::ImuInput::Memory(&sim.imu),
@@ -294,7 +307,23 @@ fn information(
         start: sim.start,
     };
     let cfg = stated_config(case, sim, &baseline);
-    signature_information(&baseline, term_index(name)?, &data, &cfg)
+    let terms = names
+        .iter()
+        .map(|n| term_index(n))
+        .collect::<anyhow::Result<Vec<usize>>>()?;
+    let j = explain::signature_information_matrix(&baseline, &terms, &data, &cfg)?;
+    if terms.len() == 1 {
+        return Ok(j);
+    }
+    let m = terms.len();
+    let inv = nalgebra::DMatrix::from_row_slice(m, m, &j).try_inverse();
+    Ok((0..m)
+        .map(|i| match &inv {
+            Some(inv) if inv[(i, i)] > 0.0 && inv[(i, i)].is_finite() => 1.0 / inv[(i, i)],
+            // the terms cannot be told apart on these data: none can be named beside the others
+            _ => 0.0,
+        })
+        .collect())
 }
 
 /// A sensor group's term: simulated without it, then put into the IMU's increments at the drawn
@@ -338,13 +367,17 @@ fn put_in_simulation(
         .ok_or_else(|| anyhow::anyhow!("case {index}: a hidden term drawn without its λ"))?;
     let pilot = drawn.scaled(0.0);
     let (sim0, aid0) = simulate_case(&pilot)?;
+    // with several terms hidden, each one's information beside the others': a case is found
+    // when every term is named, and the weakest term is named only beside the others
+    let names: Vec<&str> = drawn.hidden.iter().map(|h| h.0.as_str()).collect();
+    let info = conditional_information(&pilot, &sim0, &aid0, &names)?;
     let mut weakest = f64::INFINITY;
-    for (name, v) in &drawn.hidden {
-        weakest = weakest.min(v * v * information(&pilot, &sim0, &aid0, name)?);
+    for ((_, v), i) in drawn.hidden.iter().zip(&info) {
+        weakest = weakest.min(v * v * i);
     }
     if !(weakest.is_finite() && weakest > 0.0) {
         anyhow::bail!(
-            "case {index}: the baseline filter holds no information on {} (λ per unit {weakest})",
+            "case {index}: the baseline filter holds no information on {} beside the other hidden terms (λ per unit {weakest})",
             drawn.oracle_model()
         );
     }

@@ -1971,8 +1971,20 @@ pub fn signature_information(
     data: &ExplainData,
     cfg: &FilterConfig,
 ) -> anyhow::Result<f64> {
-    let pass = run_pass(model, &[term], data, cfg, &mut |_| {})?;
-    Ok(pass.sig.info()[0])
+    Ok(signature_information_matrix(model, &[term], data, cfg)?[0])
+}
+
+/// Joint information J (m × m, row-major, SI) of the signatures of `terms` through `model`'s
+/// filter on these data, from one pass: θ_i² / (J⁻¹)_ii is the noncentrality of term i's test
+/// with the others estimated beside it.
+pub fn signature_information_matrix(
+    model: &Model,
+    terms: &[usize],
+    data: &ExplainData,
+    cfg: &FilterConfig,
+) -> anyhow::Result<Vec<f64>> {
+    let pass = run_pass(model, terms, data, cfg, &mut |_| {})?;
+    Ok(pass.sig.info())
 }
 
 #[cfg(test)]
