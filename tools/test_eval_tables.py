@@ -5,6 +5,7 @@ docs/explain-eval/, which the repository holds).
 """
 import hashlib
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -71,6 +72,44 @@ class EvalTables(unittest.TestCase):
         left = [d for d in os.listdir(os.path.join(ROOT, "docs", "explain-eval"))
                 if "-running-" in d]
         self.assertEqual(left, [], "a run that wrote nothing left its directory")
+
+    def test_results_of_another_campaign_replace_nothing(self):
+        # a stand-in that writes a summary of another seed, with a cases.json that claims to be
+        # sensor-300's, and exits 0
+        camp = os.path.join(ROOT, "docs", "explain-eval", "sensor-300")
+        wrong = os.path.join(self.tmp.name, "wrong-sinsmodel")
+        with open(wrong, "w") as f:
+            f.write("#!/bin/sh\nfor a; do out=$a; done\nmkdir -p \"$out\"\n"
+                    f"cp '{camp}/cases.json' \"$out/cases.json\"\n"
+                    "echo '{\"seed\": 9, \"cases\": 200}' > \"$out/eval.json\"\n")
+        os.chmod(wrong, 0o755)
+        before = {f: md5(os.path.join(camp, f)) for f in os.listdir(camp)}
+        stamps = os.path.join(ROOT, "docs", "explain-eval", "measured.json")
+        stamped = md5(stamps)
+        r = run("--only", "sensor-300", "--bin", wrong)
+        kept = [d for d in os.listdir(os.path.dirname(camp)) if "-running-" in d]
+        for d in kept:
+            shutil.rmtree(os.path.join(os.path.dirname(camp), d))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("not the campaign's", r.stderr)
+        self.assertIn("seed 9", r.stderr)
+        self.assertNotIn("Traceback", r.stderr)
+        self.assertEqual(len(kept), 1, "the new results are kept for a look, once")
+        self.assertEqual({f: md5(os.path.join(camp, f)) for f in os.listdir(camp)}, before)
+        self.assertEqual(md5(stamps), stamped)
+
+    def test_a_program_that_cannot_be_run_is_named(self):
+        noexec = os.path.join(self.tmp.name, "no-shebang")
+        with open(noexec, "w") as f:
+            f.write("echo hello\n")
+        os.chmod(noexec, 0o755)
+        r = run("--only", "sensor-300", "--bin", noexec)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("cannot be run", r.stderr)
+        self.assertNotIn("Traceback", r.stderr)
+        left = [d for d in os.listdir(os.path.join(ROOT, "docs", "explain-eval"))
+                if "-running-" in d]
+        self.assertEqual(left, [])
 
     def test_a_missing_binary_is_named(self):
         r = run("--only", "sensor-300", "--bin", os.path.join(self.tmp.name, "nope"))
