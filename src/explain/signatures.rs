@@ -271,13 +271,32 @@ macro_rules! wide_fn {
                 body($($arg),*)
             }
             #[cfg(target_arch = "x86_64")]
-            if crate::model::covariance::has_avx512() {
+            if crate::model::covariance::has_avx512() && !scalar_only() {
                 // SAFETY: the CPU has AVX-512F
                 return unsafe { avx512($($arg),*) };
             }
             body($($arg),*)
         }
     };
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests: run [`wide_fn!`]'s functions as written on this thread.
+    static SCALAR_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether [`wide_fn!`]'s functions must run as written (a test's scalar reference).
+#[inline(always)]
+fn scalar_only() -> bool {
+    #[cfg(test)]
+    {
+        SCALAR_ONLY.with(|c| c.get())
+    }
+    #[cfg(not(test))]
+    {
+        false
+    }
 }
 
 wide_fn! {
@@ -507,4 +526,59 @@ fn sum_groups(groups: &[Vec<f64>]) -> Vec<f64> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The signature loops give the same bits compiled for AVX-512F as written (where the CPU
+    /// has it; elsewhere both runs take the scalar path): W = A D, D's advance, its update by a
+    /// scalar measurement and the information's accumulation, over m = 1 to 41 signatures.
+    #[test]
+    fn the_wide_loops_give_the_scalar_bits() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for m in [1, 3, 8, 17, 39, 41] {
+            let n = 31;
+            let pattern: Vec<(usize, usize)> = (0..n * n)
+                .filter(|_| rnd() > 0.7)
+                .map(|k| (k / n, k % n))
+                .collect();
+            let a: Vec<f64> = (0..n * n).map(|_| rnd() * 1e-3).collect();
+            let d0: Vec<f64> = (0..n * m).map(|_| rnd()).collect();
+            let h: Vec<f64> = (0..n)
+                .map(|j| if j % 3 == 0 { rnd() } else { 0.0 })
+                .collect();
+            let k: Vec<f64> = (0..n)
+                .map(|i| if i % 2 == 0 { rnd() } else { 0.0 })
+                .collect();
+            let run = |scalar: bool| {
+                SCALAR_ONLY.with(|c| c.set(scalar));
+                let (mut d, mut w, mut aw) = (d0.clone(), vec![0.0; n * m], vec![0.0; n * m]);
+                mul_d(&a, n, m, &pattern, &d, &mut w);
+                advance_d(&a, n, m, &pattern, &w, &mut aw, &mut d, 0.01);
+                let mut g = vec![0.0; m];
+                update_d(&h, &k, n, m, &mut g, &mut d);
+                let (mut info, mut score) = (vec![0.0; m * m], vec![0.0; m]);
+                accumulate_info(&mut info, &mut score, &g, m, 1.0 / 3.7, 0.25);
+                SCALAR_ONLY.with(|c| c.set(false));
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+                [
+                    bits(&w),
+                    bits(&aw),
+                    bits(&d),
+                    bits(&g),
+                    bits(&info),
+                    bits(&score),
+                ]
+            };
+            assert_eq!(run(true), run(false), "m = {m}");
+        }
+    }
 }
