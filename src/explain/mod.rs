@@ -1962,21 +1962,10 @@ pub fn measurement_consistency(
     ))
 }
 
-/// Information (SI, 1/θ²) the signature of term `term` carries through `model`'s filter on
-/// these data: λ = θ² I is the noncentrality of its test (independent of θ and of the data's
-/// values, so it can be computed before the term is put into the data).
-pub fn signature_information(
-    model: &Model,
-    term: usize,
-    data: &ExplainData,
-    cfg: &FilterConfig,
-) -> anyhow::Result<f64> {
-    Ok(signature_information_matrix(model, &[term], data, cfg)?[0])
-}
-
 /// Joint information J (m × m, row-major, SI) of the signatures of `terms` through `model`'s
 /// filter on these data, from one pass: θ_i² / (J⁻¹)_ii is the noncentrality of term i's test
-/// with the others estimated beside it.
+/// with the others estimated beside it (for one term, θ² J); J does not depend on θ or on the
+/// data's values, so it can be computed before the terms are put into the data.
 pub fn signature_information_matrix(
     model: &Model,
     terms: &[usize],

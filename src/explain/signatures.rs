@@ -288,6 +288,7 @@ thread_local! {
 
 /// Whether [`wide_fn!`]'s functions must run as written (a test's scalar reference).
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 fn scalar_only() -> bool {
     #[cfg(test)]
     {

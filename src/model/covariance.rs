@@ -480,7 +480,7 @@ impl SparsePropagator {
 }
 
 /// Whether this CPU has AVX2.
-pub(crate) fn has_avx2() -> bool {
+fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2")
