@@ -53,6 +53,11 @@ pub struct Finding {
     pub equivalent: Vec<String>,
     /// What each equivalent term would have to be to explain the same data.
     pub equivalent_estimates: Vec<EquivalentTerm>,
+    /// Spec terms withheld from the candidates that the data cannot tell from it either, with
+    /// the value each would need: a term outside the candidates could equally be the cause
+    /// (absent when none is, or none was withheld).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub withheld_alike: Vec<EquivalentTerm>,
     /// GLR estimate when selected (display unit).
     pub glr_estimate: f64,
     /// Its σ (display unit).

@@ -34,6 +34,7 @@ pub mod restamp;
 mod rivals;
 mod selection;
 mod signatures;
+mod withheld;
 mod words;
 
 pub use diagnostics::{
@@ -712,7 +713,8 @@ fn value_not_fixed(findings: &mut [Finding]) {
 
 /// The rules that judge the findings of the rounds `r` once their values are final (`tests`:
 /// the candidates' tests; `cands`: the candidates; `rivals`: the rivals that took the judged
-/// stand-ins' places): a companion that moves, an aiding term confounded with a sensor term, a
+/// stand-ins' places): a companion that moves, a term the candidates withhold that fits as
+/// well, an aiding term confounded with a sensor term, a
 /// value not fixed, a GNSS cause beside an offset that is none, a value that leans on a
 /// stand-in; then the noise findings `noise` join, none named beside an offset left to a
 /// stand-in. Returns whether the last two unnamed a cause (its term then leaves the extended
@@ -726,6 +728,7 @@ fn judge_final(
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<bool> {
     companions_move(ctx, r, tests, findings, progress)?;
+    withheld::withheld_alike(ctx, r, findings, cands, progress)?;
     aiding_and_sensor_confounded(ctx, r, findings, progress)?;
     value_not_fixed(findings);
     let late = rivals::offset_stand_ins(ctx, r, findings, cands, progress)?;
@@ -1665,6 +1668,7 @@ fn complete_findings(
                 .map(|e| e.term.clone())
                 .collect(),
             equivalent_estimates: n.equivalent_estimates.clone(),
+            withheld_alike: Vec::new(),
             glr_estimate: n.glr_estimate,
             glr_sigma: n.glr_sigma,
             round: n.round,
@@ -1991,6 +1995,7 @@ mod tests {
             p_value: 0.0,
             equivalent: vec![],
             equivalent_estimates: vec![],
+            withheld_alike: Vec::new(),
             glr_estimate: 0.0,
             glr_sigma: 0.0,
             round: 1,

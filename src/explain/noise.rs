@@ -1258,6 +1258,7 @@ fn noise_finding(
         p_value: f.p_holm,
         equivalent: Vec::new(),
         equivalent_estimates: Vec::new(),
+        withheld_alike: Vec::new(),
         glr_estimate: estimate,
         glr_sigma: f64::NAN,
         round: 0,

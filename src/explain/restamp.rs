@@ -352,6 +352,7 @@ fn offset_finding(e: &Explanation) -> Finding {
         p_value: of(|c| c.p_holm),
         equivalent: Vec::new(),
         equivalent_estimates: Vec::new(),
+        withheld_alike: Vec::new(),
         glr_estimate: of(|c| c.glr_estimate),
         glr_sigma: of(|c| c.glr_sigma),
         confounded_with: None,

@@ -161,18 +161,13 @@ fn select(
 ) -> (Vec<Selected>, Vec<Implausible>) {
     let (j, b, sd) = (&sc.j, &sc.b[..], &sc.sd[..]);
     let m = cands.len();
-    let margin = stats::chi2_isf(opts.alpha, 1.0);
     let bic = (innovations.max(2) as f64).ln();
     let mut pool: Vec<usize> = (0..m).filter(|&c| eligible[c]).collect();
     let mut chosen: Vec<usize> = Vec::new();
     let mut out = Vec::new();
     let mut implausible = Vec::new();
     while !pool.is_empty() {
-        // (llr, information, score) of c given the chosen set
-        let cond = |c: usize, chosen: &[usize]| -> Option<(f64, f64, f64)> {
-            let (ic, bc) = conditional(j, b, chosen, c);
-            (ic > 1e-12 * j[(c, c)].max(f64::MIN_POSITIVE)).then(|| (bc * bc / ic, ic, bc))
-        };
+        let cond = |c: usize, chosen: &[usize]| cond_llr(j, b, chosen, c);
         let mut best: Option<(usize, f64)> = None;
         for &c in &pool {
             if let Some((llr, _, _)) = cond(c, &chosen) {
@@ -195,16 +190,8 @@ fn select(
             (c, llr)
         };
         let mut members: Vec<(usize, f64, f64)> = vec![]; // (cand, θ' prior-scaled, info)
-        let with_c: Vec<usize> = chosen.iter().copied().chain([c]).collect();
         for &a in &pool {
-            // a term still significant beside c is not c's equivalent: the data separate them
-            // and hold both (d and kas hidden on one axis correlate at |ρ| > 0.97)
-            let separable = || cond(a, &with_c).is_some_and(|(l, _, _)| l >= margin);
-            let equivalent = a == c
-                || (conditional_rho(j, &chosen, a, c).abs() > opts.rho_equivalent
-                    && cond(a, &chosen).is_some_and(|(la, _, _)| llr - la < margin)
-                    && !separable());
-            if equivalent {
+            if a == c || equivalent((j, b), &chosen, (a, c, llr), opts) {
                 if let Some((_, ia, ba)) = cond(a, &chosen) {
                     members.push((a, ba / ia, ia));
                 }
@@ -263,6 +250,65 @@ fn select(
         sel.splits = split_estimates(sc, cands, sel.idx, &others);
     }
     (out, implausible)
+}
+
+/// (llr, information, score) of candidate `c` given the set `chosen`; None without information
+/// beside it.
+fn cond_llr(j: &DMatrix<f64>, b: &[f64], chosen: &[usize], c: usize) -> Option<(f64, f64, f64)> {
+    let (ic, bc) = conditional(j, b, chosen, c);
+    (ic > 1e-12 * j[(c, c)].max(f64::MIN_POSITIVE)).then(|| (bc * bc / ic, ic, bc))
+}
+
+/// Whether candidate `a` is in the equivalence class of `c` (conditional llr `llr_c`) given the
+/// set `chosen`, on the prior-scaled (J', b'): their conditional signatures correlate at |ρ| >
+/// `rho_equivalent`, the data do not prefer `c` by more than the α-level χ²₁ quantile, and beside
+/// `c` the term `a` is no longer significant at that quantile (a term still significant beside
+/// c is not c's equivalent: the data separate them and hold both, as d and kas hidden on one
+/// axis, which correlate at |ρ| > 0.97).
+fn equivalent(
+    (j, b): (&DMatrix<f64>, &[f64]),
+    chosen: &[usize],
+    (a, c, llr_c): (usize, usize, f64),
+    opts: &ExplainOptions,
+) -> bool {
+    let margin = stats::chi2_isf(opts.alpha, 1.0);
+    let with_c: Vec<usize> = chosen.iter().copied().chain([c]).collect();
+    let separable = || cond_llr(j, b, &with_c, a).is_some_and(|(l, _, _)| l >= margin);
+    conditional_rho(j, chosen, a, c).abs() > opts.rho_equivalent
+        && cond_llr(j, b, chosen, a).is_some_and(|(la, _, _)| llr_c - la < margin)
+        && !separable()
+}
+
+/// For each of the candidates `named` (indices into `sig.cands`), the candidates among `others`
+/// in its equivalence class given the rest of `named` (the same test as the selection's):
+/// (candidate index, GLR estimate, σ, display unit; |estimate| in prior σ).
+pub(super) fn alike_beside(
+    sig: &Signatures,
+    named: &[usize],
+    others: &[usize],
+    opts: &ExplainOptions,
+) -> Vec<Vec<(usize, f64, f64, f64)>> {
+    let sc = scaled(sig, opts);
+    let (j, b) = (&sc.j, &sc.b[..]);
+    named
+        .iter()
+        .map(|&c| {
+            let rest: Vec<usize> = named.iter().copied().filter(|&x| x != c).collect();
+            let Some((llr, _, _)) = cond_llr(j, b, &rest, c) else {
+                return Vec::new();
+            };
+            others
+                .iter()
+                .filter(|&&a| equivalent((j, b), &rest, (a, c, llr), opts))
+                .filter_map(|&a| {
+                    let (_, ia, ba) = cond_llr(j, b, &rest, a)?;
+                    let to_display = sc.sd[a] / common::TERMS[sig.cands[a]].display_to_si;
+                    let theta = ba / ia;
+                    Some((a, theta * to_display, to_display / ia.sqrt(), theta.abs()))
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Candidate `named`'s estimate and σ (display unit) from each group of each split of the

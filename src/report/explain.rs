@@ -309,6 +309,8 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
     for f in &e.findings {
         let verdict = if f.stand_in.is_some() {
             "fitted, but not a cause (a stand-in)"
+        } else if !f.withheld_alike.is_empty() {
+            "fitted, not attributed (a withheld term fits as well)"
         } else if f.not_attributed.is_some() {
             "fitted, not attributed (class not separable)"
         } else if f.kind == "noise" {
@@ -687,8 +689,10 @@ fn notes_section(s: &mut String) {
          what the raw increments show, a fix's σ its own innovations do not bear out, an interval \
          that holds the stated value, not one value across the data, or removing little of the \
          misfit; its words say which, and it is no property of the sensor: it probably stands in \
-         for something the candidates lack. **Fitted, not attributed** is significant, but its \
-         class holds members whose values differ by an order of magnitude or more: none is \
+         for something the candidates lack. **Fitted, not attributed** is significant, but the \
+         data do not say its term is the cause: its class holds members whose values differ by \
+         an order of magnitude or more, its value moves when a candidate is fitted beside it, or \
+         a term the candidates withhold fits the data as well; its words say which, and none is \
          named.\n",
     );
 }
