@@ -774,7 +774,7 @@ fn a_withheld_term_that_fits_as_well_is_named_and_nothing_is_claimed() {
             f["not_attributed"]
                 .as_str()
                 .unwrap()
-                .contains("which the candidates withhold"),
+                .contains("not among the candidates"),
             "{f}"
         );
         axes.push(axis.to_string());

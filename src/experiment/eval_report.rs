@@ -70,9 +70,12 @@ pub fn test_statement(s: &Summary) -> String {
          back above the χ²_k quantile 1 − α, times φ, for k added terms), its estimate holds \
          across the consistency splits and it is not a stand-in; those gates lower detection \
          below this curve, while the forward selection's later steps (conditional tests, Holm \
-         over the candidates left) can pass a candidate the first test missed. Each bin's theory is the test's power averaged over the \
-         bin's cases (their λ and m); an empty bin's, and the plotted curve, are the power at \
-         the median m.",
+         over the candidates left) can pass a candidate the first test missed. A case's λ is \
+         the noncentrality θ²I of its hidden term's test through the baseline filter; a case \
+         that hides several terms counts as found only when every one is named, so its λ is \
+         the weakest term's θ_i²/(J⁻¹)_ii, its information beside the others. Each bin's \
+         theory is the test's power averaged over the bin's cases (their λ and m); an empty \
+         bin's, and the plotted curve, are the power at the median m.",
         s.alpha, s.candidates_tested_median
     )
 }

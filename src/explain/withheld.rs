@@ -91,8 +91,9 @@ pub(super) fn withheld_alike(
             })
             .collect();
         let why = format!(
-            "the data cannot tell it from {}, which the candidates withhold: a term outside the candidates fits these data as well and could equally be the cause; offer {} as a candidate and run again",
+            "the data cannot tell it from {}, which {} not among the candidates: a term outside the candidates fits these data as well and could equally be the cause; offer {} as a candidate and run again",
             listed.join(", "),
+            if members.len() == 1 { "is" } else { "are" },
             if members.len() == 1 { "it" } else { "them" }
         );
         f.withheld_alike = members;
