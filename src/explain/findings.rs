@@ -53,11 +53,15 @@ pub struct Finding {
     pub equivalent: Vec<String>,
     /// What each equivalent term would have to be to explain the same data.
     pub equivalent_estimates: Vec<EquivalentTerm>,
-    /// Spec terms withheld from the candidates that the data cannot tell from it either, with
-    /// the value each would need: a term outside the candidates could equally be the cause
-    /// (absent when none is, or none was withheld).
+    /// Spec terms not among the candidates that explain all it explains (beside each it is no
+    /// longer significant), with the value each would need (absent when none does, or every
+    /// term was a candidate).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub withheld_alike: Vec<EquivalentTerm>,
+    /// True when a term in `withheld_alike` is why it is not named (the priors prefer it, or
+    /// would choose); the words and `not_attributed` say so.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub withheld_named: bool,
     /// GLR estimate when selected (display unit).
     pub glr_estimate: f64,
     /// Its σ (display unit).

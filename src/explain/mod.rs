@@ -255,6 +255,12 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
                 "--candidates: `!` needs a term or a family after it (`!size_*`, `!tau_x`)".into(),
             );
         }
+        if drop && item.starts_with('!') {
+            return Err(format!(
+                "--candidates: `!{item}` has a doubled `!`; one withholds (`!{}`)",
+                item.trim_start_matches('!')
+            ));
+        }
         let matched: Vec<usize> = match item.strip_suffix('*') {
             Some(prefix) => (0..common::TERM_COUNT)
                 .filter(|&t| common::TERMS[t].name.starts_with(prefix))
@@ -271,6 +277,27 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
         }
         sets.push((drop, item, matched.clone()));
         if drop {
+            // a withholding that takes nothing back is a mistake, not a no-op to pass over
+            if !matched.iter().any(|t| out.contains(t)) {
+                let names: Vec<&str> = matched.iter().map(|&t| common::TERMS[t].name).collect();
+                let why = if matched.iter().all(|&t| in_base(t)) {
+                    format!(
+                        "{} {} in the baseline model {}, so no candidate; to fit without it, give a model without it",
+                        names.join(", "),
+                        if names.len() == 1 { "is" } else { "are" },
+                        baseline.name
+                    )
+                } else {
+                    format!(
+                        "{} {} not among the terms named before it (a withholding takes terms back from the names given, or from every term when only withholdings are given)",
+                        names.join(", "),
+                        if names.len() == 1 { "is" } else { "are" }
+                    )
+                };
+                return Err(format!(
+                    "--candidates {spec}: `!{item}` withholds nothing: {why}"
+                ));
+            }
             out.retain(|t| !matched.contains(t));
             continue;
         }
@@ -297,6 +324,14 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
     if out.is_empty() {
         return Err(format!(
             "--candidates {spec}: withholds every candidate; nothing is left to test"
+        ));
+    }
+    if out.iter().all(|&t| in_base(t)) {
+        let names: Vec<&str> = out.iter().map(|&t| common::TERMS[t].name).collect();
+        return Err(format!(
+            "--candidates {spec}: every term it names ({}) is already in the baseline model {}; nothing is left to test (name terms the model lacks, or leave the option out for all of them)",
+            names.join(", "),
+            baseline.name
         ));
     }
     Ok(out)
@@ -391,6 +426,7 @@ pub fn explain(
     opts: &ExplainOptions,
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Explanation> {
+    let given = cands;
     let cands = candidates_here(baseline, cands, data);
     let first = Context {
         baseline,
@@ -470,7 +506,8 @@ pub fn explain(
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
     keep_stand_ins(ctx, &r, &mut findings, judged, &rivals, misfit_unexplained);
-    mark_passed_over(&mut findings, &stand_ins, &passed_over);
+    let kept_out = withheld_by_the_user(baseline, given);
+    mark_passed_over(&mut findings, (&stand_ins, &kept_out), &passed_over);
     let in_place = judge_final(
         ctx,
         &r,
@@ -1037,12 +1074,38 @@ fn judged_stand_ins(r: &Rounds, judged: &[Finding]) -> Vec<String> {
     out
 }
 
+/// The spec terms outside `baseline` that are not among the candidates `given` as
+/// `--candidates` withholdings: `!family_*` where every term of a family is out (a family: the
+/// names' common prefix up to its first `_`), else `!name`; none when every term is a candidate.
+fn withheld_by_the_user(baseline: &Model, given: &[usize]) -> Vec<String> {
+    let out = |t: usize| !given.contains(&t) && !baseline.states.contains(&StateRef::Term(t));
+    let family = |name: &'static str| &name[..name.find('_').map_or(name.len(), |k| k + 1)];
+    let mut items: Vec<String> = Vec::new();
+    for t in (0..common::TERM_COUNT).filter(|&t| out(t)) {
+        let fam = family(common::TERMS[t].name);
+        // a family all of whose terms are out (or in the baseline) is withheld by its prefix
+        let whole = (0..common::TERM_COUNT)
+            .filter(|&u| common::TERMS[u].name.starts_with(fam))
+            .all(|u| out(u) || baseline.states.contains(&StateRef::Term(u)));
+        let item = if whole && fam.ends_with('_') {
+            format!("!{fam}*")
+        } else {
+            format!("!{}", common::TERMS[t].name)
+        };
+        if !items.contains(&item) {
+            items.push(item);
+        }
+    }
+    items
+}
+
 /// Every cause of the sensor of a candidate in `passed_over` is no longer named: its value was
 /// fitted while the stand-ins (`stand_ins`, with their classes) took part of the misfit that
-/// candidate explains beside it; its words say so and how to fit them together.
+/// candidate explains beside it; its words say so and how to fit them together, the run's own
+/// withholdings (`kept_out`) kept.
 fn mark_passed_over(
     findings: &mut [Finding],
-    stand_ins: &[String],
+    (stand_ins, kept_out): (&[String], &[String]),
     passed_over: &[(usize, f64, f64)],
 ) {
     for f in findings.iter_mut().filter(|f| f.is_cause()) {
@@ -1066,7 +1129,12 @@ fn mark_passed_over(
         if beside.is_empty() {
             continue;
         }
-        let withheld: Vec<String> = stand_ins.iter().map(|n| format!("!{n}")).collect();
+        // (what the run's own --candidates kept out stays out)
+        let withheld: Vec<String> = kept_out
+            .iter()
+            .cloned()
+            .chain(stand_ins.iter().map(|n| format!("!{n}")))
+            .collect();
         let why = format!(
             "once the stand-ins ({}) are dropped, {} become significant beside it: its value was fitted while a stand-in took part of their misfit and is not final; run again with --candidates '{}' to fit them together",
             stand_ins.join(", "),
@@ -1669,6 +1737,7 @@ fn complete_findings(
                 .collect(),
             equivalent_estimates: n.equivalent_estimates.clone(),
             withheld_alike: Vec::new(),
+            withheld_named: false,
             glr_estimate: n.glr_estimate,
             glr_sigma: n.glr_sigma,
             round: n.round,
@@ -1996,6 +2065,7 @@ mod tests {
             equivalent: vec![],
             equivalent_estimates: vec![],
             withheld_alike: Vec::new(),
+            withheld_named: false,
             glr_estimate: 0.0,
             glr_sigma: 0.0,
             round: 1,
@@ -2321,6 +2391,39 @@ mod tests {
         );
         // a family of which one member is withheld is no contradiction
         assert!(parse_candidates(Some("size_*,!size_x"), &base).is_ok());
+    }
+
+    #[test]
+    fn a_candidate_list_that_does_nothing_it_says_is_refused() {
+        let base = Model::parse("P28").unwrap();
+        let err = |spec: &str| parse_candidates(Some(spec), &base).unwrap_err();
+        let e = err("!!d_x");
+        assert!(e.contains("doubled `!`") && e.contains("(`!d_x`)"), "{e}");
+        // a withholding of a term that was never named takes nothing back
+        let e = err("d_x,!kas_x");
+        assert!(
+            e.contains("`!kas_x` withholds nothing") && e.contains("not among"),
+            "{e}"
+        );
+        // a baseline term is no candidate to withhold, nor to name alone
+        let e = err("!nabla_x");
+        assert!(e.contains("in the baseline model P28"), "{e}");
+        let e = err("nabla_x");
+        assert!(
+            e.contains("already in the baseline model P28") && e.contains("nothing is left"),
+            "{e}"
+        );
+        // one baseline term beside a candidate is skipped (the CLI notes it)
+        assert!(parse_candidates(Some("nabla_x,d_x"), &base).is_ok());
+    }
+
+    #[test]
+    fn the_users_withholdings_are_kept_as_families_where_whole() {
+        let base = Model::parse("P28").unwrap();
+        let given = parse_candidates(Some("!d_*,!kaq_x_xy"), &base).unwrap();
+        assert_eq!(withheld_by_the_user(&base, &given), ["!d_*", "!kaq_x_xy"]);
+        let all = parse_candidates(None, &base).unwrap();
+        assert!(withheld_by_the_user(&base, &all).is_empty());
     }
 
     #[test]

@@ -1259,6 +1259,7 @@ fn noise_finding(
         equivalent: Vec::new(),
         equivalent_estimates: Vec::new(),
         withheld_alike: Vec::new(),
+        withheld_named: false,
         glr_estimate: estimate,
         glr_sigma: f64::NAN,
         round: 0,

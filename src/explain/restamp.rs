@@ -353,6 +353,7 @@ fn offset_finding(e: &Explanation) -> Finding {
         equivalent: Vec::new(),
         equivalent_estimates: Vec::new(),
         withheld_alike: Vec::new(),
+        withheld_named: false,
         glr_estimate: of(|c| c.glr_estimate),
         glr_sigma: of(|c| c.glr_sigma),
         confounded_with: None,

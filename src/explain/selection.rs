@@ -279,34 +279,48 @@ fn equivalent(
         && !separable()
 }
 
-/// For each of the candidates `named` (indices into `sig.cands`), the candidates among `others`
-/// in its equivalence class given the rest of `named` (the same test as the selection's):
-/// (candidate index, GLR estimate, σ, display unit; |estimate| in prior σ).
-pub(super) fn alike_beside(
+/// A candidate that takes a named one's place: (candidate index, GLR estimate, σ, display
+/// unit; |estimate| in prior σ).
+pub(super) type TakenBy = (usize, f64, f64, f64);
+
+/// For each of the candidates `named` (indices into `sig.cands`), given the rest of `named`:
+/// its own |GLR estimate| in prior σ (NaN when it is not significant here), and the candidates
+/// among `others` that take its place: significant alone, and beside one of them it is no
+/// longer significant at the α-level χ²₁ quantile (all it explains, that one explains too; a
+/// term of the same signature, or a wider one that fits better), each
+/// as (candidate index, GLR estimate, σ, display unit; |estimate| in prior σ), given the rest.
+pub(super) fn taken_by(
     sig: &Signatures,
     named: &[usize],
     others: &[usize],
     opts: &ExplainOptions,
-) -> Vec<Vec<(usize, f64, f64, f64)>> {
+) -> Vec<(f64, Vec<TakenBy>)> {
     let sc = scaled(sig, opts);
     let (j, b) = (&sc.j, &sc.b[..]);
+    let margin = stats::chi2_isf(opts.alpha, 1.0);
     named
         .iter()
         .map(|&c| {
             let rest: Vec<usize> = named.iter().copied().filter(|&x| x != c).collect();
-            let Some((llr, _, _)) = cond_llr(j, b, &rest, c) else {
-                return Vec::new();
+            // (a finding not significant in this pass gives nothing to take)
+            let Some((_, ic, bc)) = cond_llr(j, b, &rest, c).filter(|x| x.0 >= margin) else {
+                return (f64::NAN, Vec::new());
             };
-            others
+            let taken = others
                 .iter()
-                .filter(|&&a| equivalent((j, b), &rest, (a, c, llr), opts))
-                .filter_map(|&a| {
-                    let (_, ia, ba) = cond_llr(j, b, &rest, a)?;
-                    let to_display = sc.sd[a] / common::TERMS[sig.cands[a]].display_to_si;
-                    let theta = ba / ia;
-                    Some((a, theta * to_display, to_display / ia.sqrt(), theta.abs()))
+                .filter_map(|&w| {
+                    // (a term that explains nothing here takes nothing's place)
+                    let (_, iw, bw) = cond_llr(j, b, &rest, w).filter(|x| x.0 >= margin)?;
+                    let with_w: Vec<usize> = rest.iter().copied().chain([w]).collect();
+                    let c_beside = cond_llr(j, b, &with_w, c).map_or(0.0, |x| x.0);
+                    (c_beside < margin).then(|| {
+                        let to_display = sc.sd[w] / common::TERMS[sig.cands[w]].display_to_si;
+                        let theta = bw / iw;
+                        (w, theta * to_display, to_display / iw.sqrt(), theta.abs())
+                    })
                 })
-                .collect()
+                .collect();
+            ((bc / ic).abs(), taken)
         })
         .collect()
 }

@@ -55,11 +55,11 @@ pub(super) fn withheld_alike(
     })?;
     let named: Vec<usize> = (0..terms.len()).collect();
     let others: Vec<usize> = (terms.len()..pool.len()).collect();
-    let alike = selection::alike_beside(&pass.sig, &named, &others, ctx.opts);
-    for (&(k, t), members) in judged.iter().zip(alike) {
+    let taken = selection::taken_by(&pass.sig, &named, &others, ctx.opts);
+    for (&(k, t), (own, members)) in judged.iter().zip(taken) {
         // (a withheld term of another sensor is no rival of this one)
         let sensor = common::TERMS[t].sensor;
-        let members: Vec<EquivalentTerm> = members
+        let mut members: Vec<EquivalentTerm> = members
             .into_iter()
             .filter(|m| common::TERMS[pool[m.0]].sensor == sensor)
             .map(|(a, estimate, sigma, prior_sigmas)| {
@@ -73,9 +73,10 @@ pub(super) fn withheld_alike(
                 }
             })
             .collect();
-        if members.is_empty() {
+        if members.is_empty() || !own.is_finite() {
             continue;
         }
+        members.sort_by(|a, b| a.prior_sigmas.total_cmp(&b.prior_sigmas));
         let f = &mut findings[k];
         let listed: Vec<String> = members
             .iter()
@@ -90,14 +91,53 @@ pub(super) fn withheld_alike(
                 )
             })
             .collect();
-        let why = format!(
-            "the data cannot tell it from {}, which {} not among the candidates: a term outside the candidates fits these data as well and could equally be the cause; offer {} as a candidate and run again",
-            listed.join(", "),
-            if members.len() == 1 { "is" } else { "are" },
-            if members.len() == 1 { "it" } else { "them" }
-        );
-        f.withheld_alike = members;
-        not_named(f, why);
+        let (which, offer) = if members.len() == 1 {
+            ("which is", "it as a candidate")
+        } else {
+            ("which are", "them as candidates")
+        };
+        let most = members[0].prior_sigmas;
+        let widest = members
+            .iter()
+            .map(|m| m.prior_sigmas)
+            .chain(f.equivalent_estimates.iter().map(|e| e.prior_sigmas.abs()))
+            .fold(own, f64::max);
+        let why = if most < own {
+            // the selection would have named the withheld term: the priors prefer it
+            Some(format!(
+                "what it explains, {}, {which} not among the candidates, explains as well (beside it, it is no longer significant), and the spec's priors find {} more plausible than its {} prior σ: a term outside the candidates could equally be the cause; offer {offer} and run again",
+                listed.join(", "),
+                members[0].term,
+                sig3(own)
+            ))
+        } else if own > 3.0 && widest / own >= selection::UNATTRIBUTED_RATIO {
+            // as within a class: priors that do not fit this sensor would choose
+            Some(format!(
+                "what it explains, {}, {which} not among the candidates, explains as well (beside it, it is no longer significant); it needs {} prior σ, and the values would differ by {}× in prior σ: priors that do not fit this sensor would choose, not the data; offer {offer} and run again",
+                listed.join(", "),
+                sig3(own),
+                sig3(widest / own)
+            ))
+        } else {
+            None
+        };
+        match why {
+            Some(why) => {
+                f.withheld_named = true;
+                f.withheld_alike = members;
+                not_named(f, why);
+            }
+            None => {
+                // named by the priors, as the selection names a class's most plausible member
+                f.words.push_str(&format!(
+                    ". What it explains, {}, {which} not among the candidates, explains as well; the spec's priors find {} (at {} prior σ) the most plausible",
+                    listed.join(", "),
+                    f.term,
+                    sig3(own)
+                ));
+                f.withheld_alike = members;
+            }
+        }
     }
     Ok(())
 }

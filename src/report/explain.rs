@@ -309,7 +309,7 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
     for f in &e.findings {
         let verdict = if f.stand_in.is_some() {
             "fitted, but not a cause (a stand-in)"
-        } else if !f.withheld_alike.is_empty() {
+        } else if f.withheld_named {
             "fitted, not attributed (a withheld term fits as well)"
         } else if f.not_attributed.is_some() {
             "fitted, not attributed (class not separable)"

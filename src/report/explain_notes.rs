@@ -66,6 +66,25 @@ pub fn demo_against_truth(e: &Explanation) -> String {
         })
         .collect();
     if against.is_empty() {
+        // withheld, a d term may still be named as what a finding's term stands for
+        let mut alike: Vec<String> = Vec::new();
+        for w in e.findings.iter().flat_map(|f| &f.withheld_alike) {
+            let line = format!(
+                "{} {:+.2} % (± {:.2} %)",
+                w.term,
+                (w.estimate / 490.0 - 1.0) * 100.0,
+                w.sigma / 490.0 * 100.0
+            );
+            if w.term.starts_with("d_") && w.unit == "ug/g^2" && !alike.contains(&line) {
+                alike.push(line);
+            }
+        }
+        if !alike.is_empty() {
+            return format!(
+                "(hidden truth: d = 490 ug/g^2 on every axis; no d_ term was a finding, but the findings name d terms outside the candidates that would explain as well, at {} against it)",
+                alike.join(", ")
+            );
+        }
         return "(hidden truth: d = 490 ug/g^2 on every axis; no d_ term was found, so there is no estimate to hold against it)".to_string();
     }
     format!(
