@@ -331,6 +331,10 @@ fn finish(
 ) -> Result<()> {
     let mut e = e.clone();
     explain_notes::note_skipped(&mut e, skipped);
+    // a prefix that reaches across families (`!d*`: d_x … and dt_gnss) is said, not assumed
+    for note in explain::prefix_reach(args.candidates.as_deref()) {
+        e.summary.insert(0, note);
+    }
     // what was said about the data goes first: a finding on data with a slip stands on it
     for (k, w) in sinsmodel::io::warnings::take().into_iter().enumerate() {
         e.summary.insert(k, format!("Warning about the data: {w}"));

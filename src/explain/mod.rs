@@ -1074,12 +1074,51 @@ fn judged_stand_ins(r: &Rounds, judged: &[Finding]) -> Vec<String> {
     out
 }
 
+/// The family of a spec term's name: its prefix up to and with its first `_` (`kaq_`, `d_`).
+fn family(name: &str) -> &str {
+    &name[..name.find('_').map_or(name.len(), |k| k + 1)]
+}
+
+/// Notes on the prefix items of a `--candidates` list that match terms of more than one
+/// family (`!d*` withholds d_x, d_y, d_z and dt_gnss): what each matched.
+pub fn prefix_reach(spec: Option<&str>) -> Vec<String> {
+    let Some(spec) = spec else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for item in spec.split(',').map(str::trim) {
+        let Some(prefix) = item.trim_start_matches('!').strip_suffix('*') else {
+            continue;
+        };
+        let names: Vec<&str> = common::TERMS
+            .iter()
+            .map(|t| t.name)
+            .filter(|n| n.starts_with(prefix))
+            .collect();
+        let mut families: Vec<&str> = Vec::new();
+        for n in &names {
+            if !families.contains(&family(n)) {
+                families.push(family(n));
+            }
+        }
+        if families.len() > 1 {
+            out.push(format!(
+                "--candidates item `{item}` matches the terms {} ({} families: {}); give `{}*` for one family alone.",
+                names.join(", "),
+                families.len(),
+                families.join(", "),
+                families[0]
+            ));
+        }
+    }
+    out
+}
+
 /// The spec terms outside `baseline` that are not among the candidates `given` as
 /// `--candidates` withholdings: `!family_*` where every term of a family is out (a family: the
 /// names' common prefix up to its first `_`), else `!name`; none when every term is a candidate.
 fn withheld_by_the_user(baseline: &Model, given: &[usize]) -> Vec<String> {
     let out = |t: usize| !given.contains(&t) && !baseline.states.contains(&StateRef::Term(t));
-    let family = |name: &'static str| &name[..name.find('_').map_or(name.len(), |k| k + 1)];
     let mut items: Vec<String> = Vec::new();
     for t in (0..common::TERM_COUNT).filter(|&t| out(t)) {
         let fam = family(common::TERMS[t].name);
@@ -2422,6 +2461,13 @@ mod tests {
         let base = Model::parse("P28").unwrap();
         let given = parse_candidates(Some("!d_*,!kaq_x_xy"), &base).unwrap();
         assert_eq!(withheld_by_the_user(&base, &given), ["!d_*", "!kaq_x_xy"]);
+        // a prefix across families is said (d_ and dt_), one within a family is not
+        let notes = prefix_reach(Some("!d*,kaq_*"));
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].contains("dt_gnss") && notes[0].contains("`d_*`"),
+            "{notes:?}"
+        );
         let all = parse_candidates(None, &base).unwrap();
         assert!(withheld_by_the_user(&base, &all).is_empty());
     }
