@@ -280,7 +280,20 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
             // a withholding that takes nothing back is a mistake, not a no-op to pass over
             if !matched.iter().any(|t| out.contains(t)) {
                 let names: Vec<&str> = matched.iter().map(|&t| common::TERMS[t].name).collect();
-                let why = if matched.iter().all(|&t| in_base(t)) {
+                let earlier: Vec<String> = sets
+                    .iter()
+                    .filter(|(d, _, w)| *d && w.iter().any(|t| matched.contains(t)))
+                    .filter(|(_, name, _)| *name != item)
+                    .map(|(_, name, _)| format!("`!{name}`"))
+                    .collect();
+                let why = if !earlier.is_empty() {
+                    format!(
+                        "{} {} already withheld by {}",
+                        names.join(", "),
+                        if names.len() == 1 { "is" } else { "are" },
+                        earlier.join(", ")
+                    )
+                } else if matched.iter().all(|&t| in_base(t)) {
                     format!(
                         "{} {} in the baseline model {}, so no candidate; to fit without it, give a model without it",
                         names.join(", "),
@@ -506,7 +519,16 @@ pub fn explain(
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
     keep_stand_ins(ctx, &r, &mut findings, judged, &rivals, misfit_unexplained);
-    let kept_out = withheld_by_the_user(baseline, given);
+    // a term the candidates keep out that explains a finding as well: before the re-run a
+    // passed-over cause suggests, which then offers it
+    withheld::withheld_alike(ctx, &r, &mut findings, &cands, progress)?;
+    let offered: Vec<usize> = findings
+        .iter()
+        .filter(|f| f.withheld_named)
+        .flat_map(|f| f.withheld_alike.iter().filter_map(|w| term_index(&w.term)))
+        .chain(given.iter().copied())
+        .collect();
+    let kept_out = withheld_by_the_user(baseline, &offered);
     mark_passed_over(&mut findings, (&stand_ins, &kept_out), &passed_over);
     let in_place = judge_final(
         ctx,
@@ -750,8 +772,7 @@ fn value_not_fixed(findings: &mut [Finding]) {
 
 /// The rules that judge the findings of the rounds `r` once their values are final (`tests`:
 /// the candidates' tests; `cands`: the candidates; `rivals`: the rivals that took the judged
-/// stand-ins' places): a companion that moves, a term the candidates withhold that fits as
-/// well, an aiding term confounded with a sensor term, a
+/// stand-ins' places): a companion that moves, an aiding term confounded with a sensor term, a
 /// value not fixed, a GNSS cause beside an offset that is none, a value that leans on a
 /// stand-in; then the noise findings `noise` join, none named beside an offset left to a
 /// stand-in. Returns whether the last two unnamed a cause (its term then leaves the extended
@@ -765,7 +786,6 @@ fn judge_final(
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<bool> {
     companions_move(ctx, r, tests, findings, progress)?;
-    withheld::withheld_alike(ctx, r, findings, cands, progress)?;
     aiding_and_sensor_confounded(ctx, r, findings, progress)?;
     value_not_fixed(findings);
     let late = rivals::offset_stand_ins(ctx, r, findings, cands, progress)?;
@@ -1117,8 +1137,17 @@ pub fn prefix_reach(spec: Option<&str>) -> Vec<String> {
 /// The spec terms outside `baseline` that are not among the candidates `given` as
 /// `--candidates` withholdings: `!family_*` where every term of a family is out (a family: the
 /// names' common prefix up to its first `_`), else `!name`; none when every term is a candidate.
+/// Sensors none of whose terms is given (GNSS terms on static aiding) are left out.
 fn withheld_by_the_user(baseline: &Model, given: &[usize]) -> Vec<String> {
-    let out = |t: usize| !given.contains(&t) && !baseline.states.contains(&StateRef::Term(t));
+    // (a sensor none of whose terms is given is one the data hold no measurement of)
+    let tested = |t: usize| {
+        given
+            .iter()
+            .any(|&g| common::TERMS[g].sensor == common::TERMS[t].sensor)
+    };
+    let out = |t: usize| {
+        !given.contains(&t) && !baseline.states.contains(&StateRef::Term(t)) && tested(t)
+    };
     let mut items: Vec<String> = Vec::new();
     for t in (0..common::TERM_COUNT).filter(|&t| out(t)) {
         let fam = family(common::TERMS[t].name);
@@ -2445,6 +2474,8 @@ mod tests {
             "{e}"
         );
         // a baseline term is no candidate to withhold, nor to name alone
+        let e = err("!d_*,!d_x");
+        assert!(e.contains("already withheld by `!d_*`"), "{e}");
         let e = err("!nabla_x");
         assert!(e.contains("in the baseline model P28"), "{e}");
         let e = err("nabla_x");

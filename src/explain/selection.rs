@@ -279,6 +279,88 @@ fn equivalent(
         && !separable()
 }
 
+/// The log-likelihood ratio b_Sᵀ J_SS⁻¹ b_S of the candidates `set` together, given `chosen`
+/// (their joint conditional test, χ²_|set| under the null); 0 where the information is singular.
+fn joint_llr(j: &DMatrix<f64>, b: &[f64], chosen: &[usize], set: &[usize]) -> f64 {
+    let fit = |idx: &[usize]| -> Option<f64> {
+        if idx.is_empty() {
+            return Some(0.0);
+        }
+        let jj = DMatrix::from_fn(idx.len(), idx.len(), |x, y| j[(idx[x], idx[y])]);
+        let bb = nalgebra::DVector::from_fn(idx.len(), |x, _| b[idx[x]]);
+        let sol = jj.cholesky()?.solve(&bb);
+        Some(bb.dot(&sol))
+    };
+    let all: Vec<usize> = chosen.iter().chain(set).copied().collect();
+    match (fit(&all), fit(chosen)) {
+        (Some(a), Some(c)) => (a - c).max(0.0),
+        _ => 0.0,
+    }
+}
+
+/// Pairs of the candidates `pairs_of` (indices into `sig.cands`, among `named`) that one
+/// candidate among `others` takes the place of together, given the rest of `named`: the pair
+/// is significant together (at the α-level χ²₂ quantile) and each beside the other (χ²₁), the
+/// other is significant alone, and beside it the pair is no longer significant, together or
+/// each beside the other. Each as (a, b, that candidate, its GLR estimate, σ, display
+/// unit; |estimate| in prior σ), given the rest.
+pub(super) fn taken_together(
+    sig: &Signatures,
+    (named, pairs_of): (&[usize], &[usize]),
+    others: &[usize],
+    opts: &ExplainOptions,
+) -> Vec<(usize, usize, usize, f64, f64, f64)> {
+    let sc = scaled(sig, opts);
+    let (j, b) = (&sc.j, &sc.b[..]);
+    let (m1, m2) = (
+        stats::chi2_isf(opts.alpha, 1.0),
+        stats::chi2_isf(opts.alpha, 2.0),
+    );
+    let mut out = Vec::new();
+    for (x, &a) in pairs_of.iter().enumerate() {
+        for &c in &pairs_of[x + 1..] {
+            let rest: Vec<usize> = named
+                .iter()
+                .copied()
+                .filter(|&n| n != a && n != c)
+                .collect();
+            // each significant beside the other (both are findings here, not one and noise)
+            let beside = |x: usize, extra: &[usize]| {
+                let s: Vec<usize> = rest.iter().chain(extra).copied().collect();
+                cond_llr(j, b, &s, x).map_or(0.0, |v| v.0)
+            };
+            if joint_llr(j, b, &rest, &[a, c]) < m2 || beside(a, &[c]) < m1 || beside(c, &[a]) < m1
+            {
+                continue;
+            }
+            for &w in others {
+                let Some((_, iw, bw)) = cond_llr(j, b, &rest, w).filter(|x| x.0 >= m1) else {
+                    continue;
+                };
+                let with_w: Vec<usize> = rest.iter().copied().chain([w]).collect();
+                // beside it neither is significant, together or each beside the other
+                if joint_llr(j, b, &with_w, &[a, c]) < m2
+                    && beside(a, &[c, w]) < m1
+                    && beside(c, &[a, w]) < m1
+                {
+                    let to_display = sc.sd[w] / common::TERMS[sig.cands[w]].display_to_si;
+                    let theta = bw / iw;
+                    out.push((
+                        a,
+                        c,
+                        w,
+                        theta * to_display,
+                        to_display / iw.sqrt(),
+                        theta.abs(),
+                    ));
+                    break;
+                }
+            }
+        }
+    }
+    out
+}
+
 /// A candidate that takes a named one's place: (candidate index, GLR estimate, σ, display
 /// unit; |estimate| in prior σ).
 pub(super) type TakenBy = (usize, f64, f64, f64);

@@ -1,6 +1,7 @@
-//! Spec terms withheld from the candidates that a sensor finding cannot be told from on these
-//! data. The rounds can only name the nearest candidate; when a withheld term has the same
-//! signature, it could equally be the cause, and the finding says so instead of naming its term.
+//! Spec terms kept out of the candidates that explain all a sensor finding does. The rounds can
+//! only name the nearest candidate; when a term kept out takes the finding's place and the
+//! priors find it the more plausible, it could equally be the cause, and the finding says so
+//! instead of naming its own term.
 
 use super::findings::{EquivalentTerm, Finding};
 use super::words::sig3;
@@ -9,13 +10,17 @@ use crate::model::catalog::StateRef;
 use crate::model::generated::common;
 
 /// Each IMU-term finding among `findings` that is no stand-in (a cause, or a class not
-/// attributed, which the rounds' model may have dropped) is tested, in one more pass, against
-/// the spec terms of its sensor withheld from the candidates `cands`: the model of the rounds
-/// without those findings' terms, with the findings and the withheld terms as its candidates. A withheld term in a finding's
-/// equivalence class given the other findings (the selection's test) joins its
-/// `withheld_alike`, and the finding is not named: the data cannot say the cause is its term
-/// and not that one. Nothing runs when no term of such a sensor was withheld. (GNSS findings
-/// are tried against the withheld GNSS terms in `rivals`, one filter pass each.)
+/// attributed, which the rounds' model may have dropped) is tried, in one more pass, against
+/// the spec terms of its sensor that are not among the candidates `cands`: the model of the
+/// rounds without those findings' terms, with the findings and the terms kept out as its
+/// candidates. A term kept out that is significant alone and beside which the finding is no
+/// longer significant, given the other findings (all it explains, that term explains too),
+/// joins its `withheld_alike`. When the priors find such a term more plausible than the
+/// finding's (fewer prior σ), or the values differ by 10× in prior σ with the finding's beyond
+/// 3, the finding is not named, as the selection treats a class: the data cannot say the cause
+/// is its term and not that one. Otherwise it stays named and its words list them. Nothing runs
+/// when no term of such a sensor was kept out. (GNSS findings are tried against the GNSS terms
+/// kept out in `rivals`, one filter pass each.)
 pub(super) fn withheld_alike(
     ctx: &Context,
     r: &Rounds,
@@ -55,7 +60,64 @@ pub(super) fn withheld_alike(
     })?;
     let named: Vec<usize> = (0..terms.len()).collect();
     let others: Vec<usize> = (terms.len()..pool.len()).collect();
-    let taken = selection::taken_by(&pass.sig, &named, &others, ctx.opts);
+    // the misfit left is the rounds' model's: without the findings this pass's own mean NIS
+    // would scale every test down by the very misfit they explain (a 60-s demo's kaq_z_yz, 23σ
+    // in the extended filter, was no longer significant here)
+    let mut sig = pass.sig;
+    sig.dispersion = r.pass.sig.dispersion;
+    // one term kept out that takes two findings' place together is the simpler answer for both
+    let sensor_of = |x: usize| common::TERMS[pool[x]].sensor;
+    let mut pairs = Vec::new();
+    for &x in &named {
+        // (per sensor: the findings of one, the terms kept out of the same)
+        if named[..x].iter().any(|&y| sensor_of(y) == sensor_of(x)) {
+            continue;
+        }
+        let of = |v: &[usize]| -> Vec<usize> {
+            v.iter()
+                .copied()
+                .filter(|&y| sensor_of(y) == sensor_of(x))
+                .collect()
+        };
+        pairs.extend(selection::taken_together(
+            &sig,
+            (&named, &of(&named)),
+            &of(&others),
+            ctx.opts,
+        ));
+    }
+    for (a, b, w, est, sd, prior) in pairs {
+        if prior > ctx.opts.stand_in_prior_sigmas {
+            continue;
+        }
+        let info = &common::TERMS[pool[w]];
+        let other = |x: usize| common::TERMS[terms[x]].name;
+        for (x, y) in [(a, b), (b, a)] {
+            let f = &mut findings[judged[x].0];
+            if f.withheld_named {
+                continue;
+            }
+            let why = format!(
+                "what it and {} explain together, {} (it would need {} ± {} {}, {} prior σ, by the signatures), which is not among the candidates, explains alone (beside it, neither is significant): one term outside the candidates is the simpler answer and could be the cause of both; offer it as a candidate and run again",
+                other(y),
+                info.name,
+                sig3(est),
+                sig3(sd),
+                info.display,
+                sig3(prior)
+            );
+            f.withheld_named = true;
+            f.withheld_alike.push(EquivalentTerm {
+                term: info.name.to_string(),
+                estimate: est,
+                sigma: sd,
+                unit: info.display.to_string(),
+                prior_sigmas: prior,
+            });
+            not_named(f, why);
+        }
+    }
+    let taken = selection::taken_by(&sig, &named, &others, ctx.opts);
     for (&(k, t), (own, members)) in judged.iter().zip(taken) {
         // (a withheld term of another sensor is no rival of this one)
         let sensor = common::TERMS[t].sensor;
@@ -73,11 +135,11 @@ pub(super) fn withheld_alike(
                 }
             })
             .collect();
-        if members.is_empty() || !own.is_finite() {
+        let f = &mut findings[k];
+        if members.is_empty() || !own.is_finite() || f.withheld_named {
             continue;
         }
         members.sort_by(|a, b| a.prior_sigmas.total_cmp(&b.prior_sigmas));
-        let f = &mut findings[k];
         let listed: Vec<String> = members
             .iter()
             .map(|m| {
@@ -91,10 +153,10 @@ pub(super) fn withheld_alike(
                 )
             })
             .collect();
-        let (which, offer) = if members.len() == 1 {
-            ("which is", "it as a candidate")
+        let (each, which, offer) = if members.len() == 1 {
+            ("", "which is", "it as a candidate")
         } else {
-            ("which are", "them as candidates")
+            ("each of ", "which are", "them as candidates")
         };
         let most = members[0].prior_sigmas;
         let widest = members
@@ -105,7 +167,7 @@ pub(super) fn withheld_alike(
         let why = if most < own {
             // the selection would have named the withheld term: the priors prefer it
             Some(format!(
-                "what it explains, {}, {which} not among the candidates, explains as well (beside it, it is no longer significant), and the spec's priors find {} more plausible than its {} prior σ: a term outside the candidates could equally be the cause; offer {offer} and run again",
+                "what it explains, {each}{}, {which} not among the candidates, explains as well (beside it, it is no longer significant), and the spec's priors find {} more plausible than it (its value in that pass needs {} prior σ): a term outside the candidates could equally be the cause; offer {offer} and run again",
                 listed.join(", "),
                 members[0].term,
                 sig3(own)
@@ -113,7 +175,7 @@ pub(super) fn withheld_alike(
         } else if own > 3.0 && widest / own >= selection::UNATTRIBUTED_RATIO {
             // as within a class: priors that do not fit this sensor would choose
             Some(format!(
-                "what it explains, {}, {which} not among the candidates, explains as well (beside it, it is no longer significant); it needs {} prior σ, and the values would differ by {}× in prior σ: priors that do not fit this sensor would choose, not the data; offer {offer} and run again",
+                "what it explains, {each}{}, {which} not among the candidates, explains as well (beside it, it is no longer significant); its value in that pass needs {} prior σ, and the values would differ by {}× in prior σ: priors that do not fit this sensor would choose, not the data; offer {offer} and run again",
                 listed.join(", "),
                 sig3(own),
                 sig3(widest / own)
@@ -130,7 +192,7 @@ pub(super) fn withheld_alike(
             None => {
                 // named by the priors, as the selection names a class's most plausible member
                 f.words.push_str(&format!(
-                    ". What it explains, {}, {which} not among the candidates, explains as well; the spec's priors find {} (at {} prior σ) the most plausible",
+                    ". What it explains, {each}{}, {which} not among the candidates, explains as well; the spec's priors find {} (at {} prior σ in that pass) the most plausible",
                     listed.join(", "),
                     f.term,
                     sig3(own)

@@ -272,10 +272,33 @@ fn short_words(f: &crate::explain::Finding) -> String {
             " — probably a stand-in for an effect the candidates do not describe (section 3)",
         );
     } else if f.not_attributed.is_some() {
-        s.push_str(" — its class cannot be told apart on these data (section 3)");
+        s.push_str(&format!(" — {} (section 3)", not_attributed_because(f).1));
     }
     s.push('.');
     s
+}
+
+/// Why a finding is not attributed, short (the table's verdict) and as a clause: a term kept
+/// out of the candidates fits as well, its class cannot be told apart, or its value is not
+/// fixed (it moves beside another term, leans on a stand-in or is within 1σ of zero).
+fn not_attributed_because(f: &crate::explain::Finding) -> (&'static str, &'static str) {
+    let why = f.not_attributed.as_deref().unwrap_or("");
+    if f.withheld_named {
+        (
+            "a withheld term fits as well",
+            "a term the candidates keep out explains it as well",
+        )
+    } else if why.starts_with("the data cannot tell") {
+        (
+            "class not separable",
+            "its class cannot be told apart on these data",
+        )
+    } else {
+        (
+            "value not fixed",
+            "the data do not fix its value beside the other terms",
+        )
+    }
 }
 
 /// A figure as an HTML block in the Markdown (rendered by Markdown viewers and embedded by the
@@ -309,10 +332,8 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
     for f in &e.findings {
         let verdict = if f.stand_in.is_some() {
             "fitted, but not a cause (a stand-in)"
-        } else if f.withheld_named {
-            "fitted, not attributed (a withheld term fits as well)"
         } else if f.not_attributed.is_some() {
-            "fitted, not attributed (class not separable)"
+            &format!("fitted, not attributed ({})", not_attributed_because(f).0)
         } else if f.kind == "noise" {
             "**found: a noise level**"
         } else {
