@@ -852,7 +852,8 @@ fn a_withheld_term_that_fits_as_well_is_named_and_nothing_is_claimed() {
 /// size_y and d_y, each of which size_x_y explains together with the other; one term kept out
 /// that explains two findings is the simpler answer (helper-53: both were "Found", size_y =
 /// −37 mm and d_y = −1082 µg/g², with size_y = d_y = 0 in the scenario). The report's words
-/// give that reason, not a class that cannot be told apart.
+/// give that reason, not a class that cannot be told apart. And with one delay kept out, a
+/// delay whose value leans on it is not named.
 #[test]
 fn one_term_kept_out_that_explains_two_findings_unnames_both() {
     let dir = tmp("turntable-withheld");
@@ -913,6 +914,43 @@ fn one_term_kept_out_that_explains_two_findings_unnames_both() {
             && report.contains("fitted, not attributed (a withheld term fits as well)"),
         "{report}"
     );
+    // one delay kept out (helper-54): tau_y took up tau_z's part, "Found: tau_y = 3.81 ±
+    // 0.205 ms" for 2 hidden; fitted beside tau_z its value moves by more than 3σ
+    let out = dir.join("explain-tau");
+    let (ok, _, stderr) = sinsmodel(&[
+        "explain",
+        "--model",
+        "P28",
+        "--imu",
+        imu.to_str().unwrap(),
+        "--static-aid",
+        "30,114,20",
+        "--truth",
+        truth.to_str().unwrap(),
+        "--candidates",
+        "!tau_z",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let v = json(&out.join("explain.json"));
+    for f in v["findings"].as_array().unwrap() {
+        let (term, est) = (f["term"].as_str().unwrap(), f["estimate"].as_f64().unwrap());
+        if term.starts_with("tau_") && f["stand_in"].is_null() && f["not_attributed"].is_null() {
+            assert!(
+                (est - 2.0).abs() < 3.0 * f["sigma"].as_f64().unwrap(),
+                "{f}"
+            );
+        }
+    }
+    let tau_y = v["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["term"] == "tau_y")
+        .unwrap_or_else(|| panic!("tau_y not fitted: {stderr}"));
+    let why = tau_y["not_attributed"].as_str().unwrap_or("");
+    assert!(why.contains("leans on tau_z"), "{tau_y}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

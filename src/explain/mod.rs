@@ -519,25 +519,10 @@ pub fn explain(
     let misfit_unexplained = excess.map(|e| (last_pass.stats.nis_mean - 1.0) / e);
     let mut findings = complete_findings(ctx, &r, excess, misfit_unexplained)?;
     keep_stand_ins(ctx, &r, &mut findings, judged, &rivals, misfit_unexplained);
-    // a term the candidates keep out that explains a finding as well: before the re-run a
-    // passed-over cause suggests, which then offers it
-    withheld::withheld_alike(ctx, &r, &mut findings, &cands, progress)?;
-    let offered: Vec<usize> = findings
-        .iter()
-        .filter(|f| f.withheld_named)
-        .flat_map(|f| f.withheld_alike.iter().filter_map(|w| term_index(&w.term)))
-        .chain(given.iter().copied())
-        .collect();
-    let kept_out = withheld_by_the_user(baseline, &offered);
-    mark_passed_over(&mut findings, (&stand_ins, &kept_out), &passed_over);
-    let in_place = judge_final(
-        ctx,
-        &r,
-        &tests,
-        (&mut findings, noise),
-        (&cands, &rivals),
-        progress,
-    )?;
+    let kept_out = (&cands[..], given, &stand_ins[..], &passed_over[..]);
+    judge_kept_out(ctx, &r, &mut findings, kept_out, progress)?;
+    let judged_now = (&mut findings, noise);
+    let in_place = judge_final(ctx, &r, &tests, judged_now, (&cands, &rivals), progress)?;
     let held_by_noise = match &noise_stage {
         Some(noise) => held_only_by_the_stated_noise(ctx, &r, noise, &mut findings, progress)?,
         None => false,
@@ -590,6 +575,38 @@ pub fn explain(
     };
     expl.summary = summary(&expl);
     Ok(expl)
+}
+
+/// What [`judge_kept_out`] reads: the candidates here, the candidates as given, the stand-ins
+/// (with their classes) and the candidates passed over ((term, GLR estimate, σ)).
+type KeptOut<'a> = (
+    &'a [usize],
+    &'a [usize],
+    &'a [String],
+    &'a [(usize, f64, f64)],
+);
+
+/// The findings tried against the terms the candidates keep out ([`withheld::withheld_alike`]),
+/// then the causes a passed-over candidate un-names ([`mark_passed_over`]): first, so that the
+/// re-run those suggest offers what a finding names (`cands`: the candidates here; `given`: as
+/// given, whose withholdings the suggestion keeps).
+fn judge_kept_out(
+    ctx: &Context,
+    r: &Rounds,
+    findings: &mut [Finding],
+    (cands, given, stand_ins, passed_over): KeptOut,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<()> {
+    withheld::withheld_alike(ctx, r, findings, cands, progress)?;
+    let offered: Vec<usize> = findings
+        .iter()
+        .filter(|f| f.withheld_named)
+        .flat_map(|f| f.withheld_alike.iter().filter_map(|w| term_index(&w.term)))
+        .chain(given.iter().copied())
+        .collect();
+    let kept_out = withheld_by_the_user(ctx.baseline, &offered);
+    mark_passed_over(findings, (stand_ins, &kept_out), passed_over);
+    Ok(())
 }
 
 /// Candidates the rounds passed over that are significant beside the causes once the
@@ -1204,9 +1221,10 @@ fn mark_passed_over(
             .chain(stand_ins.iter().map(|n| format!("!{n}")))
             .collect();
         let why = format!(
-            "once the stand-ins ({}) are dropped, {} become significant beside it: its value was fitted while a stand-in took part of their misfit and is not final; run again with --candidates '{}' to fit them together",
+            "once the stand-ins ({}) are dropped, {} {} significant beside it: its value was fitted while a stand-in took part of their misfit and is not final; run again with --candidates '{}' to fit them together",
             stand_ins.join(", "),
             beside.join(", "),
+            if beside.len() == 1 { "becomes" } else { "become" },
             withheld.join(",")
         );
         not_named(f, why);

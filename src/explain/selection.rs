@@ -361,6 +361,54 @@ pub(super) fn taken_together(
     out
 }
 
+/// A candidate that moves a named one's value: (candidate, the named one's estimate beside it
+/// and its σ, the candidate's estimate and σ; display units).
+pub(super) type MovedBy = (usize, [f64; 2], [f64; 2]);
+
+/// For each of the candidates `named` (indices into `sig.cands`), given the rest of `named`:
+/// the candidates among `others` that move its value, each as (candidate, the named one's
+/// estimate beside it and its σ, the other's estimate and σ; display units). One moves it when
+/// it is significant beside it (α-level χ²₁ quantile) and the named one's estimate beside it
+/// differs from its estimate without it by more than 3 of its σ beside it: the named one's
+/// value leans on that term's absence.
+pub(super) fn moved_by(
+    sig: &Signatures,
+    named: &[usize],
+    others: &[usize],
+    opts: &ExplainOptions,
+) -> Vec<Vec<MovedBy>> {
+    let sc = scaled(sig, opts);
+    let (j, b) = (&sc.j, &sc.b[..]);
+    let margin = stats::chi2_isf(opts.alpha, 1.0);
+    let display = |x: usize, (ix, bx): (f64, f64)| {
+        let to_display = sc.sd[x] / common::TERMS[sig.cands[x]].display_to_si;
+        [bx / ix * to_display, to_display / ix.sqrt()]
+    };
+    named
+        .iter()
+        .map(|&c| {
+            let rest: Vec<usize> = named.iter().copied().filter(|&x| x != c).collect();
+            let Some((_, ic, bc)) = cond_llr(j, b, &rest, c) else {
+                return Vec::new();
+            };
+            let alone = display(c, (ic, bc));
+            let with_c: Vec<usize> = rest.iter().copied().chain([c]).collect();
+            others
+                .iter()
+                .filter_map(|&w| {
+                    cond_llr(j, b, &with_c, w).filter(|x| x.0 >= margin)?;
+                    let with_w: Vec<usize> = rest.iter().copied().chain([w]).collect();
+                    let (_, icw, bcw) = cond_llr(j, b, &with_w, c)?;
+                    let beside = display(c, (icw, bcw));
+                    let (_, iw, bw) = cond_llr(j, b, &with_c, w)?;
+                    ((beside[0] - alone[0]).abs() > 3.0 * beside[1])
+                        .then(|| (w, beside, display(w, (iw, bw))))
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// A candidate that takes a named one's place: (candidate index, GLR estimate, σ, display
 /// unit; |estimate| in prior σ).
 pub(super) type TakenBy = (usize, f64, f64, f64);

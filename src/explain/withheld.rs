@@ -65,10 +65,48 @@ pub(super) fn withheld_alike(
     // in the extended filter, was no longer significant here)
     let mut sig = pass.sig;
     sig.dispersion = r.pass.sig.dispersion;
+    let tried = Tried {
+        sig,
+        judged,
+        terms,
+        pool,
+        named,
+        others,
+    };
+    unname_pairs(&tried, findings, ctx.opts);
+    unname_moved(&tried, findings, ctx.opts);
+    name_taken(&tried, findings, ctx.opts);
+    Ok(())
+}
+
+/// The pass that tries the terms kept out: its signatures (scaled by the rounds' dispersion),
+/// the findings tried ((finding index, term)), their terms, the pass's candidates (the terms
+/// then the ones kept out), and the indices of each among them.
+struct Tried {
+    sig: super::signatures::Signatures,
+    judged: Vec<(usize, usize)>,
+    terms: Vec<usize>,
+    pool: Vec<usize>,
+    named: Vec<usize>,
+    others: Vec<usize>,
+}
+
+/// One term kept out that takes two findings' place together (each significant beside the
+/// other, neither beside it) is the simpler answer for both: both are not named.
+fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOptions) {
+    let Tried {
+        sig,
+        judged,
+        terms,
+        pool,
+        named,
+        others,
+    } = tried;
+    let ctx_opts = opts;
     // one term kept out that takes two findings' place together is the simpler answer for both
     let sensor_of = |x: usize| common::TERMS[pool[x]].sensor;
     let mut pairs = Vec::new();
-    for &x in &named {
+    for &x in named.iter() {
         // (per sensor: the findings of one, the terms kept out of the same)
         if named[..x].iter().any(|&y| sensor_of(y) == sensor_of(x)) {
             continue;
@@ -80,14 +118,14 @@ pub(super) fn withheld_alike(
                 .collect()
         };
         pairs.extend(selection::taken_together(
-            &sig,
-            (&named, &of(&named)),
-            &of(&others),
-            ctx.opts,
+            sig,
+            (named, &of(named)),
+            &of(others),
+            ctx_opts,
         ));
     }
     for (a, b, w, est, sd, prior) in pairs {
-        if prior > ctx.opts.stand_in_prior_sigmas {
+        if prior > ctx_opts.stand_in_prior_sigmas {
             continue;
         }
         let info = &common::TERMS[pool[w]];
@@ -117,7 +155,62 @@ pub(super) fn withheld_alike(
             not_named(f, why);
         }
     }
-    let taken = selection::taken_by(&sig, &named, &others, ctx.opts);
+}
+
+/// A cause whose value leans on a term kept out (fitted beside it, significant there, the value
+/// moves by more than 3σ) is no value of the sensor's: it is not named.
+fn unname_moved(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOptions) {
+    let Tried {
+        sig,
+        judged,
+        pool,
+        named,
+        others,
+        ..
+    } = tried;
+    // a finding whose value leans on a term kept out (fitted beside it, the value moves by more
+    // than 3σ) is no value of the sensor's (turntable with `!tau_z`: tau_y 3.81 ms for 2 hidden)
+    let moved = selection::moved_by(sig, named, others, opts);
+    for (&(k, t), moves) in judged.iter().zip(moved) {
+        let f = &mut findings[k];
+        let Some((w, beside, wv)) = moves
+            .into_iter()
+            .find(|m| common::TERMS[pool[m.0]].sensor == common::TERMS[t].sensor)
+        else {
+            continue;
+        };
+        if !f.is_cause() {
+            continue;
+        }
+        let info = &common::TERMS[pool[w]];
+        let why = format!(
+            "its value leans on {}, which is not among the candidates: fitted beside it ({} = {} ± {} {}, significant there), it would be {} ± {} {} in that pass, beyond 3σ of its value without it; offer {} as a candidate and run again",
+            info.name,
+            info.name,
+            sig3(wv[0]),
+            sig3(wv[1]),
+            info.display,
+            sig3(beside[0]),
+            sig3(beside[1]),
+            f.unit,
+            info.name
+        );
+        not_named(f, why);
+    }
+}
+
+/// The terms kept out that explain all a finding does join its `withheld_alike`; the priors
+/// decide whether it is still named (see [`withheld_alike`]).
+fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOptions) {
+    let Tried {
+        sig,
+        judged,
+        pool,
+        named,
+        others,
+        ..
+    } = tried;
+    let taken = selection::taken_by(sig, named, others, opts);
     for (&(k, t), (own, members)) in judged.iter().zip(taken) {
         // (a withheld term of another sensor is no rival of this one)
         let sensor = common::TERMS[t].sensor;
@@ -201,5 +294,4 @@ pub(super) fn withheld_alike(
             }
         }
     }
-    Ok(())
 }
