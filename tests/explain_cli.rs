@@ -865,24 +865,29 @@ fn one_term_kept_out_that_explains_two_findings_unnames_both() {
         sim.to_str().unwrap(),
     ]);
     assert!(ok, "{stderr}");
-    let out = dir.join("explain");
     let (imu, truth) = (sim.join("imu.txt"), sim.join("truth.txt"));
-    let (ok, _, stderr) = sinsmodel(&[
-        "explain",
-        "--model",
-        "P28",
-        "--imu",
-        imu.to_str().unwrap(),
-        "--static-aid",
-        "30,114,20",
-        "--truth",
-        truth.to_str().unwrap(),
-        "--candidates",
-        "!size_x_y,!kaq_*",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
+    // explain on the turntable with the candidates `cands`, into `name`
+    let explained = |cands: &str, name: &str| -> (PathBuf, String) {
+        let out = dir.join(name);
+        let (ok, _, stderr) = sinsmodel(&[
+            "explain",
+            "--model",
+            "P28",
+            "--imu",
+            imu.to_str().unwrap(),
+            "--static-aid",
+            "30,114,20",
+            "--truth",
+            truth.to_str().unwrap(),
+            "--candidates",
+            cands,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{stderr}");
+        (out, stderr)
+    };
+    let (out, stderr) = explained("!size_x_y,!kaq_*", "explain");
     let v = json(&out.join("explain.json"));
     let mut pointed = 0;
     for f in v["findings"].as_array().unwrap() {
@@ -916,23 +921,7 @@ fn one_term_kept_out_that_explains_two_findings_unnames_both() {
     );
     // one delay kept out (helper-54): tau_y took up tau_z's part, "Found: tau_y = 3.81 ±
     // 0.205 ms" for 2 hidden; fitted beside tau_z its value moves by more than 3σ
-    let out = dir.join("explain-tau");
-    let (ok, _, stderr) = sinsmodel(&[
-        "explain",
-        "--model",
-        "P28",
-        "--imu",
-        imu.to_str().unwrap(),
-        "--static-aid",
-        "30,114,20",
-        "--truth",
-        truth.to_str().unwrap(),
-        "--candidates",
-        "!tau_z",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
+    let (out, stderr) = explained("!tau_z", "explain-tau");
     let v = json(&out.join("explain.json"));
     for f in v["findings"].as_array().unwrap() {
         let (term, est) = (f["term"].as_str().unwrap(), f["estimate"].as_f64().unwrap());

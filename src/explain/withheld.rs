@@ -102,8 +102,6 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
         named,
         others,
     } = tried;
-    let ctx_opts = opts;
-    // one term kept out that takes two findings' place together is the simpler answer for both
     let sensor_of = |x: usize| common::TERMS[pool[x]].sensor;
     let mut pairs = Vec::new();
     for &x in named.iter() {
@@ -121,11 +119,11 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
             sig,
             (named, &of(named)),
             &of(others),
-            ctx_opts,
+            opts,
         ));
     }
     for (a, b, w, est, sd, prior) in pairs {
-        if prior > ctx_opts.stand_in_prior_sigmas {
+        if prior > opts.stand_in_prior_sigmas {
             continue;
         }
         let info = &common::TERMS[pool[w]];
@@ -160,17 +158,9 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
 /// A cause whose value leans on a term kept out (fitted beside it, significant there, the value
 /// moves by more than 3σ) is no value of the sensor's: it is not named.
 fn unname_moved(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOptions) {
-    let Tried {
-        sig,
-        judged,
-        pool,
-        named,
-        others,
-        ..
-    } = tried;
-    // a finding whose value leans on a term kept out (fitted beside it, the value moves by more
-    // than 3σ) is no value of the sensor's (turntable with `!tau_z`: tau_y 3.81 ms for 2 hidden)
-    let moved = selection::moved_by(sig, named, others, opts);
+    let (pool, judged) = (&tried.pool, &tried.judged);
+    // (turntable with `!tau_z`: tau_y 3.81 ms for 2 hidden)
+    let moved = selection::moved_by(&tried.sig, &tried.named, &tried.others, opts);
     for (&(k, t), moves) in judged.iter().zip(moved) {
         let f = &mut findings[k];
         let Some((w, beside, wv)) = moves
@@ -202,15 +192,8 @@ fn unname_moved(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
 /// The terms kept out that explain all a finding does join its `withheld_alike`; the priors
 /// decide whether it is still named (see [`withheld_alike`]).
 fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOptions) {
-    let Tried {
-        sig,
-        judged,
-        pool,
-        named,
-        others,
-        ..
-    } = tried;
-    let taken = selection::taken_by(sig, named, others, opts);
+    let (pool, judged) = (&tried.pool, &tried.judged);
+    let taken = selection::taken_by(&tried.sig, &tried.named, &tried.others, opts);
     for (&(k, t), (own, members)) in judged.iter().zip(taken) {
         // (a withheld term of another sensor is no rival of this one)
         let sensor = common::TERMS[t].sensor;
