@@ -280,6 +280,7 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
             // a withholding that takes nothing back is a mistake, not a no-op to pass over
             if !matched.iter().any(|t| out.contains(t)) {
                 let names: Vec<&str> = matched.iter().map(|&t| common::TERMS[t].name).collect();
+                let is = if names.len() == 1 { "is" } else { "are" };
                 let earlier: Vec<String> = sets
                     .iter()
                     .filter(|(d, _, w)| *d && w.iter().any(|t| matched.contains(t)))
@@ -288,23 +289,20 @@ pub fn parse_candidates(spec: Option<&str>, baseline: &Model) -> Result<Vec<usiz
                     .collect();
                 let why = if !earlier.is_empty() {
                     format!(
-                        "{} {} already withheld by {}",
+                        "{} {is} already withheld by {}",
                         names.join(", "),
-                        if names.len() == 1 { "is" } else { "are" },
                         earlier.join(", ")
                     )
                 } else if matched.iter().all(|&t| in_base(t)) {
                     format!(
-                        "{} {} in the baseline model {}, so no candidate; to fit without it, give a model without it",
+                        "{} {is} in the baseline model {}, so no candidate; to fit without it, give a model without it",
                         names.join(", "),
-                        if names.len() == 1 { "is" } else { "are" },
                         baseline.name
                     )
                 } else {
                     format!(
-                        "{} {} not among the terms named before it (a withholding takes terms back from the names given, or from every term when only withholdings are given)",
-                        names.join(", "),
-                        if names.len() == 1 { "is" } else { "are" }
+                        "{} {is} not among the terms named before it (a withholding takes terms back from the names given, or from every term when only withholdings are given)",
+                        names.join(", ")
                     )
                 };
                 return Err(format!(

@@ -161,6 +161,7 @@ fn select(
 ) -> (Vec<Selected>, Vec<Implausible>) {
     let (j, b, sd) = (&sc.j, &sc.b[..], &sc.sd[..]);
     let m = cands.len();
+    let margin = stats::chi2_isf(opts.alpha, 1.0);
     let bic = (innovations.max(2) as f64).ln();
     let mut pool: Vec<usize> = (0..m).filter(|&c| eligible[c]).collect();
     let mut chosen: Vec<usize> = Vec::new();
@@ -190,8 +191,9 @@ fn select(
             (c, llr)
         };
         let mut members: Vec<(usize, f64, f64)> = vec![]; // (cand, θ' prior-scaled, info)
+        let with_c: Vec<usize> = chosen.iter().copied().chain([c]).collect();
         for &a in &pool {
-            if a == c || equivalent((j, b), &chosen, (a, c, llr), opts) {
+            if a == c || equivalent((j, b), (&chosen, &with_c), (a, c, llr), (margin, opts)) {
                 if let Some((_, ia, ba)) = cond(a, &chosen) {
                     members.push((a, ba / ia, ia));
                 }
@@ -260,23 +262,29 @@ fn cond_llr(j: &DMatrix<f64>, b: &[f64], chosen: &[usize], c: usize) -> Option<(
 }
 
 /// Whether candidate `a` is in the equivalence class of `c` (conditional llr `llr_c`) given the
-/// set `chosen`, on the prior-scaled (J', b'): their conditional signatures correlate at |ρ| >
-/// `rho_equivalent`, the data do not prefer `c` by more than the α-level χ²₁ quantile, and beside
-/// `c` the term `a` is no longer significant at that quantile (a term still significant beside
-/// c is not c's equivalent: the data separate them and hold both, as d and kas hidden on one
-/// axis, which correlate at |ρ| > 0.97).
+/// set `chosen` (`with_c`: it and `c`), on the prior-scaled (J', b'): their conditional
+/// signatures correlate at |ρ| > `rho_equivalent`, the data do not prefer `c` by more than
+/// `margin` (the α-level χ²₁ quantile), and beside `c` the term `a` is no longer significant at
+/// that quantile (a term still significant beside c is not c's equivalent: the data separate
+/// them and hold both, as d and kas hidden on one axis, which correlate at |ρ| > 0.97).
 fn equivalent(
     (j, b): (&DMatrix<f64>, &[f64]),
-    chosen: &[usize],
+    (chosen, with_c): (&[usize], &[usize]),
     (a, c, llr_c): (usize, usize, f64),
-    opts: &ExplainOptions,
+    (margin, opts): (f64, &ExplainOptions),
 ) -> bool {
-    let margin = stats::chi2_isf(opts.alpha, 1.0);
-    let with_c: Vec<usize> = chosen.iter().copied().chain([c]).collect();
-    let separable = || cond_llr(j, b, &with_c, a).is_some_and(|(l, _, _)| l >= margin);
+    let separable = || cond_llr(j, b, with_c, a).is_some_and(|(l, _, _)| l >= margin);
     conditional_rho(j, chosen, a, c).abs() > opts.rho_equivalent
         && cond_llr(j, b, chosen, a).is_some_and(|(la, _, _)| llr_c - la < margin)
         && !separable()
+}
+
+/// Candidate `x`'s GLR estimate and σ in its display unit, and |estimate| in prior σ, from its
+/// conditional information `ix` and score `bx` on the prior-scaled `sc` (candidates `cands`).
+fn shown(sc: &Scaled, cands: &[usize], x: usize, (ix, bx): (f64, f64)) -> (f64, f64, f64) {
+    let to_display = sc.sd[x] / common::TERMS[cands[x]].display_to_si;
+    let theta = bx / ix;
+    (theta * to_display, to_display / ix.sqrt(), theta.abs())
 }
 
 /// The log-likelihood ratio b_Sᵀ J_SS⁻¹ b_S of the candidates `set` together, given `chosen`
@@ -343,16 +351,8 @@ pub(super) fn taken_together(
                     && beside(a, &[c, w]) < m1
                     && beside(c, &[a, w]) < m1
                 {
-                    let to_display = sc.sd[w] / common::TERMS[sig.cands[w]].display_to_si;
-                    let theta = bw / iw;
-                    out.push((
-                        a,
-                        c,
-                        w,
-                        theta * to_display,
-                        to_display / iw.sqrt(),
-                        theta.abs(),
-                    ));
+                    let (est, sd, prior) = shown(&sc, &sig.cands, w, (iw, bw));
+                    out.push((a, c, w, est, sd, prior));
                     break;
                 }
             }
@@ -380,9 +380,9 @@ pub(super) fn moved_by(
     let sc = scaled(sig, opts);
     let (j, b) = (&sc.j, &sc.b[..]);
     let margin = stats::chi2_isf(opts.alpha, 1.0);
-    let display = |x: usize, (ix, bx): (f64, f64)| {
-        let to_display = sc.sd[x] / common::TERMS[sig.cands[x]].display_to_si;
-        [bx / ix * to_display, to_display / ix.sqrt()]
+    let display = |x: usize, info_score: (f64, f64)| {
+        let (est, sd, _) = shown(&sc, &sig.cands, x, info_score);
+        [est, sd]
     };
     named
         .iter()
@@ -444,9 +444,8 @@ pub(super) fn taken_by(
                     let with_w: Vec<usize> = rest.iter().copied().chain([w]).collect();
                     let c_beside = cond_llr(j, b, &with_w, c).map_or(0.0, |x| x.0);
                     (c_beside < margin).then(|| {
-                        let to_display = sc.sd[w] / common::TERMS[sig.cands[w]].display_to_si;
-                        let theta = bw / iw;
-                        (w, theta * to_display, to_display / iw.sqrt(), theta.abs())
+                        let (est, sd, prior) = shown(&sc, &sig.cands, w, (iw, bw));
+                        (w, est, sd, prior)
                     })
                 })
                 .collect();

@@ -68,7 +68,6 @@ pub(super) fn withheld_alike(
     let tried = Tried {
         sig,
         judged,
-        terms,
         pool,
         named,
         others,
@@ -80,12 +79,11 @@ pub(super) fn withheld_alike(
 }
 
 /// The pass that tries the terms kept out: its signatures (scaled by the rounds' dispersion),
-/// the findings tried ((finding index, term)), their terms, the pass's candidates (the terms
-/// then the ones kept out), and the indices of each among them.
+/// the findings tried ((finding index, term)), the pass's candidates (their terms then the ones
+/// kept out), and the indices of each among them.
 struct Tried {
     sig: super::signatures::Signatures,
     judged: Vec<(usize, usize)>,
-    terms: Vec<usize>,
     pool: Vec<usize>,
     named: Vec<usize>,
     others: Vec<usize>,
@@ -97,7 +95,6 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
     let Tried {
         sig,
         judged,
-        terms,
         pool,
         named,
         others,
@@ -127,7 +124,7 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
             continue;
         }
         let info = &common::TERMS[pool[w]];
-        let other = |x: usize| common::TERMS[terms[x]].name;
+        let other = |x: usize| common::TERMS[judged[x].1].name;
         for (x, y) in [(a, b), (b, a)] {
             let f = &mut findings[judged[x].0];
             if f.withheld_named {
@@ -143,13 +140,8 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
                 sig3(prior)
             );
             f.withheld_named = true;
-            f.withheld_alike.push(EquivalentTerm {
-                term: info.name.to_string(),
-                estimate: est,
-                sigma: sd,
-                unit: info.display.to_string(),
-                prior_sigmas: prior,
-            });
+            f.withheld_alike
+                .push(kept_out_term(pool[w], (est, sd, prior)));
             not_named(f, why);
         }
     }
@@ -201,14 +193,7 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
             .into_iter()
             .filter(|m| common::TERMS[pool[m.0]].sensor == sensor)
             .map(|(a, estimate, sigma, prior_sigmas)| {
-                let info = &common::TERMS[pool[a]];
-                EquivalentTerm {
-                    term: info.name.to_string(),
-                    estimate,
-                    sigma,
-                    unit: info.display.to_string(),
-                    prior_sigmas,
-                }
+                kept_out_term(pool[a], (estimate, sigma, prior_sigmas))
             })
             .collect();
         let f = &mut findings[k];
@@ -276,5 +261,18 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
                 f.withheld_alike = members;
             }
         }
+    }
+}
+
+/// Spec term `t` kept out, with the value it would need (display unit), its σ and its prior-σ
+/// count.
+fn kept_out_term(t: usize, (estimate, sigma, prior_sigmas): (f64, f64, f64)) -> EquivalentTerm {
+    let info = &common::TERMS[t];
+    EquivalentTerm {
+        term: info.name.to_string(),
+        estimate,
+        sigma,
+        unit: info.display.to_string(),
+        prior_sigmas,
     }
 }

@@ -52,29 +52,25 @@ pub fn known_gnss(known: &[(usize, f64)]) -> Option<String> {
 /// The demo's d estimates against the hidden 490 ug/g² [%], with their 1-σ [%]: what the demo
 /// prints after its run.
 pub fn demo_against_truth(e: &Explanation) -> String {
+    // a d value (ug/g^2) and its σ against the hidden 490, in percent
+    let held = |term: &str, estimate: f64, sigma: f64| {
+        format!(
+            "{term} {:+.2} % (± {:.2} %)",
+            (estimate / 490.0 - 1.0) * 100.0,
+            sigma / 490.0 * 100.0
+        )
+    };
     let against: Vec<String> = e
         .findings
         .iter()
         .filter(|f| f.term.starts_with("d_") && f.unit == "ug/g^2" && f.estimate.is_finite())
-        .map(|f| {
-            format!(
-                "{} {:+.2} % (± {:.2} %)",
-                f.term,
-                (f.estimate / 490.0 - 1.0) * 100.0,
-                f.sigma / 490.0 * 100.0
-            )
-        })
+        .map(|f| held(&f.term, f.estimate, f.sigma))
         .collect();
     if against.is_empty() {
         // withheld, a d term may still be named as what a finding's term stands for
         let mut alike: Vec<String> = Vec::new();
         for w in e.findings.iter().flat_map(|f| &f.withheld_alike) {
-            let line = format!(
-                "{} {:+.2} % (± {:.2} %)",
-                w.term,
-                (w.estimate / 490.0 - 1.0) * 100.0,
-                w.sigma / 490.0 * 100.0
-            );
+            let line = held(&w.term, w.estimate, w.sigma);
             if w.term.starts_with("d_") && w.unit == "ug/g^2" && !alike.contains(&line) {
                 alike.push(line);
             }
