@@ -15,8 +15,16 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
+/// The JSON file at `path`; an explanation's findings are checked to record a rule for every
+/// reason they are not attributed (and none for a cause).
 fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    for f in v["findings"].as_array().into_iter().flatten() {
+        let rules = f["not_attributed_because"].as_array().unwrap();
+        assert_eq!(f["not_attributed"].is_null(), rules.is_empty(), "{f}");
+    }
+    v
 }
 
 #[test]
@@ -749,8 +757,8 @@ fn a_withheld_term_that_fits_as_well_is_named_and_nothing_is_claimed() {
         assert!(ok, "{stderr}");
         let report = std::fs::read_to_string(out.join("report.md")).unwrap();
         assert!(
-            report.contains("fitted, not attributed (a withheld term fits as well)")
-                || cands == "d_*",
+            // (the verdict lists every rule that un-named the finding, this one last)
+            report.contains("a withheld term fits as well) |") || cands == "d_*",
             "{report}"
         );
         (json(&out.join("explain.json")), stderr)
@@ -789,7 +797,7 @@ fn a_withheld_term_that_fits_as_well_is_named_and_nothing_is_claimed() {
                 (est - 490.0).abs() < 0.1 * 490.0 && (est - 490.0).abs() < 4.0 * sd.max(1.0),
                 "{cands}: {term}: d_{axis} would need {est} ± {sd} ug/g^2, hidden 490"
             );
-            assert!(f["withheld_named"] == true, "{f}");
+            assert!(because(f, "withheld_term_fits"), "{f}");
             let why = f["not_attributed"].as_str().unwrap();
             assert!(why.contains("not among the candidates"), "{f}");
             if term.starts_with(family) {
@@ -820,7 +828,7 @@ fn a_withheld_term_that_fits_as_well_is_named_and_nothing_is_claimed() {
         .collect();
     assert!(!z.is_empty(), "no z cross-quadratic fitted: {stderr}");
     for f in z {
-        assert!(f["withheld_named"] == true, "{f}");
+        assert!(because(f, "withheld_term_fits"), "{f}");
         assert_eq!(f["withheld_alike"][0]["term"], "d_z", "{f}");
     }
     let (v, stderr) = run("d_*", "demo-d-offered");
@@ -843,7 +851,7 @@ fn a_withheld_term_that_fits_as_well_is_named_and_nothing_is_claimed() {
                 .all(|a| a["prior_sigmas"].as_f64().unwrap() > 9.0),
             "{alike:?}"
         );
-        assert!(f["withheld_named"].is_null(), "{f}");
+        assert_eq!(f["not_attributed_because"], serde_json::json!([]), "{f}");
     }
 }
 
@@ -940,6 +948,7 @@ fn one_term_kept_out_that_explains_two_findings_unnames_both() {
         .unwrap_or_else(|| panic!("tau_y not fitted: {stderr}"));
     let why = tau_y["not_attributed"].as_str().unwrap_or("");
     assert!(why.contains("leans on tau_z"), "{tau_y}");
+    assert!(because(tau_y, "leans_on_withheld_term"), "{tau_y}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1578,6 +1587,7 @@ fn a_wrong_known_offset_is_not_borne_out() {
         .as_str()
         .unwrap_or_else(|| panic!("{dt}"));
     assert!(why.contains("not borne out"), "{why}");
+    assert!(because(dt, "offset_not_borne_out"), "{dt}");
     let ms = dt["estimate"].as_f64().unwrap();
     assert!(ms.abs() <= 3.0 * dt["sigma"].as_f64().unwrap(), "{ms} ms");
     for f in findings {
@@ -1585,4 +1595,11 @@ fn a_wrong_known_offset_is_not_borne_out() {
         assert!(!is_cause, "a cause named on fixes stamped right: {f}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// True when `rule` is among the rules that un-named finding `f` (its `not_attributed_because`).
+fn because(f: &serde_json::Value, rule: &str) -> bool {
+    f["not_attributed_because"]
+        .as_array()
+        .is_some_and(|r| r.iter().any(|x| x == rule))
 }

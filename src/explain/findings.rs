@@ -58,10 +58,6 @@ pub struct Finding {
     /// term was a candidate).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub withheld_alike: Vec<EquivalentTerm>,
-    /// True when a term in `withheld_alike` is why it is not named (the priors prefer it, or
-    /// would choose); the words and `not_attributed` say so.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub withheld_named: bool,
     /// GLR estimate when selected (display unit).
     pub glr_estimate: f64,
     /// Its σ (display unit).
@@ -124,6 +120,9 @@ pub struct Finding {
     /// priors, which do not fit this sensor, would choose, not the data); the finding then
     /// stands for its class and is kept out of `extended.toml`.
     pub not_attributed: Option<String>,
+    /// Which rules un-named it, in the order they did (empty for a cause or a stand-in);
+    /// `not_attributed` gives each one's words.
+    pub not_attributed_because: Vec<Unnamed>,
     /// A noise finding's maximum-likelihood scale of the stated value (white noise density, or
     /// the aiding's stated 1-σ).
     pub scale: Option<f64>,
@@ -151,6 +150,88 @@ impl Finding {
     /// True when the finding is read as a cause: neither a stand-in nor an unattributed class.
     pub fn is_cause(&self) -> bool {
         self.stand_in.is_none() && self.not_attributed.is_none()
+    }
+
+    /// True when rule `why` is among those that un-named it.
+    pub fn unnamed_because(&self, why: Unnamed) -> bool {
+        self.not_attributed_because.contains(&why)
+    }
+}
+
+/// Why a fitted finding is not named as a cause: the rule that un-named it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Unnamed {
+    /// The data cannot tell its equivalence class apart, and only priors that do not fit this
+    /// sensor (≥ 10× apart, the most plausible beyond 3 prior σ) would choose.
+    ClassNotSeparable,
+    /// A spec term kept out of the candidates explains what it explains (alone, or for it and
+    /// another finding together), and the priors do not prefer the finding.
+    WithheldTermFits,
+    /// Its value leans on a spec term kept out of the candidates (it moves > 3σ beside it).
+    LeansOnWithheldTerm,
+    /// The candidates it takes up, fitted beside it, move its value by more than 3σ.
+    ValueMoves,
+    /// Its value in the extended filter is within 1σ of zero.
+    ValueNearZero,
+    /// Its value was fitted beside a stand-in and changes once the stand-in is dropped or a
+    /// rival takes its place.
+    LeansOnStandIn,
+    /// An aiding term and a sensor term whose estimates correlate beyond ±0.9.
+    AidingSensorConfound,
+    /// Fitted beside an IMU–GNSS time offset the re-stamped runs did not settle.
+    OffsetUnsettled,
+    /// An IMU–GNSS time offset the re-stamped fixes do not bear out.
+    OffsetNotBorneOut,
+    /// A noise level fitted beside a time offset the model does not hold.
+    NoiseBesideOffset,
+}
+
+impl Unnamed {
+    /// The reason in a few words (the report's verdict column) and as a clause (its summary).
+    pub fn words(self) -> (&'static str, &'static str) {
+        match self {
+            Self::ClassNotSeparable => (
+                "class not separable",
+                "its class cannot be told apart on these data",
+            ),
+            Self::WithheldTermFits => (
+                "a withheld term fits as well",
+                "a term the candidates keep out explains it as well",
+            ),
+            Self::LeansOnWithheldTerm => (
+                "leans on a withheld term",
+                "its value moves beside a term the candidates keep out",
+            ),
+            Self::ValueMoves => (
+                "value moves beside other terms",
+                "its value moves beside the candidates it takes up",
+            ),
+            Self::ValueNearZero => (
+                "value within 1σ of zero",
+                "the extended filter leaves its value within 1σ of zero",
+            ),
+            Self::LeansOnStandIn => (
+                "leans on a stand-in",
+                "its value was fitted beside a stand-in and changes without it",
+            ),
+            Self::AidingSensorConfound => (
+                "confounded with an aiding term",
+                "the data cannot separate an aiding term from a sensor term here",
+            ),
+            Self::OffsetUnsettled => (
+                "time offset unsettled",
+                "it was fitted beside a time offset the re-stamped runs did not settle",
+            ),
+            Self::OffsetNotBorneOut => (
+                "offset not borne out",
+                "the re-stamped fixes want no offset",
+            ),
+            Self::NoiseBesideOffset => (
+                "fitted beside a missing offset",
+                "it was fitted while a stand-in took the place of a time offset",
+            ),
+        }
     }
 }
 

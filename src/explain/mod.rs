@@ -42,7 +42,7 @@ pub use diagnostics::{
 };
 pub use findings::{
     CandidateTest, Consistency, EquivalentTerm, Explanation, Finding, Gain, GroupEstimate,
-    Implausible, Normalised, TightPrior,
+    Implausible, Normalised, TightPrior, Unnamed,
 };
 pub use selection::prior_sigma;
 pub use words::{finding_line, separation_hint, share_percent, sig3, verdict};
@@ -598,7 +598,7 @@ fn judge_kept_out(
     withheld::withheld_alike(ctx, r, findings, cands, progress)?;
     let offered: Vec<usize> = findings
         .iter()
-        .filter(|f| f.withheld_named)
+        .filter(|f| f.unnamed_because(Unnamed::WithheldTermFits))
         .flat_map(|f| f.withheld_alike.iter().filter_map(|w| term_index(&w.term)))
         .chain(given.iter().copied())
         .collect();
@@ -740,7 +740,7 @@ fn companions_move(
             sig3(moved),
             sig3(gain)
         );
-        not_named(f, why);
+        not_named(f, Unnamed::ValueMoves, why);
     }
     Ok(())
 }
@@ -780,7 +780,7 @@ fn value_not_fixed(findings: &mut [Finding]) {
                 f.unit,
                 sig3(f.two_delta_loglik)
             );
-            not_named(f, why);
+            not_named(f, Unnamed::ValueNearZero, why);
         }
     }
 }
@@ -1062,7 +1062,7 @@ fn aiding_and_sensor_confounded(
         }
     }
     for (k, w) in why {
-        not_named(&mut findings[k], w);
+        not_named(&mut findings[k], Unnamed::AidingSensorConfound, w);
     }
     Ok(())
 }
@@ -1077,10 +1077,13 @@ fn term_sensor(name: &str) -> Option<Sensor> {
     term_index(name).map(|t| common::TERMS[t].sensor)
 }
 
-/// Cause `f` is no longer named: `why` joins its reasons and ends its words.
-fn not_named(f: &mut Finding, why: String) {
+/// Cause `f` is no longer named by rule `rule`: `why` joins its reasons and ends its words.
+fn not_named(f: &mut Finding, rule: Unnamed, why: String) {
     f.words.push_str(&format!(". Not named as a cause: {why}"));
     f.not_attributed = joined(f.not_attributed.take(), Some(why));
+    if !f.unnamed_because(rule) {
+        f.not_attributed_because.push(rule);
+    }
 }
 
 /// The term indices of the stand-ins among `judged` (one finding per named term of `r`).
@@ -1225,7 +1228,7 @@ fn mark_passed_over(
             if beside.len() == 1 { "becomes" } else { "become" },
             withheld.join(",")
         );
-        not_named(f, why);
+        not_named(f, Unnamed::LeansOnStandIn, why);
     }
 }
 
@@ -1821,7 +1824,6 @@ fn complete_findings(
                 .collect(),
             equivalent_estimates: n.equivalent_estimates.clone(),
             withheld_alike: Vec::new(),
-            withheld_named: false,
             glr_estimate: n.glr_estimate,
             glr_sigma: n.glr_sigma,
             round: n.round,
@@ -1873,6 +1875,7 @@ fn complete_findings(
                     .join(", ")
                 )
             }),
+            not_attributed_because: Vec::new(),
             scale: None,
             scale_interval: None,
             scale_bound: None,
@@ -1889,6 +1892,9 @@ fn complete_findings(
                 })
                 .collect(),
         };
+        if f.not_attributed.is_some() {
+            f.not_attributed_because.push(Unnamed::ClassNotSeparable);
+        }
         f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
         f.suggested_prior = suggested_prior(&f, ctx.opts);
         (f.headline, f.words) =
@@ -2137,6 +2143,57 @@ pub fn signature_information_matrix(
 mod tests {
     use super::*;
 
+    #[test]
+    fn every_rule_that_unnames_a_finding_is_recorded_once_in_order() {
+        let mut f = finding(5.0, Some(0.8));
+        assert!(f.is_cause() && f.not_attributed_because.is_empty());
+        not_named(&mut f, Unnamed::ValueMoves, "a".into());
+        not_named(&mut f, Unnamed::LeansOnStandIn, "b".into());
+        not_named(&mut f, Unnamed::ValueMoves, "c".into());
+        assert!(!f.is_cause());
+        assert_eq!(
+            f.not_attributed_because,
+            [Unnamed::ValueMoves, Unnamed::LeansOnStandIn]
+        );
+        assert_eq!(f.not_attributed.as_deref(), Some("a; b; c"));
+        assert!(
+            f.words.ends_with(". Not named as a cause: c"),
+            "{}",
+            f.words
+        );
+        // each rule says something of its own, in the report and in the JSON
+        let all = [
+            Unnamed::ClassNotSeparable,
+            Unnamed::WithheldTermFits,
+            Unnamed::LeansOnWithheldTerm,
+            Unnamed::ValueMoves,
+            Unnamed::ValueNearZero,
+            Unnamed::LeansOnStandIn,
+            Unnamed::AidingSensorConfound,
+            Unnamed::OffsetUnsettled,
+            Unnamed::OffsetNotBorneOut,
+            Unnamed::NoiseBesideOffset,
+        ];
+        let distinct = |x: Vec<String>| x.iter().collect::<std::collections::HashSet<_>>().len();
+        assert_eq!(
+            distinct(all.iter().map(|u| u.words().0.into()).collect()),
+            all.len()
+        );
+        assert_eq!(
+            distinct(all.iter().map(|u| u.words().1.into()).collect()),
+            all.len()
+        );
+        let json = |u: &Unnamed| serde_json::to_string(u).unwrap();
+        assert_eq!(distinct(all.iter().map(json).collect()), all.len());
+        assert_eq!(json(&Unnamed::WithheldTermFits), "\"withheld_term_fits\"");
+        // the README lists every rule by its JSON name
+        let readme = include_str!("../../README.md");
+        for u in &all {
+            let name = format!("`{}`", json(u).trim_matches('"'));
+            assert!(readme.contains(&name), "README.md does not list {name}");
+        }
+    }
+
     fn finding(prior_sigmas: f64, misfit_share: Option<f64>) -> Finding {
         Finding {
             term: "size_x".into(),
@@ -2149,7 +2206,6 @@ mod tests {
             equivalent: vec![],
             equivalent_estimates: vec![],
             withheld_alike: Vec::new(),
-            withheld_named: false,
             glr_estimate: 0.0,
             glr_sigma: 0.0,
             round: 1,
@@ -2173,6 +2229,7 @@ mod tests {
             suggested_prior: None,
             offset_in_place: None,
             not_attributed: None,
+            not_attributed_because: Vec::new(),
             scale: None,
             scale_interval: None,
             scale_bound: None,

@@ -186,6 +186,7 @@ fn unsettled(mut e: Explanation, passes: &[Pass], why: &str) -> Explanation {
     for f in e.findings.iter_mut().filter(|f| f.is_cause()) {
         super::not_named(
             f,
+            super::Unnamed::OffsetUnsettled,
             format!(
                 "it was fitted beside a time offset the re-stamped runs did not settle ({why})"
             ),
@@ -232,6 +233,7 @@ fn fold(
     let mut f = offset_finding(first);
     // (the first run's verdict on it, to first order, is replaced by the one below)
     (f.stand_in, f.not_attributed, f.offset_in_place) = (None, None, None);
+    f.not_attributed_because.clear();
     let nis0 = first.baseline.nis_mean;
     f.estimate = total;
     f.sigma = sigma;
@@ -353,7 +355,6 @@ fn offset_finding(e: &Explanation) -> Finding {
         equivalent: Vec::new(),
         equivalent_estimates: Vec::new(),
         withheld_alike: Vec::new(),
-        withheld_named: false,
         glr_estimate: of(|c| c.glr_estimate),
         glr_sigma: of(|c| c.glr_sigma),
         confounded_with: None,
@@ -401,8 +402,7 @@ fn judge(
                 sig3(sigma)
             )
         };
-        f.words.push_str(&format!(". Not named as a cause: {why}"));
-        f.not_attributed = Some(why);
+        super::not_named(f, super::Unnamed::OffsetNotBorneOut, why);
     } else if !split.holds {
         // the kinds of fix want different offsets: no one time offset of the receiver
         let by: Vec<String> = split

@@ -283,7 +283,7 @@ pub(super) fn noise_beside_an_offset<'a>(
             sig3(d),
             sig3(sd)
         );
-        super::not_named(f, why);
+        super::not_named(f, super::Unnamed::NoiseBesideOffset, why);
     }
 }
 
@@ -315,7 +315,7 @@ pub(super) fn leaning_on_stand_ins(findings: &mut [Finding], rivals: &[Option<Ri
                 sig3(sd),
                 f.unit
             );
-            super::not_named(f, why);
+            super::not_named(f, super::Unnamed::LeansOnStandIn, why);
             any = true;
         }
     }

@@ -3,7 +3,7 @@
 //! priors find it the more plausible, it could equally be the cause, and the finding says so
 //! instead of naming its own term.
 
-use super::findings::{EquivalentTerm, Finding};
+use super::findings::{EquivalentTerm, Finding, Unnamed};
 use super::words::sig3;
 use super::{model_with, not_named, run_pass, selection, term_index, Context, Rounds};
 use crate::model::catalog::StateRef;
@@ -127,7 +127,7 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
         let other = |x: usize| common::TERMS[judged[x].1].name;
         for (x, y) in [(a, b), (b, a)] {
             let f = &mut findings[judged[x].0];
-            if f.withheld_named {
+            if f.unnamed_because(Unnamed::WithheldTermFits) {
                 continue;
             }
             let why = format!(
@@ -139,10 +139,9 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
                 info.display,
                 sig3(prior)
             );
-            f.withheld_named = true;
             f.withheld_alike
                 .push(kept_out_term(pool[w], (est, sd, prior)));
-            not_named(f, why);
+            not_named(f, Unnamed::WithheldTermFits, why);
         }
     }
 }
@@ -177,7 +176,7 @@ fn unname_moved(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
             f.unit,
             info.name
         );
-        not_named(f, why);
+        not_named(f, Unnamed::LeansOnWithheldTerm, why);
     }
 }
 
@@ -197,7 +196,7 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
             })
             .collect();
         let f = &mut findings[k];
-        if members.is_empty() || !own.is_finite() || f.withheld_named {
+        if members.is_empty() || !own.is_finite() || f.unnamed_because(Unnamed::WithheldTermFits) {
             continue;
         }
         members.sort_by(|a, b| a.prior_sigmas.total_cmp(&b.prior_sigmas));
@@ -246,9 +245,8 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
         };
         match why {
             Some(why) => {
-                f.withheld_named = true;
                 f.withheld_alike = members;
-                not_named(f, why);
+                not_named(f, Unnamed::WithheldTermFits, why);
             }
             None => {
                 // named by the priors, as the selection names a class's most plausible member

@@ -117,7 +117,7 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
         ));
     }
     for f in e.findings.iter().filter(|f| f.not_attributed.is_some()) {
-        if f.equivalent.is_empty() {
+        if !f.unnamed_because(crate::explain::Unnamed::ClassNotSeparable) {
             s.push_str(&format!(
                 "# {} is left out: it is not attributed ({}).\n",
                 f.term,
@@ -278,27 +278,16 @@ fn short_words(f: &crate::explain::Finding) -> String {
     s
 }
 
-/// Why a finding is not attributed, short (the table's verdict) and as a clause: a term kept
-/// out of the candidates fits as well, its class cannot be told apart, or its value is not
-/// fixed (it moves beside another term, leans on a stand-in or is within 1σ of zero).
-fn not_attributed_because(f: &crate::explain::Finding) -> (&'static str, &'static str) {
-    let why = f.not_attributed.as_deref().unwrap_or("");
-    if f.withheld_named {
-        (
-            "a withheld term fits as well",
-            "a term the candidates keep out explains it as well",
-        )
-    } else if why.starts_with("the data cannot tell") {
-        (
-            "class not separable",
-            "its class cannot be told apart on these data",
-        )
-    } else {
-        (
-            "value not fixed",
-            "the data do not fix its value beside the other terms",
-        )
+/// Why a finding is not attributed, short (the table's verdict) and as a clause: each rule
+/// that un-named it (`not_attributed_because`), in the order they did.
+fn not_attributed_because(f: &crate::explain::Finding) -> (String, String) {
+    let (short, clause): (Vec<&str>, Vec<&str>) =
+        f.not_attributed_because.iter().map(|u| u.words()).unzip();
+    if short.is_empty() {
+        // (every rule that un-names a finding records itself; this is a guard, not a verdict)
+        return ("reason not recorded".into(), "see section 3".into());
     }
+    (short.join("; "), clause.join(", and "))
 }
 
 /// A figure as an HTML block in the Markdown (rendered by Markdown viewers and embedded by the
