@@ -127,10 +127,22 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
                     .replace('\n', " ")
             ));
         } else {
+            // (and the other rules that un-named it, in a few words each)
+            let also: Vec<&str> = f
+                .not_attributed_because
+                .iter()
+                .filter(|&&u| u != crate::explain::Unnamed::ClassNotSeparable)
+                .map(|u| u.words().1)
+                .collect();
             s.push_str(&format!(
-                "# {} is left out: the data cannot tell it from {} and the priors would choose.\n",
+                "# {} is left out: the data cannot tell it from {} and the priors would choose{}.\n",
                 f.term,
-                f.equivalent.join(", ")
+                f.equivalent.join(", "),
+                if also.is_empty() {
+                    String::new()
+                } else {
+                    format!("; also, {}", also.join(", and "))
+                }
             ));
         }
     }
