@@ -39,9 +39,22 @@ pub(super) fn offset_stand_ins(
     if (ctx.config_for)(&model_with(&ctx.baseline.name, [w])?).is_err() {
         return Ok(Vec::new());
     }
+    // the rival's model drops the stand-ins and the classes not attributed; a finding un-named
+    // only because a term kept out may take its place stays, as it was when the rounds fitted
+    // the aiding term (dropping it left a drive's hidden g-sensitivity out of the offset's fit,
+    // and a lever arm standing in for the offset was named)
+    let kept_out_only = |f: &Finding| {
+        f.stand_in.is_none()
+            && f.not_attributed_because.iter().all(|u| {
+                matches!(
+                    u,
+                    super::Unnamed::WithheldTermFits | super::Unnamed::LeansOnWithheldTerm
+                )
+            })
+    };
     let others: Vec<usize> = findings
         .iter()
-        .filter(|f| !f.is_cause() && f.term != "dt_gnss")
+        .filter(|f| !f.is_cause() && !kept_out_only(f) && f.term != "dt_gnss")
         .filter_map(|f| term(&f.term))
         .collect();
     let levers: Vec<usize> = ["lever_x", "lever_y"]

@@ -6,7 +6,7 @@
 use super::findings::{EquivalentTerm, Finding, Unnamed};
 use super::words::sig3;
 use super::{model_with, not_named, run_pass, selection, term_index, Context, Rounds};
-use crate::model::catalog::StateRef;
+use crate::model::catalog::{Sensor, StateRef};
 use crate::model::generated::common;
 
 /// Each IMU-term finding among `findings` that is no stand-in (a cause, or a class not
@@ -36,13 +36,16 @@ pub(super) fn withheld_alike(
         .filter_map(|(k, f)| Some((k, term_index(&f.term)?)))
         .filter(|&(_, t)| !common::TERMS[t].sensor.enters_h())
         .collect();
+    // a GNSS term only where the data hold fixes the baseline forms (a turntable's static
+    // aiding refuses them)
+    let fixes = |w: usize| {
+        common::TERMS[w].sensor != Sensor::Gnss
+            || model_with(&ctx.baseline.name, [w]).is_ok_and(|m| (ctx.config_for)(&m).is_ok())
+    };
     let withheld: Vec<usize> = (0..common::TERM_COUNT)
         .filter(|&w| !cands.contains(&w) && !in_model(w))
-        .filter(|&w| {
-            judged
-                .iter()
-                .any(|&(_, t)| common::TERMS[t].sensor == common::TERMS[w].sensor)
-        })
+        .filter(|&w| judged.iter().any(|&(_, t)| may_take(t, w)))
+        .filter(|&w| fixes(w))
         .collect();
     if judged.is_empty() || withheld.is_empty() {
         return Ok(());
@@ -76,6 +79,16 @@ pub(super) fn withheld_alike(
     unname_moved(&tried, findings, ctx.opts);
     name_taken(&tried, findings, ctx.opts);
     Ok(())
+}
+
+/// Whether kept-out term `w` may take the place of a finding of term `t`: a term of the same
+/// sensor, or a GNSS term (an antenna lever arm moves the fixes in turns, a time offset by speed
+/// × it; an IMU term, an accelerometer delay above all, takes either up: an antenna lever arm
+/// kept out gave "Found: accelerometer y delay tau_y = 29.0 ± 6.63 ms" on a simulated drive,
+/// helper-55).
+fn may_take(t: usize, w: usize) -> bool {
+    let (s, sw) = (common::TERMS[t].sensor, common::TERMS[w].sensor);
+    s == sw || (sw == Sensor::Gnss && !s.enters_h())
 }
 
 /// The pass that tries the terms kept out: its signatures (scaled by the rounds' dispersion),
@@ -112,10 +125,15 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
                 .filter(|&y| sensor_of(y) == sensor_of(x))
                 .collect()
         };
+        let rivals: Vec<usize> = others
+            .iter()
+            .copied()
+            .filter(|&y| may_take(pool[x], pool[y]))
+            .collect();
         pairs.extend(selection::taken_together(
             sig,
             (named, &of(named)),
-            &of(others),
+            &rivals,
             opts,
         ));
     }
@@ -154,10 +172,7 @@ fn unname_moved(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
     let moved = selection::moved_by(&tried.sig, &tried.named, &tried.others, opts);
     for (&(k, t), moves) in judged.iter().zip(moved) {
         let f = &mut findings[k];
-        let Some((w, beside, wv)) = moves
-            .into_iter()
-            .find(|m| common::TERMS[pool[m.0]].sensor == common::TERMS[t].sensor)
-        else {
+        let Some((w, beside, wv)) = moves.into_iter().find(|m| may_take(t, pool[m.0])) else {
             continue;
         };
         if !f.is_cause() {
@@ -186,11 +201,10 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
     let (pool, judged) = (&tried.pool, &tried.judged);
     let taken = selection::taken_by(&tried.sig, &tried.named, &tried.others, opts);
     for (&(k, t), (own, members)) in judged.iter().zip(taken) {
-        // (a withheld term of another sensor is no rival of this one)
-        let sensor = common::TERMS[t].sensor;
+        // (a withheld term of another IMU sensor is no rival of this one)
         let mut members: Vec<EquivalentTerm> = members
             .into_iter()
-            .filter(|m| common::TERMS[pool[m.0]].sensor == sensor)
+            .filter(|m| may_take(t, pool[m.0]))
             .map(|(a, estimate, sigma, prior_sigmas)| {
                 kept_out_term(pool[a], (estimate, sigma, prior_sigmas))
             })
