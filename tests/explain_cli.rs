@@ -1687,7 +1687,17 @@ fn explain_p13_drive(
     }
     let (ok, _, stderr) = sinsmodel(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(ok, "{stderr}");
-    (json(&out.join("explain.json")), stderr)
+    let v = json(&out.join("explain.json"));
+    // the findings at a glance give a stand-in's other reasons as well
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for f in v["findings"].as_array().unwrap() {
+        if !f["stand_in"].is_null() && !f["not_attributed"].is_null() {
+            let row = format!("| {} |", f["term"].as_str().unwrap());
+            let line = report.lines().find(|l| l.starts_with(&row)).unwrap();
+            assert!(line.contains("(a stand-in; also "), "{line}");
+        }
+    }
+    (v, stderr)
 }
 
 /// The drive with an antenna lever arm hidden and kept out of the candidates (`!lever_*`): an

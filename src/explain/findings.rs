@@ -120,8 +120,8 @@ pub struct Finding {
     /// priors, which do not fit this sensor, would choose, not the data); the finding then
     /// stands for its class and is kept out of `extended.toml`.
     pub not_attributed: Option<String>,
-    /// Which rules un-named it, in the order they did (empty for a cause or a stand-in);
-    /// `not_attributed` gives each one's words.
+    /// Which rules un-named it, in the order they did (empty for a cause; a stand-in may carry
+    /// some too); `not_attributed` gives each one's words.
     pub not_attributed_because: Vec<Unnamed>,
     /// A noise finding's maximum-likelihood scale of the stated value (white noise density, or
     /// the aiding's stated 1-σ).

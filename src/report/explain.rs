@@ -331,7 +331,13 @@ fn at_a_glance(e: &Explanation, s: &mut String) {
         "\n## Findings at a glance\n\n| term | kind | value ± σ | explains of the excess misfit | verdict |\n|---|---|---|---|---|\n",
     );
     for f in &e.findings {
-        let verdict = if f.stand_in.is_some() {
+        let verdict = if f.stand_in.is_some() && f.not_attributed.is_some() {
+            // (a stand-in that a rule un-named as well says both)
+            &format!(
+                "fitted, but not a cause (a stand-in; also {})",
+                not_attributed_because(f).0
+            )
+        } else if f.stand_in.is_some() {
             "fitted, but not a cause (a stand-in)"
         } else if f.not_attributed.is_some() {
             &format!("fitted, not attributed ({})", not_attributed_because(f).0)
