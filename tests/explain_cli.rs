@@ -1270,21 +1270,33 @@ fn simulated_drive(dir: &Path, rate_hz: f64) -> PathBuf {
 
 /// [`simulated_drive`] with the scenario's `[errors]` lines `errors` (e.g. `lever_x = "0.8 m"`).
 fn simulated_drive_with(dir: &Path, rate_hz: f64, errors: &str) -> PathBuf {
+    simulated_drive_shaped(dir, 7, (60.0, 60.0, [30.0, 30.0, 60.0]), rate_hz, errors)
+}
+
+/// [`simulated_drive_with`] with the scenario's `seed` and the legs' durations [s]: the rest at
+/// each end, each of the three cruises, and the three turns (3°/s, −3°/s, 3°/s).
+fn simulated_drive_shaped(
+    dir: &Path,
+    seed: u64,
+    (rest, cruise, turns): (f64, f64, [f64; 3]),
+    rate_hz: f64,
+    errors: &str,
+) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
-    let mut sc = String::from(
-        "name = \"late\"\nimu_rate_hz = 100.0\ntruth_rate_hz = 10.0\nseed = 7\n\
+    let mut sc = format!(
+        "name = \"late\"\nimu_rate_hz = 100.0\ntruth_rate_hz = 10.0\nseed = {seed}\n\
          [start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\neuler_deg = [0.0, 0.0, 30.0]\n\
-         [[segment]]\nkind = \"rest\"\nduration_s = 60.0\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = {rest:?}\n\
          [[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = 1.5\n",
     );
-    for (turn, rate) in [(30.0, 3.0), (30.0, -3.0), (60.0, 3.0)] {
+    for (turn, rate) in turns.into_iter().zip([3.0, -3.0, 3.0]) {
         sc.push_str(&format!(
-            "[[segment]]\nkind = \"cruise\"\nduration_s = 60.0\n[[segment]]\nkind = \"turn\"\nduration_s = {turn}\nyaw_rate_deg_s = {rate}\n"
+            "[[segment]]\nkind = \"cruise\"\nduration_s = {cruise:?}\n[[segment]]\nkind = \"turn\"\nduration_s = {turn}\nyaw_rate_deg_s = {rate}\n"
         ));
     }
     sc.push_str(&format!(
         "[[segment]]\nkind = \"accelerate\"\nduration_s = 10.0\naccel_mps2 = -1.5\n\
-         [[segment]]\nkind = \"rest\"\nduration_s = 60.0\n\
+         [[segment]]\nkind = \"rest\"\nduration_s = {rest:?}\n\
          [errors]\n{errors}\n\
          [noise]\narw = \"0.1 deg/sqrt(h)\"\nvrw = \"50 ug/sqrt(Hz)\"\n\
          [gnss]\nrate_hz = {rate_hz}\nsigma_ne = \"0.1 m\"\nsigma_d = \"0.2 m\"\nsigma_v = \"0.02 m/s\"\n"
@@ -1329,7 +1341,17 @@ fn explain_drive(
     args.extend_from_slice(extra);
     let (ok, _, stderr) = sinsmodel(&args);
     assert!(ok, "{stderr}");
-    (json(&out.join("explain.json")), stderr)
+    let v = json(&out.join("explain.json"));
+    // the findings at a glance give a stand-in's other reasons as well
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for f in v["findings"].as_array().unwrap() {
+        if !f["stand_in"].is_null() && !f["not_attributed"].is_null() {
+            let row = format!("| {} |", f["term"].as_str().unwrap());
+            let line = report.lines().find(|l| l.starts_with(&row)).unwrap();
+            assert!(line.contains("(a stand-in; also "), "{line}");
+        }
+    }
+    (v, stderr)
 }
 
 /// The simulation `sim`'s GNSS fixes stamped `late` [s] late (the fix stamped t is the
@@ -1604,102 +1626,6 @@ fn because(f: &serde_json::Value, rule: &str) -> bool {
         .is_some_and(|r| r.iter().any(|x| x == rule))
 }
 
-/// A 300-s car drive as the reviews drew them (100 Hz, rest, a 1.5 m/s² start, three cruise
-/// and ±3°/s turn legs, a stop, rest; 1-Hz fixes with velocities of σ 0.1 m and 0.02 m/s;
-/// tactical noise) with the legs' durations (rest, cruise, the three turns) [s], the scenario
-/// `errors` (TOML lines) and `seed`, simulated under `dir`: its directory.
-fn simulated_p13_drive(
-    dir: &Path,
-    seed: u64,
-    (rest, cruise, turns): (f64, f64, [f64; 3]),
-    errors: &str,
-) -> PathBuf {
-    std::fs::create_dir_all(dir).unwrap();
-    let d = |s: f64| format!("duration_s = {s:?}");
-    let legs = [
-        ("rest", d(rest)),
-        ("accelerate", d(10.0) + "\naccel_mps2 = 1.5"),
-        ("cruise", d(cruise)),
-        ("turn", d(turns[0]) + "\nyaw_rate_deg_s = 3.0"),
-        ("cruise", d(cruise)),
-        ("turn", d(turns[1]) + "\nyaw_rate_deg_s = -3.0"),
-        ("cruise", d(cruise)),
-        ("turn", d(turns[2]) + "\nyaw_rate_deg_s = 3.0"),
-        ("accelerate", d(10.0) + "\naccel_mps2 = -1.5"),
-        ("rest", d(rest)),
-    ];
-    let segments: String = legs
-        .iter()
-        .map(|(kind, rest)| format!("[[segment]]\nkind = \"{kind}\"\n{rest}\n"))
-        .collect();
-    let scenario = dir.join(format!("drive_{seed}.toml"));
-    std::fs::write(
-        &scenario,
-        format!(
-            "name = \"drive_{seed}\"\nimu_rate_hz = 100.0\ntruth_rate_hz = 10.0\nseed = {seed}\n\
-             [start]\nlat_deg = 40.0966\nlon_deg = -105.1474\nh_m = 1601.0\neuler_deg = [0.0, 0.0, 30.0]\n\
-             {segments}[errors]\n{errors}\n\
-             [noise]\narw = \"0.1 deg/sqrt(h)\"\nvrw = \"50 ug/sqrt(Hz)\"\n\
-             [gnss]\nrate_hz = 1.0\nsigma_ne = \"0.1 m\"\nsigma_d = \"0.2 m\"\nsigma_v = \"0.02 m/s\"\n"
-        ),
-    )
-    .unwrap();
-    let sim = dir.join(format!("sim_{seed}"));
-    let (ok, _, stderr) = sinsmodel(&[
-        "simulate",
-        scenario.to_str().unwrap(),
-        "--out",
-        sim.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
-    sim
-}
-
-/// explain (P13, tactical grade, the drive's noise stated right) on the drive simulated in
-/// `sim` with the fixes `aid`, the candidates `cands` (all without), into `out`: explain.json
-/// and stderr.
-fn explain_p13_drive(
-    sim: &Path,
-    aid: &Path,
-    cands: Option<&str>,
-    out: &Path,
-) -> (serde_json::Value, String) {
-    let file = |f: &str| sim.join(f).to_str().unwrap().to_string();
-    let mut args = vec![
-        "explain".to_string(),
-        "--model".into(),
-        "P13".into(),
-        "--grade".into(),
-        "tactical".into(),
-        "--noise".into(),
-        "arw=0.1 deg/sqrt(h), vrw=50 ug/sqrt(Hz)".into(),
-        "--imu".into(),
-        file("imu.txt"),
-        "--aid".into(),
-        aid.to_str().unwrap().into(),
-        "--truth".into(),
-        file("truth.txt"),
-        "--out".into(),
-        out.to_str().unwrap().into(),
-    ];
-    if let Some(c) = cands {
-        args.extend(["--candidates".to_string(), c.to_string()]);
-    }
-    let (ok, _, stderr) = sinsmodel(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(ok, "{stderr}");
-    let v = json(&out.join("explain.json"));
-    // the findings at a glance give a stand-in's other reasons as well
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    for f in v["findings"].as_array().unwrap() {
-        if !f["stand_in"].is_null() && !f["not_attributed"].is_null() {
-            let row = format!("| {} |", f["term"].as_str().unwrap());
-            let line = report.lines().find(|l| l.starts_with(&row)).unwrap();
-            assert!(line.contains("(a stand-in; also "), "{line}");
-        }
-    }
-    (v, stderr)
-}
-
 /// The drive with an antenna lever arm hidden and kept out of the candidates (`!lever_*`): an
 /// accelerometer delay takes it up (helper-55: "Found: accelerometer y delay tau_y = 29.0 ±
 /// 6.63 ms" on seed 5, hidden none). Now the IMU findings are tried against the GNSS terms kept
@@ -1714,11 +1640,12 @@ fn an_antenna_lever_arm_kept_out_is_no_accelerometer_delay() {
             "lever_x = \"{} m\"\nlever_y = \"{} m\"\nlever_z = \"{} m\"",
             lever[0], lever[1], lever[2]
         );
-        // (helper-55's legs)
+        // (helper-55's drives: 300 s)
         let legs = (60.0, 40.0 / 3.0, [30.0, 30.0, 60.0]);
-        let sim = simulated_p13_drive(&dir, seed, legs, &errors);
-        let out = dir.join(format!("explain_{seed}"));
-        let (v, stderr) = explain_p13_drive(&sim, &sim.join("gnss.txt"), Some("!lever_*"), &out);
+        let d = dir.join(format!("seed_{seed}"));
+        let sim = simulated_drive_shaped(&d, seed, legs, 1.0, &errors);
+        let cands = ["--candidates", "!lever_*"];
+        let (v, stderr) = explain_drive(&sim, &sim.join("gnss.txt"), &d.join("explain"), &cands);
         let findings = v["findings"].as_array().unwrap();
         for f in findings {
             assert!(
@@ -1759,22 +1686,10 @@ fn an_antenna_lever_arm_kept_out_is_no_accelerometer_delay() {
 #[test]
 fn a_small_time_offset_is_no_accelerometer_delay() {
     let dir = tmp("drive-small-offset");
-    // (helper-56's legs)
-    let sim = simulated_p13_drive(&dir, 11, (20.0, 44.0, [36.0; 3]), "");
-    // a fix stamped t is the trajectory at t − 10 ms: dt_gnss = −10 ms
-    let text = std::fs::read_to_string(sim.join("gnss.txt")).unwrap();
-    let late: String = text
-        .lines()
-        .map(|l| match l.split_once(' ') {
-            Some((t, rest)) if !l.starts_with('#') => {
-                format!("{:.4} {rest}\n", t.parse::<f64>().unwrap() + 0.010)
-            }
-            _ => format!("{l}\n"),
-        })
-        .collect();
-    let aid = dir.join("gnss_late.txt");
-    std::fs::write(&aid, late).unwrap();
-    let (v, stderr) = explain_p13_drive(&sim, &aid, None, &dir.join("explain"));
+    // (helper-56's drive: 300 s), its fixes stamped 10 ms late: dt_gnss = −10 ms
+    let sim = simulated_drive_shaped(&dir, 11, (20.0, 44.0, [36.0; 3]), 1.0, "");
+    let aid = late_fixes(&sim, 0.010);
+    let (v, stderr) = explain_drive(&sim, &aid, &dir.join("explain"), &[]);
     let findings = v["findings"].as_array().unwrap();
     for f in findings {
         let named = f["stand_in"].is_null() && f["not_attributed"].is_null();
@@ -1783,10 +1698,7 @@ fn a_small_time_offset_is_no_accelerometer_delay() {
             "a delay named for a late fix: {stderr}"
         );
     }
-    let dt = findings
-        .iter()
-        .find(|f| f["term"] == "dt_gnss")
-        .unwrap_or_else(|| panic!("no time offset: {stderr}"));
+    let dt = time_offset(findings, &stderr);
     assert!(
         dt["stand_in"].is_null() && dt["not_attributed"].is_null(),
         "{dt}"
