@@ -128,44 +128,19 @@ fn on_data(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let refs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     let out = OutputDir::create(&args.out, &refs, "explain")?;
     super::data::print_noise(&args.data)?;
-    // a time offset found is refitted on fixes re-stamped by it (explain::restamp)
-    let given = args.data.gnss_delay_s()?.unwrap_or(0.0);
-    let restamped = |shift: f64| {
-        let mut d = args.data.clone();
-        // (below 1 ms a re-stamp changes nothing measurable: `--gnss-delay` refuses it)
-        d.gnss_delay = (shift.abs() >= 1e-3).then(|| format!("{shift:.9} s"));
-        d
-    };
-    let mut first = true;
-    let mut e = explain::restamp::explain_restamped(
-        given,
-        |shift| {
-            let d = restamped(shift);
-            let inputs = if std::mem::take(&mut first) {
-                d.load_for_passes(&mut super::data::note)?
-            } else {
-                eprintln!(
-                    "explain: the GNSS fixes re-stamped by {:.1} ms (the time offset found so far), explain runs again",
-                    shift * 1e3
-                );
-                d.load_for_passes(&mut |_| {})?
-            };
-            let data = explain_data::explain_data(&inputs)?;
-            let config_for = explain_data::config_for(&d, &inputs);
-            run_explain(&baseline, &cands, &data, &config_for, &opts)
-        },
-        |shift| {
-            let d = restamped(shift);
-            let inputs = d.load_for_passes(&mut |_| {})?;
-            let data = explain_data::explain_data(&inputs)?;
-            let cfg = explain_data::config_for(&d, &inputs)(&baseline)?;
-            let dt = sinsmodel::model::generated::common::TERMS
-                .iter()
-                .position(|t| t.name == "dt_gnss")
-                .expect("the spec declares dt_gnss");
-            explain::measurement_consistency(&baseline, dt, &data, &cfg, &opts)
+    // a time offset found is refitted on fixes re-stamped by it (explain::restamp), then tried
+    // against a lever arm on the fixes as given
+    let pb = progress::bar(1000, "explain");
+    let mut e = explain_data::explain_restamped(
+        &args.data,
+        (&baseline, &cands, &opts),
+        &mut super::data::note,
+        &mut |pass, f| {
+            pb.set_message(format!("pass {pass}"));
+            pb.set_position((f * 1000.0) as u64);
         },
     )?;
+    pb.finish_and_clear();
     if let Some(line) = explain_notes::known_gnss(&args.data.known_gnss()?) {
         e.summary.insert(0, line);
     }

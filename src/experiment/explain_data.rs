@@ -5,7 +5,8 @@
 
 use crate::data::{DataOptions, PassInputs};
 use crate::estimate::filter::FilterConfig;
-use crate::explain::{ExplainData, ExplainOptions, FileIdentity, ImuInput};
+use crate::explain::restamp::{self, OnFixes};
+use crate::explain::{ExplainData, ExplainOptions, Explanation, FileIdentity, ImuInput};
 use crate::model::catalog::Sensor;
 use crate::model::generated::common;
 use crate::model::Model;
@@ -64,4 +65,77 @@ pub fn config_for<'a>(
         crate::data::apply_opened(&mut c, m, inputs.init_sigma, inputs.step_s);
         Ok(c)
     }
+}
+
+/// explain on the data `data` names ((baseline, candidates, options)) with a time offset found
+/// refitted on fixes re-stamped by it ([`restamp::explain_restamped`]), then tried against an
+/// antenna lever arm on the fixes as given ([`restamp::offset_or_lever_arm`]); `note` takes the
+/// first load's notes, `progress` (pass, fraction done) every pass's.
+pub fn explain_restamped(
+    data: &DataOptions,
+    (baseline, cands, opts): (&Model, &[usize], &ExplainOptions),
+    note: &mut dyn FnMut(&str),
+    progress: &mut dyn FnMut(usize, f64),
+) -> Result<Explanation> {
+    let given = data.gnss_delay_s()?.unwrap_or(0.0);
+    let restamped = |shift: f64| {
+        let mut d = data.clone();
+        // (below 1 ms a re-stamp changes nothing measurable: `--gnss-delay` refuses it)
+        d.gnss_delay = (shift.abs() >= 1e-3).then(|| format!("{shift:.9} s"));
+        d
+    };
+    let mut first = true;
+    let mut e = restamp::explain_restamped(
+        given,
+        |shift| {
+            let d = restamped(shift);
+            let inputs = if std::mem::take(&mut first) {
+                d.load_for_passes(note)?
+            } else {
+                note(&format!(
+                    "explain: the GNSS fixes re-stamped by {:.1} ms (the time offset found so far), explain runs again",
+                    shift * 1e3
+                ));
+                d.load_for_passes(&mut |_| {})?
+            };
+            let x = explain_data(&inputs)?;
+            let cfg = config_for(&d, &inputs);
+            crate::explain::explain(baseline, cands, &x, &cfg, opts, progress)
+        },
+        |shift| {
+            let d = restamped(shift);
+            let inputs = d.load_for_passes(&mut |_| {})?;
+            let x = explain_data(&inputs)?;
+            let cfg = config_for(&d, &inputs)(baseline)?;
+            let dt = common::TERMS
+                .iter()
+                .position(|t| t.name == "dt_gnss")
+                .expect("the spec declares dt_gnss");
+            crate::explain::measurement_consistency(baseline, dt, &x, &cfg, opts)
+        },
+    )?;
+    let Some(shift) = e.restamp.as_ref().and_then(|r| r.passes.last()) else {
+        return Ok(e);
+    };
+    let shift = shift.shift_ms * 1e-3;
+    let (dg, ds) = (restamped(given), restamped(shift));
+    let (ig, is) = (
+        dg.load_for_passes(&mut |_| {})?,
+        ds.load_for_passes(&mut |_| {})?,
+    );
+    let (xg, xs) = (explain_data(&ig)?, explain_data(&is)?);
+    let (cg, cs) = (config_for(&dg, &ig), config_for(&ds, &is));
+    let on = |data, config_for, shift| OnFixes {
+        data,
+        config_for,
+        shift,
+    };
+    restamp::offset_or_lever_arm(
+        &mut e,
+        baseline,
+        opts,
+        (&on(&xg, &cg, given), &on(&xs, &cs, shift)),
+        progress,
+    )?;
+    Ok(e)
 }

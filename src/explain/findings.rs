@@ -185,6 +185,9 @@ pub enum Unnamed {
     OffsetNotBorneOut,
     /// A noise level fitted beside a time offset the model does not hold.
     NoiseBesideOffset,
+    /// An IMU–GNSS time offset an antenna lever arm fits as well on the fixes as stamped, or a
+    /// GNSS term whose value moves with that offset.
+    OffsetOrLeverArm,
 }
 
 impl Unnamed {
@@ -230,6 +233,10 @@ impl Unnamed {
             Self::NoiseBesideOffset => (
                 "fitted beside a missing offset",
                 "it was fitted while a stand-in took the place of a time offset",
+            ),
+            Self::OffsetOrLeverArm => (
+                "offset or lever arm, not told apart",
+                "the data cannot tell an IMU–GNSS time offset from an antenna lever arm here",
             ),
         }
     }

@@ -29,6 +29,7 @@
 mod diagnostics;
 mod findings;
 mod noise;
+mod offset_lever;
 mod raw_noise;
 pub mod restamp;
 mod rivals;
@@ -2173,6 +2174,7 @@ mod tests {
             Unnamed::OffsetUnsettled,
             Unnamed::OffsetNotBorneOut,
             Unnamed::NoiseBesideOffset,
+            Unnamed::OffsetOrLeverArm,
         ];
         let distinct = |x: Vec<String>| x.iter().collect::<std::collections::HashSet<_>>().len();
         assert_eq!(

@@ -10,6 +10,8 @@ use super::words::{sig3, summary};
 use crate::estimate::filter::AidingEpoch;
 use serde::Serialize;
 
+pub use super::offset_lever::{offset_or_lever_arm, OnFixes};
+
 /// Smallest time offset [s] a pass refits on re-stamped fixes: below, the first-order H's
 /// error (of order a dt² / 2 in position) is under a millimetre on a car.
 pub const RESTAMP_MIN_S: f64 = 0.005;
