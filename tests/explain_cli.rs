@@ -1718,8 +1718,9 @@ fn a_small_time_offset_is_no_accelerometer_delay() {
 /// lever arm along the track moves the fixes as speed × a time offset does, the rounds took
 /// the offset first, and explain printed "Found: GNSS time offset dt_gnss = -11.2 ± 2.92 ms"
 /// with no offset hidden (helper-55's lvo_7, seed 7), or an offset beside a lever arm 2.6σ
-/// from the hidden one (seed 10). Tried against a lever arm on the fixes as given, the offset
-/// is not named, and each lever arm named holds the hidden value within 2σ.
+/// from the hidden one (seed 10). Tried against a lever arm on the fixes as given, or fitted
+/// beside the lever arms it re-stamped for, the offset is not named, and each lever arm named
+/// holds the hidden value within 2σ.
 #[test]
 fn a_lever_arm_is_no_time_offset_on_a_drive_at_one_speed() {
     let dir = tmp("drive-lever-offered");
@@ -1734,7 +1735,9 @@ fn a_lever_arm_is_no_time_offset_on_a_drive_at_one_speed() {
         let (v, stderr) = explain_drive(&sim, &sim.join("gnss.txt"), &d.join("explain"), &[]);
         let findings = v["findings"].as_array().unwrap();
         let dt = time_offset(findings, &stderr);
-        assert!(because(dt, "offset_or_lever_arm"), "seed {seed}: {dt}");
+        // (or, fitted beside the lever arms it re-stamped for, it is no offset in all)
+        let rules = ["offset_or_lever_arm", "offset_not_borne_out"];
+        assert!(rules.iter().any(|r| because(dt, r)), "seed {seed}: {dt}");
         for f in findings
             .iter()
             .filter(|f| is_cause(f) && f["kind"] != "noise")
@@ -1755,4 +1758,89 @@ fn a_lever_arm_is_no_time_offset_on_a_drive_at_one_speed() {
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A uniform draw in [lo, hi) from `seed` and `k` (splitmix64): the campaign's lever arms.
+fn draw(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
+    let mut z = seed
+        .wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        .wrapping_add(k.wrapping_mul(0xbf58_476d_1ce4_e5b9));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// The developer's campaign behind the offset-or-lever-arm numbers of docs/explain.md (about
+/// 2.5 s per run): 300-s P13 drives (as `a_lever_arm_is_no_time_offset_on_a_drive_at_one_speed`),
+/// an antenna lever arm drawn per seed (|x| 0.3–0.8 m, y ±0.8 m, z ±0.6 m), every candidate
+/// offered, with the fixes as simulated, 15 ms late and 30 ms late, and 30 ms late without the
+/// lever arm; prints per group how often dt_gnss is named and how often its value is beyond 3σ
+/// of the hidden one. `SEEDS=1-40 cargo test --release --test explain_cli
+/// offset_or_lever_arm_campaign -- --ignored --nocapture` (default 1-20).
+#[test]
+#[ignore]
+fn offset_or_lever_arm_campaign() {
+    let seeds = std::env::var("SEEDS").unwrap_or_else(|_| "1-20".into());
+    let (a, b) = seeds.split_once('-').expect("SEEDS=FIRST-LAST");
+    let (a, b): (u64, u64) = (a.parse().unwrap(), b.parse().unwrap());
+    let dir = tmp("offset-lever-campaign");
+    // (group, fixes late [s], with a lever arm)
+    for (group, late, lever) in [
+        ("lever arm, no offset", 0.0, true),
+        ("lever arm, 15 ms late", 0.015, true),
+        ("lever arm, 30 ms late", 0.030, true),
+        ("no lever arm, 30 ms late", 0.030, false),
+    ] {
+        let (mut runs, mut named, mut off, mut taken) = (0, 0, 0, 0);
+        for seed in a..=b {
+            let sign = if draw(seed, 0, 0.0, 1.0) < 0.5 {
+                -1.0
+            } else {
+                1.0
+            };
+            let arm = [
+                sign * draw(seed, 1, 0.3, 0.8),
+                draw(seed, 2, -0.8, 0.8),
+                draw(seed, 3, -0.6, 0.6),
+            ];
+            let errors = if lever {
+                format!(
+                    "lever_x = \"{:.3} m\"\nlever_y = \"{:.3} m\"\nlever_z = \"{:.3} m\"",
+                    arm[0], arm[1], arm[2]
+                )
+            } else {
+                String::new()
+            };
+            let d = dir.join(format!("{seed}-{late}-{lever}"));
+            let legs = (60.0, 40.0 / 3.0, [30.0, 30.0, 60.0]);
+            let sim = simulated_drive_shaped(&d, seed, legs, 1.0, &errors);
+            let aid = if late > 0.0 {
+                late_fixes(&sim, late)
+            } else {
+                sim.join("gnss.txt")
+            };
+            let (v, _) = explain_drive(&sim, &aid, &d.join("explain"), &[]);
+            runs += 1;
+            let dt = v["findings"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|f| f["term"] == "dt_gnss");
+            // (un-named by the offset-or-lever-arm rule alone: named before it)
+            let only = |f: &&serde_json::Value| {
+                f["not_attributed_because"] == serde_json::json!(["offset_or_lever_arm"])
+            };
+            taken += dt.filter(only).map_or(0, |_| 1);
+            if let Some(dt) = dt.filter(|f| is_cause(f)) {
+                named += 1;
+                let (ms, sd) = value(dt);
+                if (ms + late * 1e3).abs() > 3.0 * sd {
+                    off += 1;
+                }
+            }
+            std::fs::remove_dir_all(&d).unwrap();
+        }
+        eprintln!("{group}: {runs} runs (seeds {a}-{b}), dt_gnss named in {named}, {off} of them beyond 3σ of the hidden offset; {taken} more un-named by offset_or_lever_arm alone");
+    }
 }

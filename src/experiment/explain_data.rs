@@ -134,7 +134,11 @@ pub fn explain_restamped(
         &mut e,
         baseline,
         opts,
-        (&on(&xg, &cg, given), &on(&xs, &cs, shift)),
+        (
+            &on(&xg, &cg, given),
+            &on(&xs, &cs, shift),
+            data.lever_arm.is_some(),
+        ),
         progress,
     )?;
     Ok(e)

@@ -23,18 +23,20 @@ pub struct OnFixes<'a> {
     pub shift: f64,
 }
 
-/// The time offset `e` names after re-stamping (a cause) against the antenna lever arms along
-/// the body's horizontal axes on the fixes as given. The model of `e`'s causes on the
-/// re-stamped fixes (`stamped`) is fitted beside the same model on the fixes as given
-/// (`given`), with a horizontal lever arm added, or as it is when it holds one. When one of
-/// those fits the data as well (the re-stamp not better beyond chance,
-/// [`Comparison::better_in_few_blocks`]) with a lever arm beyond 3σ, the offset is not named,
-/// and the causes that move with it are judged ([`moved_with_the_offset`]).
+/// The time offset `e` names after re-stamping (a cause) against an antenna lever arm along
+/// the track (body x) on the fixes as given; `lever_known`: the user gave the lever arm
+/// (`--lever-arm`), and it is not tried. First the offset left on the re-stamped fixes is
+/// fitted beside the GNSS causes that took it up ([`left_beside_its_takers`]). Then the model
+/// of `e`'s causes on the re-stamped fixes (`stamped`) is fitted beside the same model with
+/// lever_x added, or as it is when it holds it, on the fixes as given (`given`). When that fits
+/// the data as well (the re-stamp not better beyond chance,
+/// [`Comparison::better_in_few_blocks`]) with lever_x beyond 3σ, the offset is not named, and
+/// the causes that move with it are judged ([`moved_with_the_offset`]).
 pub fn offset_or_lever_arm(
     e: &mut Explanation,
     baseline: &Model,
     opts: &ExplainOptions,
-    (given, stamped): (&OnFixes, &OnFixes),
+    (given, stamped, lever_known): (&OnFixes, &OnFixes, bool),
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<()> {
     let Some(k) = e.findings.iter().position(|f| f.term == "dt_gnss") else {
@@ -52,12 +54,6 @@ pub fn offset_or_lever_arm(
     } else {
         Vec::new()
     };
-    let causes: Vec<usize> = e
-        .findings
-        .iter()
-        .filter(|f| f.is_cause() && f.term != "dt_gnss")
-        .filter_map(|f| super::term_index(&f.term))
-        .collect();
     let ctx_g = Context {
         baseline,
         data: given.data,
@@ -69,6 +65,14 @@ pub fn offset_or_lever_arm(
         config_for: stamped.config_for,
         ..ctx_g
     };
+    left_beside_its_takers(e, &ctx_s, &widened, k, progress)?;
+    let Some(lx) = super::term_index("lever_x").filter(|_| e.findings[k].is_cause()) else {
+        return unattributed(e, &ctx_s, &widened, progress);
+    };
+    if lever_known {
+        return Ok(());
+    }
+    let causes = causes_of(e);
     let round = e.rounds + 1;
     let named = model_with(&baseline.name, causes.iter().copied())?;
     let cfg = ctx_s.extended_config(&named, &widened)?;
@@ -77,115 +81,243 @@ pub fn offset_or_lever_arm(
         return Ok(());
     };
     let occam_s = occam(&ctx_s, &named, &cfg, &end_s.sigma);
-    let levers: Vec<usize> = ["lever_x", "lever_y"]
-        .iter()
-        .filter_map(|n| super::term_index(n))
-        .collect();
-    // the rivals: the model as it is when it holds a lever arm, and with each one it lacks
-    let mut rivals: Vec<Vec<usize>> = Vec::new();
-    if causes.iter().any(|t| levers.contains(t)) {
-        rivals.push(causes.clone());
-    }
-    for &l in levers.iter().filter(|l| !causes.contains(l)) {
-        rivals.push(causes.iter().copied().chain([l]).collect());
-    }
-    for terms in rivals {
-        let m = model_with(&baseline.name, terms.iter().copied())?;
-        // (a configuration that refuses a lever arm has no antenna to put it on)
-        let Ok(cfg_g) = ctx_g.extended_config(&m, &widened) else {
-            continue;
-        };
-        let p_g = run_pass(&m, &[], given.data, &cfg_g, &mut |x| progress(round, x))?;
-        let Some(end_g) = p_g.run.records.last() else {
-            continue;
-        };
-        let occam_g = occam(&ctx_g, &m, &cfg_g, &end_g.sigma);
-        let shift = stamped.shift - given.shift;
-        // (the lever arm's run as the named one: the fit is the re-stamp's against it)
-        let Some(fit) = compare(given.data, &p_g.run, &p_s.run, (shift, occam_s - occam_g)) else {
-            continue;
-        };
-        if fit.better_in_few_blocks() {
-            continue;
-        }
-        let fitted = |name: &str| m.index_of(name).map(|i| (end_g.x[i], end_g.sigma[i]));
-        let Some(how) = lever_words(e, &levers, &fitted, &fit) else {
-            continue;
-        };
-        moved_with_the_offset(e, &fitted, &how);
-        super::not_named(&mut e.findings[k], super::Unnamed::OffsetOrLeverArm, how);
-        let line = e.summary.first().cloned();
-        e.summary = super::words::summary(e);
-        if let Some(line) = line.filter(|l| l.starts_with("The GNSS fixes were re-stamped")) {
-            e.summary.insert(0, line);
-        }
+    // the rival: the model with the lever arm along the track (a lever arm across it, or a
+    // term the re-stamped model lacks, would win by what the other misses)
+    let m = model_with(
+        &baseline.name,
+        causes.iter().copied().filter(|&t| t != lx).chain([lx]),
+    )?;
+    // (a configuration that refuses a lever arm has no antenna to put it on)
+    let Ok(cfg_g) = ctx_g.extended_config(&m, &widened) else {
+        return Ok(());
+    };
+    let p_g = run_pass(&m, &[], given.data, &cfg_g, &mut |x| progress(round, x))?;
+    let Some(end_g) = p_g.run.records.last() else {
+        return Ok(());
+    };
+    let occam_g = occam(&ctx_g, &m, &cfg_g, &end_g.sigma);
+    let shift = stamped.shift - given.shift;
+    // (the lever arm's run as the named one: the fit is the re-stamp's against it)
+    let Some(fit) = compare(given.data, &p_g.run, &p_s.run, (shift, occam_s - occam_g)) else {
+        return Ok(());
+    };
+    if fit.better_in_few_blocks() {
         return Ok(());
     }
+    let fitted = |name: &str| m.index_of(name).map(|i| (end_g.x[i], end_g.sigma[i]));
+    let on = if given.shift == 0.0 {
+        "on the fixes as stamped".to_string()
+    } else {
+        format!(
+            "on the fixes as given (shifted by --gnss-delay {} ms)",
+            sig3(given.shift * 1e3)
+        )
+    };
+    let Some(how) = lever_words(e, lx, &fitted, &fit, (&on, given.shift != 0.0)) else {
+        return Ok(());
+    };
+    moved_with_the_offset(e, &fitted, &how, &on);
+    super::not_named(&mut e.findings[k], super::Unnamed::OffsetOrLeverArm, how);
+    unattributed(e, &ctx_s, &widened, progress)
+}
+
+/// The terms of `e`'s causes but the time offset.
+fn causes_of(e: &Explanation) -> Vec<usize> {
+    e.findings
+        .iter()
+        .filter(|f| f.is_cause() && f.term != "dt_gnss")
+        .filter_map(|f| super::term_index(&f.term))
+        .collect()
+}
+
+/// `e` with its time offset not named: the summary opens with the re-stamp no offset was
+/// named for, and when a term of the extended model is no cause now, that model is refitted
+/// without it on the re-stamped fixes (`ctx`, the widened priors `widened`).
+fn unattributed(
+    e: &mut Explanation,
+    ctx: &Context,
+    widened: &[(usize, f64)],
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<()> {
+    let causes = causes_of(e);
+    let m = model_with(&ctx.baseline.name, causes.iter().copied())?;
+    if m.name != e.extended_model {
+        let cfg = ctx.extended_config(&m, widened)?;
+        let round = e.rounds + 1;
+        let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(round, x))?;
+        let excess = super::baseline_excess(&e.baseline);
+        e.extended_model = m.name.clone();
+        e.gain = super::Gain::between(&e.baseline, &p.stats);
+        e.misfit_unexplained = excess.map(|x| ((p.stats.nis_mean - 1.0) / x).max(0.0));
+        e.innovations_after = super::normalised(&p.run);
+        e.model_error_after = super::model_error_series(&p.run);
+        e.extended = p.stats;
+    }
+    let Some(r) = &e.restamp else {
+        return Ok(());
+    };
+    let line = super::restamp::restamp_line_unattributed(
+        r.passes.last().map_or(0.0, |p| p.shift_ms),
+        r.nis_as_stamped,
+    );
+    e.summary = super::words::summary(e);
+    e.summary.insert(0, line);
     Ok(())
 }
 
-/// Why the offset of `e` is not named when the lever arms among `levers` fitted on the fixes as
-/// given (`fitted`: a term's value and σ, SI) fit as `fit` says: None when none is beyond 3σ.
+/// When the GNSS causes of `e`'s last re-stamped run took up what was left of the offset (its
+/// candidate test alone then counted for nothing, and a lever arm beside an overshooting
+/// re-stamp kept it: fixes 30 ms late came out −39.5 ± 2.87 ms beside lever_x), the offset
+/// left is fitted beside them on the re-stamped fixes (`ctx`; the model of `e`'s causes, the
+/// widened priors `widened`), and the offset in all (finding `k`) is the re-stamp plus that,
+/// with its σ; not named when that is within 3σ of nothing. The causes take their values and
+/// σ from that fit too.
+fn left_beside_its_takers(
+    e: &mut Explanation,
+    ctx: &Context,
+    widened: &[(usize, f64)],
+    k: usize,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<()> {
+    let Some(restamp) = &e.restamp else {
+        return Ok(());
+    };
+    let Some(last) = restamp.passes.last().filter(|p| !p.taken_up_by.is_empty()) else {
+        return Ok(());
+    };
+    let (shift, takers) = (last.shift_ms, last.taken_up_by.join(", "));
+    let Some(w) = super::term_index("dt_gnss") else {
+        return Ok(());
+    };
+    let m = model_with(&ctx.baseline.name, causes_of(e).into_iter().chain([w]))?;
+    let cfg = ctx.extended_config(&m, widened)?;
+    let round = e.rounds + 1;
+    let p = run_pass(&m, &[], ctx.data, &cfg, &mut |x| progress(round, x))?;
+    let (Some(i), Some(end)) = (m.index_of("dt_gnss"), p.run.records.last()) else {
+        return Ok(());
+    };
+    let ms = 1.0 / common::TERMS[w].display_to_si;
+    let (left, sigma) = (end.x[i] * ms, end.sigma[i] * ms);
+    if !(left.is_finite() && sigma.is_finite()) {
+        return Ok(());
+    }
+    let total = shift + left;
+    let nis0 = restamp.nis_as_stamped;
+    // the causes beside it as fitted with it: their σ holds what the offset left may take
+    for g in e
+        .findings
+        .iter_mut()
+        .filter(|g| g.is_cause() && g.term != "dt_gnss")
+    {
+        let (Some(j), Some(t)) = (m.index_of(&g.term), super::term_index(&g.term)) else {
+            continue;
+        };
+        let si = common::TERMS[t].display_to_si;
+        let (x, s) = (end.x[j] / si, end.sigma[j] / si);
+        if (x - g.estimate).abs() > 0.5 * g.sigma || s > 1.03 * g.sigma {
+            let before = format!("{} ± {} {}", sig3(g.estimate), sig3(g.sigma), g.unit);
+            set_value(g, x, s);
+            g.words.push_str(&format!(
+                ". Its value is the fit beside the time offset left on the re-stamped fixes ({before} without it)"
+            ));
+        }
+    }
+    let f = &mut e.findings[k];
+    let old = f.headline.clone();
+    (f.estimate, f.sigma) = (total, sigma);
+    // (as the re-stamp's fold words it)
+    f.headline = format!(
+        "GNSS time offset dt_gnss = {} ± {} {}",
+        sig3(total),
+        sig3(sigma),
+        f.unit
+    );
+    f.words = f.words.replacen(&old, &f.headline, 1);
+    f.words.push_str(&format!(
+        ". Fitted beside {takers} on the re-stamped fixes, {} ± {} ms is left on top of the re-stamp by {} ms, so the offset in all is {} ± {} ms",
+        sig3(left),
+        sig3(sigma),
+        sig3(shift),
+        sig3(total),
+        sig3(sigma)
+    ));
+    if total.abs() <= 3.0 * sigma {
+        let why = format!(
+            "beside {takers} the fixes want no offset in all ({} ± {} ms)",
+            sig3(total),
+            sig3(sigma)
+        );
+        super::not_named(f, super::Unnamed::OffsetNotBorneOut, why);
+    }
+    if let Some(r) = &mut e.restamp {
+        (r.total_ms, r.sigma_ms) = (total, sigma);
+    }
+    e.summary = super::words::summary(e);
+    e.summary
+        .insert(0, super::restamp::restamp_line(shift, left, sigma, nis0));
+    Ok(())
+}
+
+/// Sets finding `f`'s value and σ (display unit) and its headline's, in its words too.
+fn set_value(f: &mut super::Finding, estimate: f64, sigma: f64) {
+    let old = f.headline.clone();
+    f.headline = old.replacen(
+        &format!("= {} ± {} {}", sig3(f.estimate), sig3(f.sigma), f.unit),
+        &format!("= {} ± {} {}", sig3(estimate), sig3(sigma), f.unit),
+        1,
+    );
+    (f.estimate, f.sigma) = (estimate, sigma);
+    f.words = f.words.replacen(&old, &f.headline, 1);
+}
+
+/// Why the offset of `e` is not named when lever_x (term `lx`) fitted on the fixes as given
+/// (`fitted`: a term's value and σ, SI; `on`: those fixes in words; `delay_given`: the user
+/// gave `--gnss-delay`) fits as `fit` says: None when it is not beyond 3σ.
 fn lever_words(
     e: &Explanation,
-    levers: &[usize],
+    lx: usize,
     fitted: &dyn Fn(&str) -> Option<(f64, f64)>,
     fit: &Comparison,
+    (on, delay_given): (&str, bool),
 ) -> Option<String> {
-    let held: Vec<String> = levers
-        .iter()
-        .filter_map(|&l| {
-            let info = &common::TERMS[l];
-            let (x, s) = fitted(info.name)?;
-            (x.abs() > 3.0 * s).then(|| {
-                let offered = e.candidates.iter().any(|c| c.term == info.name);
-                format!(
-                    "{} = {} ± {} {}{}",
-                    info.name,
-                    sig3(x / info.display_to_si),
-                    sig3(s / info.display_to_si),
-                    info.display,
-                    if offered {
-                        ""
-                    } else {
-                        ", not a candidate here"
-                    }
-                )
-            })
-        })
-        .collect();
-    if held.is_empty() {
-        return None;
-    }
+    let info = &common::TERMS[lx];
+    let (x, s) = fitted(info.name).filter(|(x, s)| x.abs() > 3.0 * s)?;
+    let offered = e.candidates.iter().any(|c| c.term == info.name);
     let by = fit.z.map_or(String::new(), |z| {
         format!(
-            " (the re-stamp's gain {} of its σ over {BLOCKS} blocks of fixes, {} of the quiet blocks')",
+            " (the re-stamp's difference {} of its σ over {BLOCKS} blocks of fixes, {} of the quiet blocks')",
             sig3(z),
             sig3(fit.z_quiet.unwrap_or(f64::NAN))
         )
     });
+    let as_well = if fit.loglik - fit.loglik_named + fit.occam > 0.0 {
+        "almost as well (the re-stamp's advantage is within what the data leave to chance)"
+    } else {
+        "as well or better"
+    };
     Some(format!(
-        "on the fixes as stamped, {} {} the data {}: a log-likelihood {} against {} for the re-stamped fixes{by}. On this motion an antenna lever arm along the track moves the fixes as speed × a time offset does, and the data do not tell them apart; a known lever arm (--lever-arm) or offset (--gnss-delay), or a run with more changes of speed, decides",
-        held.join(" and "),
-        if held.len() == 1 { "fits" } else { "fit" },
-        if fit.loglik - fit.loglik_named + fit.occam > 0.0 {
-            "as well"
-        } else {
-            "better"
-        },
+        "{on}, {} = {} ± {} {}{} fits the data {as_well}: a log-likelihood {} against {} for the re-stamped fixes{by}. On this motion a lever arm along the track moves the fixes as speed × a time offset does, and the data do not tell them apart; a known lever arm (--lever-arm){}, or a run with more changes of speed, decides",
+        info.name,
+        sig3(x / info.display_to_si),
+        sig3(s / info.display_to_si),
+        info.display,
+        if offered { "" } else { " (not a candidate here)" },
         sig3(fit.loglik_named),
         sig3(fit.loglik),
+        if delay_given { "" } else { " or offset (--gnss-delay)" },
     ))
 }
 
 /// Each cause of `e` but the offset against its value on the fixes as given (`fitted`: value
-/// and σ, SI): one that moves by more than 3σ is not named (its value is the offset's as much
-/// as its own, `how`); one that moves by more than σ/2 is given the mean of the two, its σ
-/// widened by half their difference (either fit may be the true one).
+/// and σ, SI; `on`: those fixes in words): one that moves by more than 3σ is not named (its
+/// value is the offset's as much as its own, `how`); one that moves by more than σ/2 is given
+/// the mean of the two, its σ widened by half their difference (either fit may be the true
+/// one).
 fn moved_with_the_offset(
     e: &mut Explanation,
     fitted: &dyn Fn(&str) -> Option<(f64, f64)>,
     how: &str,
+    on: &str,
 ) {
     for f in e
         .findings
@@ -198,15 +330,18 @@ fn moved_with_the_offset(
         let si = common::TERMS[t].display_to_si;
         let (a, s, b, sb) = (f.estimate, f.sigma, b / si, sb / si);
         let both = format!(
-            "{} {} on the re-stamped fixes, {} ± {} {} on the fixes as stamped",
+            "{} ± {} {} on the re-stamped fixes, {} ± {} {} {on}",
             sig3(a),
+            sig3(s),
             f.unit,
             sig3(b),
             sig3(sb),
             f.unit
         );
         if (a - b).abs() > 3.0 * s {
-            let why = format!("its value moves with the time offset: {both}, where {how}");
+            let why = format!(
+                "its value moves with the time offset ({both}), which the data do not tell from a lever arm: {how}"
+            );
             super::not_named(f, super::Unnamed::OffsetOrLeverArm, why);
             continue;
         }
@@ -214,15 +349,7 @@ fn moved_with_the_offset(
             // (it does not move: its σ would grow by 3 % at most)
             continue;
         }
-        let old = f.headline.clone();
-        f.estimate = 0.5 * (a + b);
-        f.sigma = (s * s + 0.25 * (a - b).powi(2)).sqrt();
-        f.headline = old.replacen(
-            &format!("= {} ± {} {}", sig3(a), sig3(s), f.unit),
-            &format!("= {} ± {} {}", sig3(f.estimate), sig3(f.sigma), f.unit),
-            1,
-        );
-        f.words = f.words.replacen(&old, &f.headline, 1);
+        set_value(f, 0.5 * (a + b), (s * s + 0.25 * (a - b).powi(2)).sqrt());
         f.words.push_str(&format!(
             ". Its value moves with the time offset, which the data do not tell from a lever arm: {both}; the value above is the mean of the two, its σ widened by half their difference"
         ));

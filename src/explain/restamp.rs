@@ -315,18 +315,32 @@ fn fold(
         nis_as_stamped: nis0,
     });
     last.summary = summary(&last);
-    last.summary.insert(
-        0,
-        format!(
-            "The GNSS fixes were re-stamped by {} ms, the time offset the runs found (`--gnss-delay '{} ms'` does the same; {} ± {} ms more is left on top, in the offset's value below): the baseline pass, the candidates and every other finding below are on the re-stamped fixes; the baseline's mean NIS on the fixes as given was {}.",
-            sig3(shift),
-            sig3(shift),
-            sig3(rest),
-            sig3(sigma),
-            sig3(nis0)
-        ),
-    );
+    last.summary
+        .insert(0, restamp_line(shift, rest, sigma, nis0));
     last
+}
+
+/// The summary's first line after a re-stamp by `shift` [ms] whose offset is not named;
+/// `nis0` the baseline's mean NIS on the fixes as given.
+pub(super) fn restamp_line_unattributed(shift: f64, nis0: f64) -> String {
+    format!(
+        "The GNSS fixes were re-stamped by {} ms, the time offset the runs fitted, but that offset is not named a cause (its finding below says why): the baseline pass, the candidates and every other finding below are on the re-stamped fixes; the baseline's mean NIS on the fixes as given was {}.",
+        sig3(shift),
+        sig3(nis0)
+    )
+}
+
+/// The summary's first line after a re-stamp by `shift` [ms] with `rest` ± `sigma` [ms] left
+/// on top; `nis0` the baseline's mean NIS on the fixes as given.
+pub(super) fn restamp_line(shift: f64, rest: f64, sigma: f64, nis0: f64) -> String {
+    format!(
+        "The GNSS fixes were re-stamped by {} ms, the time offset the runs found (`--gnss-delay '{} ms'` does the same; {} ± {} ms more is left on top, in the offset's value below): the baseline pass, the candidates and every other finding below are on the re-stamped fixes; the baseline's mean NIS on the fixes as given was {}.",
+        sig3(shift),
+        sig3(shift),
+        sig3(rest),
+        sig3(sigma),
+        sig3(nis0)
+    )
 }
 
 /// The first run `e`'s dt_gnss finding, or, where it named none (a lever arm along the track
