@@ -1636,10 +1636,7 @@ fn an_antenna_lever_arm_kept_out_is_no_accelerometer_delay() {
     let dir = tmp("drive-lever-withheld");
     // (seed, lever arm [m]) as helper-55 drew them
     for (seed, lever) in [(5, [0.37, 0.48, -0.31]), (7, [-0.53, -0.70, -0.52])] {
-        let errors = format!(
-            "lever_x = \"{} m\"\nlever_y = \"{} m\"\nlever_z = \"{} m\"",
-            lever[0], lever[1], lever[2]
-        );
+        let errors = lever_errors(lever);
         // (helper-55's drives: 300 s)
         let legs = (60.0, 40.0 / 3.0, [30.0, 30.0, 60.0]);
         let d = dir.join(format!("seed_{seed}"));
@@ -1725,10 +1722,7 @@ fn a_small_time_offset_is_no_accelerometer_delay() {
 fn a_lever_arm_is_no_time_offset_on_a_drive_at_one_speed() {
     let dir = tmp("drive-lever-offered");
     for (seed, lever) in [(7, [-0.53, -0.70, -0.52]), (10, [0.55, 0.48, -0.28])] {
-        let errors = format!(
-            "lever_x = \"{} m\"\nlever_y = \"{} m\"\nlever_z = \"{} m\"",
-            lever[0], lever[1], lever[2]
-        );
+        let errors = lever_errors(lever);
         let legs = (60.0, 40.0 / 3.0, [30.0, 30.0, 60.0]);
         let d = dir.join(format!("seed_{seed}"));
         let sim = simulated_drive_shaped(&d, seed, legs, 1.0, &errors);
@@ -1758,6 +1752,14 @@ fn a_lever_arm_is_no_time_offset_on_a_drive_at_one_speed() {
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The scenario's `[errors]` lines of an antenna lever arm (x, y, z) [m].
+fn lever_errors(lever: [f64; 3]) -> String {
+    format!(
+        "lever_x = \"{} m\"\nlever_y = \"{} m\"\nlever_z = \"{} m\"",
+        lever[0], lever[1], lever[2]
+    )
 }
 
 /// A uniform draw in [lo, hi) from `seed` and `k` (splitmix64): the campaign's lever arms.
@@ -1804,11 +1806,9 @@ fn offset_or_lever_arm_campaign() {
                 draw(seed, 2, -0.8, 0.8),
                 draw(seed, 3, -0.6, 0.6),
             ];
+            let arm = arm.map(|x| (x * 1e3).round() / 1e3);
             let errors = if lever {
-                format!(
-                    "lever_x = \"{:.3} m\"\nlever_y = \"{:.3} m\"\nlever_z = \"{:.3} m\"",
-                    arm[0], arm[1], arm[2]
-                )
+                lever_errors(arm)
             } else {
                 String::new()
             };

@@ -496,27 +496,13 @@ pub(super) fn compare(
         };
         let m = median(sums.clone());
         let mad = median(sums.iter().map(|s| (s - m).abs()).collect());
-        let sd = (BLOCKS as f64).sqrt() * 1.4826 * mad;
-        if sd > 0.0 {
-            diff / sd
-        } else if diff == 0.0 {
-            0.0
-        } else {
-            diff.signum() * f64::INFINITY
-        }
+        in_sigmas(diff, (BLOCKS as f64).sqrt() * 1.4826 * mad)
     });
     let z = enough.then(|| {
         let mean = sums.iter().sum::<f64>() / BLOCKS as f64;
         let var = sums.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (BLOCKS - 1) as f64;
-        // the total's σ: √(blocks × the blocks' variance); a difference of nothing is 0 σ
-        let sd = (BLOCKS as f64 * var).sqrt();
-        if sd > 0.0 {
-            diff / sd
-        } else if diff == 0.0 {
-            0.0
-        } else {
-            diff.signum() * f64::INFINITY
-        }
+        // the total's σ: √(blocks × the blocks' variance)
+        in_sigmas(diff, (BLOCKS as f64 * var).sqrt())
     });
     Some(Comparison {
         loglik,
@@ -526,6 +512,17 @@ pub(super) fn compare(
         z_quiet,
         fixes: pairs.len(),
     })
+}
+
+/// `diff` in units of `sd`: a difference of nothing is 0σ, any other over no spread ±∞.
+fn in_sigmas(diff: f64, sd: f64) -> f64 {
+    if sd > 0.0 {
+        diff / sd
+    } else if diff == 0.0 {
+        0.0
+    } else {
+        diff.signum() * f64::INFINITY
+    }
 }
 
 /// The Occam factor of `model`'s terms beyond the baseline, fitted with the priors of `cfg` to
