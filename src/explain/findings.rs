@@ -172,7 +172,7 @@ pub enum Unnamed {
     LeansOnWithheldTerm,
     /// The candidates it takes up, fitted beside it, move its value by more than 3σ.
     ValueMoves,
-    /// Its value in the extended filter is within 1σ of zero.
+    /// Its value in the extended filter is within 2σ of zero.
     ValueNearZero,
     /// Its value was fitted beside a stand-in and changes once the stand-in is dropped or a
     /// rival takes its place.
@@ -211,8 +211,8 @@ impl Unnamed {
                 "its value moves beside the candidates it takes up",
             ),
             Self::ValueNearZero => (
-                "value within 1σ of zero",
-                "the extended filter leaves its value within 1σ of zero",
+                "value within 2σ of zero",
+                "the extended filter leaves its value within 2σ of zero",
             ),
             Self::LeansOnStandIn => (
                 "leans on a stand-in",
