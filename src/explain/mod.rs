@@ -456,10 +456,7 @@ pub fn explain(
         &stage.r.pass.run,
         &config_for(&stage.r.model)?,
     );
-    let widen: Vec<(usize, f64)> = tight
-        .iter()
-        .map(|p| (p.index, p.suggested * common::TERMS[p.index].display_to_si))
-        .collect();
+    let widen = widened_priors(&tight);
     let config_widened = |m: &Model| -> anyhow::Result<FilterConfig> {
         let mut c = config_for(m)?;
         widen_priors(&mut c, m, &widen);
@@ -1455,6 +1452,15 @@ impl Context<'_> {
         widen_priors(&mut cfg, m, widened);
         Ok(cfg)
     }
+}
+
+/// The priors explain widens for baseline terms whose priors are too tight: (term, the
+/// suggested σ, SI).
+fn widened_priors(tight: &[TightPrior]) -> Vec<(usize, f64)> {
+    tight
+        .iter()
+        .map(|p| (p.index, p.suggested * common::TERMS[p.index].display_to_si))
+        .collect()
 }
 
 /// Widens the prior σ of each term in `widened` ((term, least σ, SI)) that `m` holds.

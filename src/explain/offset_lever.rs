@@ -46,11 +46,8 @@ pub fn offset_or_lever_arm(
         return Ok(());
     }
     // the run's widened baseline priors, as its passes had them
-    let widened: Vec<(usize, f64)> = if e.baseline_priors_widened {
-        e.baseline_priors_tight
-            .iter()
-            .map(|p| (p.index, p.suggested * common::TERMS[p.index].display_to_si))
-            .collect()
+    let widened = if e.baseline_priors_widened {
+        super::widened_priors(&e.baseline_priors_tight)
     } else {
         Vec::new()
     };
@@ -223,16 +220,7 @@ fn left_beside_its_takers(
         }
     }
     let f = &mut e.findings[k];
-    let old = f.headline.clone();
-    (f.estimate, f.sigma) = (total, sigma);
-    // (as the re-stamp's fold words it)
-    f.headline = format!(
-        "GNSS time offset dt_gnss = {} ± {} {}",
-        sig3(total),
-        sig3(sigma),
-        f.unit
-    );
-    f.words = f.words.replacen(&old, &f.headline, 1);
+    set_value(f, total, sigma);
     f.words.push_str(&format!(
         ". Fitted beside {takers} on the re-stamped fixes, {} ± {} ms is left on top of the re-stamp by {} ms, so the offset in all is {} ± {} ms",
         sig3(left),
@@ -290,7 +278,7 @@ fn lever_words(
             sig3(fit.z_quiet.unwrap_or(f64::NAN))
         )
     });
-    let as_well = if fit.loglik - fit.loglik_named + fit.occam > 0.0 {
+    let as_well = if fit.gain() > 0.0 {
         "almost as well (the re-stamp's advantage is within what the data leave to chance)"
     } else {
         "as well or better"

@@ -419,16 +419,21 @@ pub(super) struct Comparison {
 }
 
 impl Comparison {
+    /// The rival's log-likelihood less the named model's, with the Occam factors.
+    pub(super) fn gain(&self) -> f64 {
+        self.loglik - self.loglik_named + self.occam
+    }
+
     /// The rival fits the data as well: not worse beyond chance (t < −2.09 on 19 degrees of
     /// freedom; a log-likelihood within 2 without the block test).
     fn as_well(&self) -> bool {
-        let diff = self.loglik - self.loglik_named + self.occam;
+        let diff = self.gain();
         self.z.map_or(diff >= -2.0, |z| z >= -T_19)
     }
 
     /// The rival fits better beyond chance.
     fn better(&self) -> bool {
-        let diff = self.loglik - self.loglik_named + self.occam;
+        let diff = self.gain();
         self.z.map_or(diff > 2.0, |z| z > T_19)
     }
 
@@ -438,9 +443,9 @@ impl Comparison {
     /// itself when a few hold it all (a time offset shows in a vehicle's speed changes, two of
     /// them on a drive), and their t-test stays near 2 at any size of it.
     pub(super) fn better_in_few_blocks(&self) -> bool {
-        let diff = self.loglik - self.loglik_named + self.occam;
         self.better()
-            || (self.z_quiet.is_some_and(|z| z > QUIET_Z) && diff > (self.fixes.max(2) as f64).ln())
+            || (self.z_quiet.is_some_and(|z| z > QUIET_Z)
+                && self.gain() > (self.fixes.max(2) as f64).ln())
     }
 }
 
