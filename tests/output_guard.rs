@@ -461,6 +461,34 @@ fn a_file_size_limit_is_an_error_naming_the_file() {
     assert!(left.is_empty(), "{left:?}");
 }
 
+/// The same for filter's nav.txt, which a thread of its own formats and writes straight to the
+/// file: the error names nav.txt, and no run directory or temporary is left.
+#[test]
+fn a_file_size_limit_on_filter_nav_txt_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let script = format!(
+        "ulimit -f 20; exec '{}' filter --model P13 --imu '{}' --aid '{}' --init 30,110,0,0,0,0 --out '{}'",
+        env!("CARGO_BIN_EXE_sinsmodel"),
+        o.join("imu.txt").display(),
+        o.join("gnss.txt").display(),
+        d.join("f").display()
+    );
+    let out = Command::new("sh").args(["-c", &script]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cannot write") && err.contains("nav.txt") && err.contains("too large"),
+        "{err}"
+    );
+    let left: Vec<String> = names(d)
+        .into_iter()
+        .filter(|n| n == "f" || n.contains(".f."))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
 /// A run killed between its two renames leaves the earlier result only in its set-aside
 /// directory: the next run into the same place restores it (even one that then fails) instead
 /// of sweeping it away; a set-aside directory holding anything unlisted is never swept.

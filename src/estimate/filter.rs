@@ -513,6 +513,8 @@ struct Engine<'a> {
     gate_runs: Vec<(&'static str, usize, u32)>,
     /// (t [s], north and east pos_ne residual [m] before the epoch's updates).
     pos_ne_prior: Vec<(f64, [f64; 2])>,
+    /// −10⁻⁹ σ₀² of each state: a variance below it is negative beyond round-off.
+    neg_tol: Vec<f64>,
     /// Updates beyond the gate applied because the gate had rejected GATE_RUN epochs in a row.
     gate_passed: usize,
     model: &'a Model,
@@ -632,6 +634,7 @@ impl<'a> Engine<'a> {
             gate_runs: Vec::new(),
             pos_ne_prior: Vec::new(),
             gate_passed: 0,
+            neg_tol: cfg.prior_sigma.iter().map(|s| -1e-9 * s.powi(2)).collect(),
         }
     }
 
@@ -889,10 +892,20 @@ impl<'a> Engine<'a> {
     /// step, so the time named is the step where it happened).
     fn step_divergence(&self, t: f64) -> Option<String> {
         let n = self.n;
-        let bad = (0..n).find(|&i| {
+        let bad_at = |i: usize| {
             let v = self.p[i * n + i];
             !self.x[i].is_finite() || !v.is_finite() || v < -1e-9 * self.cfg.prior_sigma[i].powi(2)
-        })?;
+        };
+        // every state at once, without a branch per state (the same test as `bad_at`: a NaN
+        // fails `>=`), and which one only when one fails
+        let all_good = (0..n).fold(true, |ok, i| {
+            let v = self.p[i * n + i];
+            ok & self.x[i].is_finite() & (v < f64::INFINITY) & (v >= self.neg_tol[i])
+        });
+        if all_good {
+            return None;
+        }
+        let bad = (0..n).find(|&i| bad_at(i))?;
         let s = &self.nav.state;
         let nav_finite = [s.lat, s.lon, s.h, s.v.x, s.v.y, s.v.z]
             .iter()

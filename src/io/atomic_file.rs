@@ -147,6 +147,14 @@ impl NamedWriter {
     }
 }
 
+impl NamedWriter {
+    /// The file behind the buffer (for hints to the operating system, such as starting the
+    /// write-back of what was written so far; writing goes through the writer).
+    pub fn file(&self) -> &std::fs::File {
+        self.inner.get_ref()
+    }
+}
+
 impl Write for NamedWriter {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         self.inner.write(buf).map_err(|e| self.named(e))

@@ -10,19 +10,58 @@ const POW10: [f64; 13] = [
 ];
 
 /// Writes `value` with `decimals` (≤ 12) digits after the point; falls back to `{:.d$}` when the
-/// scaled value does not fit exactly in an integer or is not finite.
+/// scaled value does not fit exactly in an integer or is not finite. Unlike `std`, −0.0 is
+/// written without its sign (a value that rounds to zero from below keeps its `-`, as in `std`).
 pub fn write_fixed<W: Write>(w: &mut W, value: f64, decimals: usize) -> io::Result<()> {
-    let scale = POW10[decimals.min(12)];
+    match fixed_bytes(value, decimals) {
+        Some((buf, len)) => w.write_all(&buf[..len]),
+        None => write!(w, "{value:.decimals$}"),
+    }
+}
+
+/// [`write_fixed`] onto the end of `out` (one copy of a fixed size per number instead of a
+/// call per number: the nav.txt rows).
+pub fn push_fixed(out: &mut Vec<u8>, value: f64, decimals: usize) {
+    match fixed_bytes(value, decimals) {
+        Some((buf, len)) => push_bytes(out, &buf, len),
+        // (writing into a Vec cannot fail)
+        None => drop(write!(out, "{value:.decimals$}")),
+    }
+}
+
+/// Appends the first `len` bytes of `buf`: all of it is copied (a copy the compiler knows the
+/// size of), then the rest is cut off again.
+fn push_bytes(out: &mut Vec<u8>, buf: &[u8; NUMBER_BYTES], len: usize) {
+    let start = out.len();
+    out.extend_from_slice(buf);
+    out.truncate(start + len);
+}
+
+/// Room for one formatted number (sign, 16 integer digits, point and 12 decimals; a scientific
+/// one is shorter).
+const NUMBER_BYTES: usize = 48;
+
+/// The bytes of `{value:.decimals$}` and their count, when integer arithmetic settles them.
+fn fixed_bytes(value: f64, decimals: usize) -> Option<([u8; NUMBER_BYTES], usize)> {
+    let scale = *POW10.get(decimals)?;
     let scaled = (value * scale).round();
     if !scaled.is_finite() || scaled.abs() >= 9.0e15 || (value * scale - scaled).abs() == 0.5 {
-        return write!(w, "{value:.decimals$}");
+        return None;
     }
     let neg = scaled < 0.0 || (scaled == 0.0 && value.is_sign_negative() && value != 0.0);
     let n = scaled.abs() as u64;
     let unit = scale as u64;
     let (int, frac) = (n / unit, n % unit);
-    let mut buf = [0u8; 40];
-    let mut k = buf.len();
+    let mut int_digits = 1;
+    let mut i = int;
+    while i >= 10 {
+        i /= 10;
+        int_digits += 1;
+    }
+    let len = usize::from(neg) + int_digits + if decimals > 0 { 1 + decimals } else { 0 };
+    // written from the last digit back
+    let mut buf = [0u8; NUMBER_BYTES];
+    let mut k = len;
     if decimals > 0 {
         let mut f = frac;
         for _ in 0..decimals {
@@ -46,7 +85,7 @@ pub fn write_fixed<W: Write>(w: &mut W, value: f64, decimals: usize) -> io::Resu
         k -= 1;
         buf[k] = b'-';
     }
-    w.write_all(&buf[k..])
+    Some((buf, len))
 }
 
 /// Exact powers of ten 10⁰ … 10²² (every one is a double).
@@ -65,52 +104,65 @@ fn scaled_by_pow10(a: f64, k: i32) -> Option<f64> {
 /// bytes of `{:.decimals$e}` (`-1.2346e-5`, `0.0000e0`); digits that cannot be settled exactly
 /// here are left to `std`.
 pub fn write_sci<W: Write>(w: &mut W, value: f64, decimals: usize) -> io::Result<()> {
-    match sci_digits(value, decimals) {
-        Some((digits, exp)) => {
-            let mut buf = [0u8; 48];
-            let mut k = 0;
-            if value.is_sign_negative() {
-                buf[k] = b'-';
-                k += 1;
-            }
-            let mut d = [0u8; 13];
-            let mut rest = digits;
-            for slot in d[..=decimals].iter_mut().rev() {
-                *slot = b'0' + (rest % 10) as u8;
-                rest /= 10;
-            }
-            buf[k] = d[0];
-            k += 1;
-            if decimals > 0 {
-                buf[k] = b'.';
-                buf[k + 1..k + 1 + decimals].copy_from_slice(&d[1..=decimals]);
-                k += 1 + decimals;
-            }
-            buf[k] = b'e';
-            k += 1;
-            if exp < 0 {
-                buf[k] = b'-';
-                k += 1;
-            }
-            let mut e = [0u8; 4];
-            let mut ne = 0;
-            let mut x = exp.unsigned_abs();
-            loop {
-                e[ne] = b'0' + (x % 10) as u8;
-                ne += 1;
-                x /= 10;
-                if x == 0 {
-                    break;
-                }
-            }
-            for c in e[..ne].iter().rev() {
-                buf[k] = *c;
-                k += 1;
-            }
-            w.write_all(&buf[..k])
-        }
+    match sci_bytes(value, decimals) {
+        Some((buf, len)) => w.write_all(&buf[..len]),
         None => write!(w, "{value:.decimals$e}"),
     }
+}
+
+/// [`write_sci`] onto the end of `out` (as [`push_fixed`]).
+pub fn push_sci(out: &mut Vec<u8>, value: f64, decimals: usize) {
+    match sci_bytes(value, decimals) {
+        Some((buf, len)) => push_bytes(out, &buf, len),
+        // (writing into a Vec cannot fail)
+        None => drop(write!(out, "{value:.decimals$e}")),
+    }
+}
+
+/// The bytes of `{value:.decimals$e}` and their count, when [`sci_digits`] settles them.
+fn sci_bytes(value: f64, decimals: usize) -> Option<([u8; NUMBER_BYTES], usize)> {
+    let (digits, exp) = sci_digits(value, decimals)?;
+    let mut buf = [0u8; NUMBER_BYTES];
+    let mut k = 0;
+    if value.is_sign_negative() {
+        buf[k] = b'-';
+        k += 1;
+    }
+    let mut d = [0u8; 13];
+    let mut rest = digits;
+    for slot in d[..=decimals].iter_mut().rev() {
+        *slot = b'0' + (rest % 10) as u8;
+        rest /= 10;
+    }
+    buf[k] = d[0];
+    k += 1;
+    if decimals > 0 {
+        buf[k] = b'.';
+        buf[k + 1..k + 1 + decimals].copy_from_slice(&d[1..=decimals]);
+        k += 1 + decimals;
+    }
+    buf[k] = b'e';
+    k += 1;
+    if exp < 0 {
+        buf[k] = b'-';
+        k += 1;
+    }
+    let mut e = [0u8; 4];
+    let mut ne = 0;
+    let mut x = exp.unsigned_abs();
+    loop {
+        e[ne] = b'0' + (x % 10) as u8;
+        ne += 1;
+        x /= 10;
+        if x == 0 {
+            break;
+        }
+    }
+    for c in e[..ne].iter().rev() {
+        buf[k] = *c;
+        k += 1;
+    }
+    Some((buf, k))
 }
 
 /// The `decimals + 1` significant digits of |value| as an integer and its decimal exponent, when
@@ -157,15 +209,47 @@ mod tests {
     #[test]
     fn matches_std_formatting() {
         let mut rng = crate::sim::rng::Rng::new(3);
-        for _ in 0..20000 {
-            let v = (rng.uniform() - 0.5) * 10f64.powf(rng.uniform() * 8.0 - 3.0);
-            for d in [0, 3, 4, 9] {
+        let special = [
+            0.0,
+            1e-300,
+            -1e-300,
+            0.5,
+            -0.5,
+            2.5,
+            f64::NAN,
+            f64::INFINITY,
+            9.1e15,
+            -1e20,
+        ];
+        for k in 0..20000 + special.len() {
+            let v = special
+                .get(k.wrapping_sub(20000))
+                .copied()
+                .unwrap_or_else(|| (rng.uniform() - 0.5) * 10f64.powf(rng.uniform() * 8.0 - 3.0));
+            // nav.txt's columns take 4, 6, 9 and 11 decimals; 13 is left to std
+            for d in [0, 3, 4, 6, 9, 11, 12, 13] {
                 let mut a = Vec::new();
                 write_fixed(&mut a, v, d).unwrap();
                 let b = format!("{v:.d$}");
                 assert_eq!(String::from_utf8(a).unwrap(), b, "{v} {d}");
+                let mut c = b"x ".to_vec();
+                push_fixed(&mut c, v, d);
+                assert_eq!(c, format!("x {b}").into_bytes(), "{v} {d}");
             }
         }
+    }
+
+    #[test]
+    fn negative_zero_is_written_without_its_sign() {
+        // (as every output written so far has it; std writes "-0.0000")
+        let mut a = Vec::new();
+        write_fixed(&mut a, -0.0, 4).unwrap();
+        let mut b = Vec::new();
+        push_fixed(&mut b, -0.0, 4);
+        assert_eq!(
+            (a.as_slice(), b.as_slice()),
+            (&b"0.0000"[..], &b"0.0000"[..])
+        );
     }
 
     #[test]
@@ -177,6 +261,9 @@ mod tests {
                 write_sci(&mut a, v, d).unwrap();
                 let b = format!("{v:.d$e}");
                 assert_eq!(String::from_utf8(a).unwrap(), b, "{v:e} {d}");
+                let mut c = b"x ".to_vec();
+                push_sci(&mut c, v, d);
+                assert_eq!(c, format!("x {b}").into_bytes(), "{v:e} {d}");
             }
         };
         for _ in 0..200_000 {

@@ -121,29 +121,44 @@ pub fn parse_numbers_into(
 ) -> Result<()> {
     out.clear();
     let mut count = 0usize;
-    for f in line
-        .split(|c: char| c.is_whitespace() || c == ',')
-        .filter(|s| !s.is_empty())
-    {
+    let mut field = |f: &[u8]| -> Result<()> {
         count += 1;
         if count > n {
-            continue;
+            return Ok(());
         }
         // the correctly rounded value, as str::parse gives it (fast-float2 is the algorithm the
         // standard library adopted, without its per-call checks)
-        let v: f64 = fast_float2::parse(f.as_bytes()).map_err(|_| {
+        let text = || shown(&String::from_utf8_lossy(f));
+        let v: f64 = fast_float2::parse(f).map_err(|_| {
             anyhow::anyhow!(
                 "{file}:{lineno}: column {count}: `{}` is not a number",
-                shown(f)
+                text()
             )
         })?;
         if !v.is_finite() {
             bail!(
                 "{file}:{lineno}: column {count}: `{}` is not finite",
-                shown(f)
+                text()
             );
         }
         out.push(v);
+        Ok(())
+    };
+    if line.is_ascii() {
+        // every line of a numeric table: split byte by byte on the separators
+        // `char::is_whitespace` gives for an ASCII byte (space, \t, \n, \x0B, \x0C, \r) and ','
+        let sep = |b: &u8| matches!(b, b' ' | b'\t' | b'\n' | 0x0B | 0x0C | b'\r' | b',');
+        for f in line.as_bytes().split(sep).filter(|f| !f.is_empty()) {
+            field(f)?;
+        }
+    } else {
+        // any other line by `char`, where Unicode white space separates too
+        for f in line
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|s| !s.is_empty())
+        {
+            field(f.as_bytes())?;
+        }
     }
     if count != n {
         bail!("{file}:{lineno}: expected {n} columns, found {count}");
@@ -251,4 +266,38 @@ pub fn write_text(path: &Path, data: &ImuData, header: &str) -> Result<()> {
         )?;
     }
     f.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_numbers_into;
+
+    /// The byte-wise split of an ASCII line and the `char` split of any other line find the
+    /// same fields as `char::is_whitespace` and ',' always did.
+    #[test]
+    fn fields_split_on_the_same_separators_either_way() {
+        let mut out = Vec::new();
+        for (line, want) in [
+            (
+                "1 2\t3,4\u{0B}5\u{0C}6\r",
+                vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+            ),
+            ("  1,, 2e-3  -4.5 ", vec![1.0, 2e-3, -4.5]),
+            // non-ASCII white space (no-break space, ideographic space) separates too
+            ("1\u{A0}2\u{3000}3", vec![1.0, 2.0, 3.0]),
+        ] {
+            parse_numbers_into(line, want.len(), "f", 7, &mut out).unwrap();
+            assert_eq!(out, want, "{line:?}");
+        }
+        // a non-ASCII field is named as it was written
+        let e = parse_numbers_into("1 2µ 3", 3, "f", 7, &mut out).unwrap_err();
+        assert!(e.to_string().contains("f:7: column 2: `2µ`"), "{e}");
+        let e = parse_numbers_into("1 x 3", 3, "f", 7, &mut out).unwrap_err();
+        assert!(
+            e.to_string().contains("f:7: column 2: `x` is not a number"),
+            "{e}"
+        );
+        let e = parse_numbers_into("1 2", 3, "f", 7, &mut out).unwrap_err();
+        assert!(e.to_string().contains("expected 3 columns, found 2"), "{e}");
+    }
 }

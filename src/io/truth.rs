@@ -36,10 +36,33 @@ pub fn create(path: &Path, header: &str) -> Result<AtomicFile> {
 
 /// Writes one row of the truth layout (`t lat lon h v_n v_e v_d roll pitch yaw`, degrees).
 pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
+    for (k, (v, dec)) in columns(r).iter().enumerate() {
+        if k > 0 {
+            w.write_all(b" ")?;
+        }
+        write_fixed(w, *v, *dec)?;
+    }
+    w.write_all(b"\n")
+}
+
+/// [`write_row`] onto the end of `out`, the same bytes without a call per number (nav.txt's
+/// rows at every IMU sample).
+pub fn push_row(out: &mut Vec<u8>, r: &TruthRow) {
+    for (k, (v, dec)) in columns(r).iter().enumerate() {
+        if k > 0 {
+            out.push(b' ');
+        }
+        crate::io::fixed::push_fixed(out, *v, *dec);
+    }
+    out.push(b'\n');
+}
+
+/// A truth row's ten written values (degrees for angles) and the decimals each is written with.
+fn columns(r: &TruthRow) -> [(f64, usize); 10] {
     let d = 180.0 / std::f64::consts::PI;
     // longitude in [-180, 180) and yaw within ±360 whatever the navigator accumulated
     let lon_deg = crate::io::bounds::written_lon_deg(r.lon * d);
-    let cols: [(f64, usize); 10] = [
+    [
         (r.t, 4),
         (r.lat * d, 11),
         (lon_deg, 11),
@@ -50,14 +73,7 @@ pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
         (r.euler.x * d, 9),
         (r.euler.y * d, 9),
         (crate::io::bounds::written_yaw_deg(r.euler.z * d), 9),
-    ];
-    for (k, (v, dec)) in cols.iter().enumerate() {
-        if k > 0 {
-            w.write_all(b" ")?;
-        }
-        write_fixed(w, *v, *dec)?;
-    }
-    w.write_all(b"\n")
+    ]
 }
 
 /// Checks one truth row's ranges and converts it (degrees → radians).
