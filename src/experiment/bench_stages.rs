@@ -345,11 +345,12 @@ fn write_stage(sim: &SimOutput) -> Stage {
                 v: Vector3::new(1e-3, -2e-3, 5e-4),
                 euler: Vector3::new(1e-4, -2e-4, 0.3),
             };
-            let _ = crate::io::truth::write_row(&mut buf, &row);
+            // as filter's nav.txt thread appends them
+            crate::io::truth::push_row(&mut buf, &row);
             buf.pop();
             for v in sig {
                 buf.push(b' ');
-                let _ = crate::io::fixed::write_sci(&mut buf, v * (1.0 + i as f64 * 1e-9), 4);
+                crate::io::fixed::push_sci(&mut buf, v * (1.0 + i as f64 * 1e-9), 4);
             }
             buf.push(b'\n');
             if buf.len() > 200 * 1024 {

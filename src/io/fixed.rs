@@ -44,48 +44,79 @@ const NUMBER_BYTES: usize = 48;
 /// The bytes of `{value:.decimals$}` and their count, when integer arithmetic settles them.
 fn fixed_bytes(value: f64, decimals: usize) -> Option<([u8; NUMBER_BYTES], usize)> {
     let scale = *POW10.get(decimals)?;
-    let scaled = (value * scale).round();
-    if !scaled.is_finite() || scaled.abs() >= 9.0e15 || (value * scale - scaled).abs() == 0.5 {
+    let v = value * scale;
+    // not finite or too large
+    if v.is_nan() || v.abs() >= 9.0e15 {
         return None;
     }
-    let neg = scaled < 0.0 || (scaled == 0.0 && value.is_sign_negative() && value != 0.0);
-    let n = scaled.abs() as u64;
+    // rounded half away from zero, as f64::round, in integers: the truncation and the
+    // fraction it leaves are exact below 2⁵³; a tie is left to std
+    let t = v as i64;
+    let f = v - t as f64;
+    if f.abs() == 0.5 {
+        return None;
+    }
+    let scaled = t + i64::from(f > 0.5) - i64::from(f < -0.5);
+    if scaled.unsigned_abs() >= 9_000_000_000_000_000 {
+        return None;
+    }
+    let neg = scaled < 0 || (scaled == 0 && value.is_sign_negative() && value != 0.0);
+    let n = scaled.unsigned_abs();
     let unit = scale as u64;
     let (int, frac) = (n / unit, n % unit);
-    let mut int_digits = 1;
-    let mut i = int;
-    while i >= 10 {
-        i /= 10;
-        int_digits += 1;
-    }
+    // (int < 9·10¹⁵: at most 16 digits)
+    let int_digits = 1 + POW10_U64[1..].iter().take_while(|&&p| int >= p).count();
     let len = usize::from(neg) + int_digits + if decimals > 0 { 1 + decimals } else { 0 };
     // written from the last digit back
     let mut buf = [0u8; NUMBER_BYTES];
     let mut k = len;
     if decimals > 0 {
-        let mut f = frac;
-        for _ in 0..decimals {
-            k -= 1;
-            buf[k] = b'0' + (f % 10) as u8;
-            f /= 10;
-        }
-        k -= 1;
+        k = put_digits(&mut buf, k, frac, decimals) - 1;
         buf[k] = b'.';
     }
-    let mut i = int;
-    loop {
-        k -= 1;
-        buf[k] = b'0' + (i % 10) as u8;
-        i /= 10;
-        if i == 0 {
-            break;
-        }
-    }
+    k = put_digits(&mut buf, k, int, int_digits);
     if neg {
-        k -= 1;
-        buf[k] = b'-';
+        buf[k - 1] = b'-';
     }
     Some((buf, len))
+}
+
+/// 10⁰ … 10¹⁶ as integers.
+const POW10_U64: [u64; 17] = {
+    let mut p = [1u64; 17];
+    let mut i = 1;
+    while i < 17 {
+        p[i] = p[i - 1] * 10;
+        i += 1;
+    }
+    p
+};
+
+/// "00", "01", … "99": two decimal digits at a time.
+const DIGIT_PAIRS: [[u8; 2]; 100] = {
+    let mut t = [[0u8; 2]; 100];
+    let mut i = 0;
+    while i < 100 {
+        t[i] = [b'0' + (i / 10) as u8, b'0' + (i % 10) as u8];
+        i += 1;
+    }
+    t
+};
+
+/// Writes the last `count` decimal digits of `v` (leading zeros included) to end at
+/// `buf[end - 1]`, two at a time; returns where they start.
+fn put_digits(buf: &mut [u8], end: usize, mut v: u64, count: usize) -> usize {
+    let mut k = end;
+    for _ in 0..count / 2 {
+        k -= 2;
+        buf[k..k + 2].copy_from_slice(&DIGIT_PAIRS[(v % 100) as usize]);
+        v /= 100;
+    }
+    if count % 2 == 1 {
+        k -= 1;
+        buf[k] = b'0' + (v % 10) as u8;
+    }
+    k
 }
 
 /// Exact powers of ten 10⁰ … 10²² (every one is a double).
