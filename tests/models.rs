@@ -158,6 +158,50 @@ fn preset_path_equals_runtime_path() {
     }
 }
 
+/// The run-time composition writes every entry of A's pattern and nothing else, so the filter
+/// leaves A unzeroed between steps on that path: over an A full of NaN the pattern comes out
+/// as over a zeroed one, and every other entry is untouched.
+#[test]
+fn runtime_composition_writes_the_whole_pattern_and_nothing_else() {
+    let mut rng = Rng(0x2545f4914f6cdd1d);
+    for name in [
+        "P13+vertical+kg_11+kg_22+kg_33+ka_11+ka_22+ka_33",
+        "P28+kaq_x_xy+kgf_xz",
+        "P31+vertical",
+        "P13+dt_gnss+lever_x+lever_y+tau_x",
+    ] {
+        let m = Model::parse(name).unwrap().runtime_only();
+        assert!(m.fill_a_writes_whole_pattern(), "{name}");
+        let n = m.n();
+        for _ in 0..20 {
+            let (nav, f, w) = random_point(&mut rng);
+            let mut acc = m.accumulator();
+            acc.add(&ImuSignals {
+                f,
+                w,
+                dw: w.cross(&f),
+                df: f.cross(&w),
+            });
+            let r = acc.mean();
+            let mut zeroed = vec![0.0; n * n];
+            m.fill_a_runtime(&nav, &r, &mut zeroed);
+            let mut over = vec![f64::NAN; n * n];
+            m.fill_a_runtime(&nav, &r, &mut over);
+            let pattern: std::collections::HashSet<usize> =
+                m.a_pattern().iter().map(|&(i, j)| i * n + j).collect();
+            for k in 0..n * n {
+                if pattern.contains(&k) {
+                    assert_eq!(over[k].to_bits(), zeroed[k].to_bits(), "{name} entry {k}");
+                } else {
+                    assert!(over[k].is_nan(), "{name}: entry {k} is off the pattern");
+                }
+            }
+        }
+    }
+    // a preset's kernel gets a zeroed A
+    assert!(!Model::parse("P31").unwrap().fill_a_writes_whole_pattern());
+}
+
 #[test]
 fn measurement_support_follows_the_states() {
     let m = Model::parse("P31").unwrap();

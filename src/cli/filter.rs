@@ -116,7 +116,10 @@ pub fn run(args: &FilterArgs) -> Result<()> {
         super::data::note(&format!("warning: {w}"));
     }
     let errors = files.commit(&out, &run, &provenance)?;
-    if let (Some(r), 1) = (args.nav_rate, nav.rows) {
+    let nav_rows = nav.rows;
+    // (said once nav.txt is known to be whole)
+    nav.finish(&out.file("nav.png"))?;
+    if let (Some(r), 1) = (args.nav_rate, nav_rows) {
         super::data::note(&format!(
             "note: --nav-rate {}: one row every {} s, longer than the {:.3} s filtered; nav.txt has only the start row",
             sinsmodel::io::units::shown_number(r),
@@ -124,8 +127,6 @@ pub fn run(args: &FilterArgs) -> Result<()> {
             t_last - start.t
         ));
     }
-    let nav_rows = nav.rows;
-    nav.finish(&out.file("nav.png"))?;
     let outage_rows = metrics::outage_drifts(&inputs.outages, &run, t_first, t_last)?;
     if !outage_rows.is_empty() {
         sinsmodel::io::atomic_file::write_text(

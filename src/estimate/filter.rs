@@ -688,8 +688,11 @@ impl<'a> Engine<'a> {
             self.np
                 .set_step_acceleration(&((s.v - self.step_v0) / step_dt));
         }
-        for &(i, j) in self.model.a_pattern() {
-            self.a[i * n + j] = 0.0;
+        // (the run-time composition writes every entry of the pattern: nothing left to zero)
+        if !self.model.fill_a_writes_whole_pattern() {
+            for &(i, j) in self.model.a_pattern() {
+                self.a[i * n + j] = 0.0;
+            }
         }
         self.acc.mean_into(&mut self.r_mean);
         self.model.fill_a(&self.np, &self.r_mean, &mut self.a);

@@ -338,7 +338,14 @@ impl Model {
         }
     }
 
-    /// Fills A by run-time composition: the generated navigation block and per-term columns.
+    /// Whether [`Model::fill_a`] writes every entry of [`Model::a_pattern`] (the run-time
+    /// composition does, each once), so that A needs no zeroing between two calls.
+    pub fn fill_a_writes_whole_pattern(&self) -> bool {
+        self.preset.is_none()
+    }
+
+    /// Fills A by run-time composition: the generated navigation block and per-term columns;
+    /// every entry of the pattern is written (a zero too), nothing else.
     pub fn fill_a_runtime(&self, nav: &NavPoint, r: &[f64], a: &mut [f64]) {
         let n = self.n();
         let mut block = [[0.0; common::NAV_COUNT]; common::NAV_COUNT];

@@ -5,4 +5,5 @@ pub mod attitude;
 pub mod earth;
 pub mod free_inertial;
 pub mod nav_point;
+pub mod nav_rows;
 pub mod strapdown;
