@@ -437,28 +437,37 @@ mod libc_sig {
     pub const SIGTERM: i32 = 15;
 }
 
-/// Past a file-size limit (`ulimit -f`) a write fails with an error naming the file (no
-/// SIGXFSZ death, no message-less exit) and no temporary is left.
-#[test]
-fn a_file_size_limit_is_an_error_naming_the_file() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let o = simulate(d);
+/// `sinsmodel ARGS` under a file-size limit of 20 blocks (`ulimit -f`): it must fail with exit
+/// code 2 and an error naming `file` as too large (no SIGXFSZ death, no message-less exit), and
+/// leave nothing in `d` whose name `leftover` picks.
+fn fails_past_a_file_size_limit(d: &Path, args: &str, file: &str, leftover: fn(&str) -> bool) {
     let script = format!(
-        "ulimit -f 20; exec '{}' navigate --imu '{}' --lat 30 --lon 110 --att 0,0,0 --out-rate 100 --out '{}'",
-        env!("CARGO_BIN_EXE_sinsmodel"),
-        o.join("imu.txt").display(),
-        d.join("big.txt").display()
+        "ulimit -f 20; exec '{}' {args}",
+        env!("CARGO_BIN_EXE_sinsmodel")
     );
     let out = Command::new("sh").args(["-c", &script]).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("cannot write") && err.contains("big.txt") && err.contains("too large"),
+        err.contains("cannot write") && err.contains(file) && err.contains("too large"),
         "{err}"
     );
-    let left: Vec<String> = names(d).into_iter().filter(|n| n.contains("big")).collect();
+    let left: Vec<String> = names(d).into_iter().filter(|n| leftover(n)).collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// Past a file-size limit a write fails with an error naming the file and no temporary is left.
+#[test]
+fn a_file_size_limit_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = simulate(d);
+    let args = format!(
+        "navigate --imu '{}' --lat 30 --lon 110 --att 0,0,0 --out-rate 100 --out '{}'",
+        o.join("imu.txt").display(),
+        d.join("big.txt").display()
+    );
+    fails_past_a_file_size_limit(d, &args, "big.txt", |n| n.contains("big"));
 }
 
 /// The same for filter's nav.txt, which a thread of its own formats and writes straight to the
@@ -468,25 +477,13 @@ fn a_file_size_limit_on_filter_nav_txt_is_an_error_naming_it() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let o = simulate(d);
-    let script = format!(
-        "ulimit -f 20; exec '{}' filter --model P13 --imu '{}' --aid '{}' --init 30,110,0,0,0,0 --out '{}'",
-        env!("CARGO_BIN_EXE_sinsmodel"),
+    let args = format!(
+        "filter --model P13 --imu '{}' --aid '{}' --init 30,110,0,0,0,0 --out '{}'",
         o.join("imu.txt").display(),
         o.join("gnss.txt").display(),
         d.join("f").display()
     );
-    let out = Command::new("sh").args(["-c", &script]).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("cannot write") && err.contains("nav.txt") && err.contains("too large"),
-        "{err}"
-    );
-    let left: Vec<String> = names(d)
-        .into_iter()
-        .filter(|n| n == "f" || n.contains(".f."))
-        .collect();
-    assert!(left.is_empty(), "{left:?}");
+    fails_past_a_file_size_limit(d, &args, "nav.txt", |n| n == "f" || n.contains(".f."));
 }
 
 /// A run killed between its two renames leaves the earlier result only in its set-aside
