@@ -28,7 +28,7 @@ fn start_writeback(file: &std::fs::File) {
 
 /// Writes `nav.txt` rows from the filter's [`Observer::nav_sample`].
 pub struct NavWriter {
-    writer: Option<RowWriter>,
+    writer: RowWriter,
     batch: Vec<RawRow>,
     clock: RowClock,
     idx: [Option<usize>; 9],
@@ -87,12 +87,7 @@ impl NavWriter {
             "# attitude sigmas are the tilt errors about north, east, down (= roll, pitch, yaw near level)"
         )?;
         Ok(NavWriter {
-            writer: Some(RowWriter::spawn(
-                file,
-                path,
-                idx.map(|i| i.is_some()),
-                start_writeback,
-            )?),
+            writer: RowWriter::spawn(file, path, idx.map(|i| i.is_some()), start_writeback)?,
             batch: Vec::with_capacity(BATCH_ROWS),
             clock,
             idx,
@@ -106,11 +101,7 @@ impl NavWriter {
     /// plots.
     pub fn finish(mut self, png: &std::path::Path) -> anyhow::Result<()> {
         self.send_batch();
-        let w = self
-            .writer
-            .take()
-            .ok_or_else(|| anyhow::anyhow!("nav.txt: its writing thread is gone"))?;
-        let (file, plots) = w.finish().map_err(anyhow::Error::msg)?;
+        let (file, plots) = self.writer.finish().map_err(anyhow::Error::msg)?;
         file.commit()?;
         draw_plots(png, plots)
     }
@@ -122,9 +113,7 @@ impl NavWriter {
             return;
         }
         let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH_ROWS));
-        if let Some(w) = &self.writer {
-            w.send(batch);
-        }
+        self.writer.send(batch);
     }
 
     /// Copies the state, the nine estimates and their variances out for the writing thread.

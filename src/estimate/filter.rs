@@ -895,20 +895,16 @@ impl<'a> Engine<'a> {
     /// step, so the time named is the step where it happened).
     fn step_divergence(&self, t: f64) -> Option<String> {
         let n = self.n;
-        let bad_at = |i: usize| {
+        // a finite estimate and a finite variance not negative beyond round-off (a NaN fails
+        // `>=`), tested for every state without a branch each; which one failed only then
+        let good = |i: usize| {
             let v = self.p[i * n + i];
-            !self.x[i].is_finite() || !v.is_finite() || v < -1e-9 * self.cfg.prior_sigma[i].powi(2)
+            self.x[i].is_finite() & (v < f64::INFINITY) & (v >= self.neg_tol[i])
         };
-        // every state at once, without a branch per state (the same test as `bad_at`: a NaN
-        // fails `>=`), and which one only when one fails
-        let all_good = (0..n).fold(true, |ok, i| {
-            let v = self.p[i * n + i];
-            ok & self.x[i].is_finite() & (v < f64::INFINITY) & (v >= self.neg_tol[i])
-        });
-        if all_good {
+        if (0..n).fold(true, |ok, i| ok & good(i)) {
             return None;
         }
-        let bad = (0..n).find(|&i| bad_at(i))?;
+        let bad = (0..n).find(|&i| !good(i))?;
         let s = &self.nav.state;
         let nav_finite = [s.lat, s.lon, s.h, s.v.x, s.v.y, s.v.z]
             .iter()

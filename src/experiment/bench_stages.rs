@@ -346,8 +346,7 @@ fn write_stage(sim: &SimOutput) -> Stage {
                 euler: Vector3::new(1e-4, -2e-4, 0.3),
             };
             // as filter's nav.txt thread appends them
-            crate::io::truth::push_row(&mut buf, &row);
-            buf.pop();
+            crate::io::truth::push_row_values(&mut buf, &row);
             for v in sig {
                 buf.push(b' ');
                 crate::io::fixed::push_sci(&mut buf, v * (1.0 + i as f64 * 1e-9), 4);

@@ -139,19 +139,17 @@ pub struct NamedWriter {
 }
 
 impl NamedWriter {
+    /// The file behind the buffer, for a writer that bypasses it (flush the buffer first) or
+    /// hints to the operating system such as starting the write-back.
+    pub fn file(&self) -> &std::fs::File {
+        self.inner.get_ref()
+    }
+
     fn named(&self, e: std::io::Error) -> std::io::Error {
         std::io::Error::new(
             e.kind(),
             format!("cannot write {}: {e}", self.target.display()),
         )
-    }
-}
-
-impl NamedWriter {
-    /// The file behind the buffer (for hints to the operating system, such as starting the
-    /// write-back of what was written so far; writing goes through the writer).
-    pub fn file(&self) -> &std::fs::File {
-        self.inner.get_ref()
     }
 }
 

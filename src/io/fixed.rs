@@ -5,10 +5,6 @@
 
 use std::io::{self, Write};
 
-const POW10: [f64; 13] = [
-    1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
-];
-
 /// Writes `value` with `decimals` (≤ 12) digits after the point; falls back to `{:.d$}` when the
 /// scaled value does not fit exactly in an integer or is not finite. Unlike `std`, −0.0 is
 /// written without its sign (a value that rounds to zero from below keeps its `-`, as in `std`).
@@ -43,7 +39,7 @@ const NUMBER_BYTES: usize = 48;
 
 /// The bytes of `{value:.decimals$}` and their count, when integer arithmetic settles them.
 fn fixed_bytes(value: f64, decimals: usize) -> Option<([u8; NUMBER_BYTES], usize)> {
-    let scale = *POW10.get(decimals)?;
+    let scale = *EXACT_POW10[..=12].get(decimals)?;
     let v = value * scale;
     // not finite or too large
     if v.is_nan() || v.abs() >= 9.0e15 {
@@ -56,10 +52,8 @@ fn fixed_bytes(value: f64, decimals: usize) -> Option<([u8; NUMBER_BYTES], usize
     if f.abs() == 0.5 {
         return None;
     }
+    // (|v| < 9·10¹⁵ < 2⁵³, where doubles are at most 1 apart: |scaled| < 9·10¹⁵ too)
     let scaled = t + i64::from(f > 0.5) - i64::from(f < -0.5);
-    if scaled.unsigned_abs() >= 9_000_000_000_000_000 {
-        return None;
-    }
     let neg = scaled < 0 || (scaled == 0 && value.is_sign_negative() && value != 0.0);
     let n = scaled.unsigned_abs();
     let unit = scale as u64;

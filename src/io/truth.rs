@@ -45,16 +45,15 @@ pub fn write_row<W: Write>(w: &mut W, r: &TruthRow) -> std::io::Result<()> {
     w.write_all(b"\n")
 }
 
-/// [`write_row`] onto the end of `out`, the same bytes without a call per number (nav.txt's
-/// rows at every IMU sample).
-pub fn push_row(out: &mut Vec<u8>, r: &TruthRow) {
+/// [`write_row`]'s values onto the end of `out`, without its line end (the caller adds more
+/// columns): the same bytes without a call per number (nav.txt's rows at every IMU sample).
+pub fn push_row_values(out: &mut Vec<u8>, r: &TruthRow) {
     for (k, (v, dec)) in columns(r).iter().enumerate() {
         if k > 0 {
             out.push(b' ');
         }
         crate::io::fixed::push_fixed(out, *v, *dec);
     }
-    out.push(b'\n');
 }
 
 /// A truth row's ten written values (degrees for angles) and the decimals each is written with.

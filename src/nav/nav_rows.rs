@@ -5,7 +5,7 @@
 
 use crate::io::atomic_file::AtomicFile;
 use crate::io::fixed::push_sci;
-use crate::io::truth::{push_row, TruthRow};
+use crate::io::truth::{push_row_values, TruthRow};
 use crate::nav::earth;
 use crate::nav::strapdown::NavState;
 use std::io::Write;
@@ -201,8 +201,7 @@ impl RowWriter {
                     for r in &batch {
                         let (row, sig, n_sig) = former.row(r)?;
                         // the truth layout (same digits), then the sigmas
-                        push_row(&mut chunk, &row);
-                        chunk.pop(); // its newline
+                        push_row_values(&mut chunk, &row);
                         for v in &sig[..n_sig] {
                             chunk.push(b' ');
                             push_sci(&mut chunk, *v, 4);
