@@ -6,10 +6,12 @@
 use anyhow::{bail, Result};
 
 /// Address space one job takes for cases of `seconds` simulated seconds [bytes]: measured
-/// 36 MB at 300 s and about 0.115 MB per simulated second (max RSS of `--jobs 1`, `2`, `4` with
-/// one malloc arena), taken as 0.125 MB/s plus 4 MB for the thread's stack and buffers.
+/// (2026-12-07, max RSS of `--jobs 2` less `--jobs 1`, one malloc arena) 48 MB at 300 s and 167
+/// MB at 1200 s, and 62 MB and 208 MB for the whole `--jobs 1` process: the case's samples and
+/// the navigation tape its passes share (about 0.115 and 0.049 MB per simulated second), taken
+/// as 0.175 MB/s plus 4 MB for the thread's stack and buffers.
 pub fn job_bytes(seconds: f64) -> f64 {
-    4e6 + 0.125e6 * seconds
+    4e6 + 0.175e6 * seconds
 }
 
 /// The address-space limit of this process [bytes], if there is one.

@@ -286,6 +286,7 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,
+        tape: None,
     };
     let config_for = |m: &Model| reproduce::config(m, &priors);
     let e = run_explain(&baseline, &cands, &data, &config_for, opts)?;

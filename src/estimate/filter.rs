@@ -16,6 +16,7 @@
 //!   update attitude, velocity and position are corrected and every instrument term's estimate is
 //!   moved into a correction applied to all later increments (per sample, with its regressor).
 
+pub use super::nav_tape::{NavTape, StepSums};
 use crate::io::imu::{ImuData, ImuSample};
 use crate::io::truth::{TruthLookup, TruthRow, TruthSlice};
 use crate::model::catalog::{AidRecord, Aiding, ResidualState, Sensor, StateRef, WhiteNoise};
@@ -350,6 +351,9 @@ pub trait Observer {
     /// At the start and after every IMU sample: the navigation state, and the error estimate x
     /// and covariance P (n×n row-major) as of the last propagation step or update.
     fn nav_sample(&mut self, _s: &NavState, _x: &[f64], _p: &[f64]) {}
+    /// In a replay ([`run_replay`]), instead of every `sample`: the sums over the step's samples,
+    /// before the step's propagation.
+    fn step_sums(&mut self, _sums: &StepSums<'_>) {}
     /// Every scalar measurement before the update takes it (applied, gated or not finite): its
     /// row `h`, residual z (computed − aiding, after the known GNSS terms) and 1-σ (after the
     /// configuration's σ scale), in the measurement's SI units.
@@ -398,6 +402,10 @@ impl Observer for Tee<'_> {
     fn nav_sample(&mut self, s: &NavState, x: &[f64], p: &[f64]) {
         self.0.nav_sample(s, x, p);
         self.1.nav_sample(s, x, p);
+    }
+    fn step_sums(&mut self, sums: &StepSums<'_>) {
+        self.0.step_sums(sums);
+        self.1.step_sums(sums);
     }
     fn residual(&mut self, t: f64, meas: &'static str, comp: usize, h: &[f64], z: f64, sigma: f64) {
         self.0.residual(t, meas, comp, h, z, sigma);
@@ -672,6 +680,56 @@ impl<'a> Engine<'a> {
         self.f_sum += f_c;
         self.w_sum += w_c;
         self.in_step += 1;
+    }
+
+    /// The end of a step at `t` [s] (a sample's time): propagation, the divergence check, then
+    /// every aiding epoch due, each updated, recorded and (closed loop) fed back. Returns why
+    /// the run must stop, if it must.
+    fn end_step<'t, I: Iterator<Item = AidingEpoch>>(
+        &mut self,
+        t: f64,
+        aiding: &mut std::iter::Peekable<I>,
+        mut truth: Option<&mut (dyn TruthLookup + 't)>,
+        obs: &mut dyn Observer,
+        out: &mut Records<'_>,
+    ) -> anyhow::Result<Option<String>> {
+        self.propagate(t, obs);
+        if let Some(d) = self.step_divergence(t) {
+            return Ok(Some(d));
+        }
+        while let Some(ep) = aiding.next_if(|a| a.t <= t + 1e-9) {
+            self.update(&ep, obs);
+            let rec = self.record(&ep, truth.as_deref_mut())?;
+            if let Some(d) = self.divergence(&rec) {
+                return Ok(Some(d));
+            }
+            (out.on_record)(&rec)?;
+            if out.keep {
+                out.all.push(rec);
+            } else {
+                *out.last = Some(rec);
+            }
+            if self.cfg.mode == Mode::ClosedLoop {
+                self.feedback();
+            }
+        }
+        Ok(None)
+    }
+
+    /// The run's result from its kept records and why it stopped early, if it did.
+    fn finish(self, records: Vec<Record>, diverged: Option<String>) -> FilterRun {
+        FilterRun {
+            names: self.model.names.clone(),
+            records,
+            innovations: self.innovations,
+            final_state: self.nav.state,
+            nonfinite_updates: self.nonfinite,
+            first_nonfinite_t: self.first_nonfinite_t,
+            diverged,
+            gated: self.gated,
+            gate_passed: self.gate_passed,
+            pos_ne_prior: self.pos_ne_prior,
+        }
     }
 
     /// Propagates x and P over the step that ends now: A(t) at the navigation point with the
@@ -1165,46 +1223,82 @@ pub fn run_stream(
         if !step_done && !aid_due && next.is_some() {
             continue;
         }
-        e.propagate(smp.t, obs);
-        diverged = e.step_divergence(smp.t);
-        if diverged.is_some() {
-            break;
-        }
-        while let Some(ep) = aiding.next_if(|a| a.t <= smp.t + 1e-9) {
-            e.update(&ep, obs);
-            let rec = e.record(&ep, io.truth.as_deref_mut())?;
-            diverged = e.divergence(&rec);
-            if diverged.is_some() {
-                break;
-            }
-            on_record(&rec)?;
-            if keep_records {
-                records.push(rec);
-            } else {
-                last = Some(rec);
-            }
-            if cfg.mode == Mode::ClosedLoop {
-                e.feedback();
-            }
-        }
+        let mut out = Records {
+            keep: keep_records,
+            all: &mut records,
+            last: &mut last,
+            on_record,
+        };
+        diverged = e.end_step(smp.t, &mut aiding, io.truth.as_deref_mut(), obs, &mut out)?;
         if diverged.is_some() {
             break;
         }
     }
     progress(1.0);
     records.extend(last);
-    Ok(FilterRun {
-        names: model.names.clone(),
-        records,
-        innovations: e.innovations,
-        final_state: e.nav.state,
-        nonfinite_updates: e.nonfinite,
-        first_nonfinite_t: e.first_nonfinite_t,
-        diverged,
-        gated: e.gated,
-        gate_passed: e.gate_passed,
-        pos_ne_prior: e.pos_ne_prior,
-    })
+    Ok(e.finish(records, diverged))
+}
+
+/// Where a run's records go: each to `on_record`, then kept (all, or the last only).
+struct Records<'r> {
+    keep: bool,
+    all: &'r mut Vec<Record>,
+    last: &'r mut Option<Record>,
+    on_record: &'r mut dyn FnMut(&Record) -> anyhow::Result<()>,
+}
+
+/// An open-loop filter pass from a [`NavTape`] recorded over the same data: the propagations,
+/// updates and records of [`run_stream`] from the recorded navigation, bit-identical to a full
+/// pass over the samples, without them. The observers are told every step's sums
+/// ([`Observer::step_sums`]) instead of every sample, and `nav_sample` once per step (after its
+/// first sample, as a full pass first shows them the step's x): only observers that need no
+/// more may watch a replay. The caller checks [`NavTape::fits`] (else this is an error).
+#[allow(clippy::too_many_arguments)]
+pub fn run_replay(
+    model: &Model,
+    cfg: &FilterConfig,
+    tape: &NavTape,
+    aid: &[AidingEpoch],
+    truth: Option<&mut (dyn TruthLookup + '_)>,
+    mut progress: impl FnMut(f64),
+    obs: &mut dyn Observer,
+    keep_records: bool,
+) -> anyhow::Result<FilterRun> {
+    let start = tape.start();
+    if !tape.fits(cfg, &start, aid) {
+        anyhow::bail!("internal: a navigation tape replayed for a pass it was not recorded for");
+    }
+    let mut e = Engine::new(model, cfg, start);
+    let mut aiding = aid.iter().cloned().peekable();
+    let mut truth = truth;
+    let (mut records, mut last) = (Vec::new(), None);
+    let mut diverged = None;
+    obs.nav_sample(&e.nav.state, &e.x, &e.p);
+    let steps = tape.len();
+    for k in 0..steps {
+        let (first, end, sums) = tape.step(k);
+        obs.nav_sample(first, &e.x, &e.p);
+        obs.step_sums(&sums);
+        e.nav.state = *end;
+        e.acc.set_sums(sums.regressors, sums.count);
+        (e.f_sum, e.w_sum, e.in_step) = (sums.f, sums.w, sums.count as usize);
+        if k.is_multiple_of(200) {
+            progress(k as f64 / steps.max(1) as f64);
+        }
+        let mut out = Records {
+            keep: keep_records,
+            all: &mut records,
+            last: &mut last,
+            on_record: &mut |_| Ok(()),
+        };
+        diverged = e.end_step(end.t, &mut aiding, truth.as_deref_mut(), obs, &mut out)?;
+        if diverged.is_some() {
+            break;
+        }
+    }
+    progress(1.0);
+    records.extend(last);
+    Ok(e.finish(records, diverged))
 }
 
 /// The navigation state `s` taken back (or forward) to time `t` [s] along its velocity and

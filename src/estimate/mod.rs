@@ -9,5 +9,6 @@ pub mod filter;
 pub mod imu_check;
 pub mod init;
 pub mod metrics;
+pub mod nav_tape;
 pub mod replay;
 pub mod stats;

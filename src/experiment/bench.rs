@@ -226,6 +226,7 @@ pub fn explain_job(seconds: f64) -> Result<ExplainTiming> {
         aid: &aid,
         truth: None,
         start: sim.start,
+        tape: None,
     };
     let mut pass_start = Instant::now();
     let mut passes: Vec<f64> = Vec::new();

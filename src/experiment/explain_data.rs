@@ -51,6 +51,7 @@ pub fn explain_data(inputs: &PassInputs) -> Result<ExplainData<'_>> {
         aid: &inputs.aid,
         truth: inputs.truth.as_deref(),
         start: inputs.start,
+        tape: None,
     })
 }
 

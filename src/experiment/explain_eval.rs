@@ -305,6 +305,7 @@ fn conditional_information(
         aid,
         truth: Some(&sim.truth),
         start: sim.start,
+        tape: None,
     };
     let cfg = stated_config(case, sim, &baseline);
     let terms = names

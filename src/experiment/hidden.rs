@@ -56,11 +56,14 @@ pub fn run_hidden_on(
     if case.static_aid {
         cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
     }
+    // explain's passes and the oracle's share one navigation of the data where they can
+    let slot = crate::explain::TapeSlot::new(&ImuInput::Memory(&sim.imu));
     let data = ExplainData {
         imu: ImuInput::Memory(&sim.imu),
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,
+        tape: opts.share_navigation.then_some(&slot),
     };
     let stated = |m: &Model| stated_config(case, sim, m);
     let config_for = |m: &Model| -> anyhow::Result<FilterConfig> { Ok(stated(m)) };
@@ -89,15 +92,18 @@ pub fn run_hidden_on(
             oracle_cfg.prior_sigma[i] = sigma.max(3.0 * v.abs());
         }
     }
-    let run = filter::run(
-        &oracle,
-        &oracle_cfg,
-        &sim.imu,
-        sim.start,
-        &aid,
-        Some(&sim.truth),
-        |_| {},
-    );
+    let run = match slot.replay(&oracle, &oracle_cfg, &data)? {
+        Some(run) => run,
+        None => filter::run(
+            &oracle,
+            &oracle_cfg,
+            &sim.imu,
+            sim.start,
+            &aid,
+            Some(&sim.truth),
+            |_| {},
+        ),
+    };
     let t_end = run.records.last().map(|r| r.t).unwrap_or(0.0);
     let t0 = run.records.first().map(|r| r.t).unwrap_or(0.0);
     let oracle_rms = filter::model_error_rms_arcsec(&run, 0.5 * (t0 + t_end), t_end + 1.0)

@@ -49,6 +49,7 @@ pub use selection::prior_sigma;
 pub use words::{finding_line, separation_hint, share_percent, sig3, verdict};
 
 use crate::estimate::filter::{self, AidingEpoch, FilterConfig, FilterRun};
+use crate::estimate::nav_tape::{self, NavTape, TapeRecorder};
 use crate::estimate::stats;
 use crate::io::imu::ImuData;
 use crate::io::truth::TruthRow;
@@ -99,6 +100,10 @@ pub struct ExplainOptions {
     pub stand_in_share: f64,
     /// Test the noise levels (white noise, aiding σ) when the extended model is inconsistent.
     pub noise_levels: bool,
+    /// Replay the first open-loop pass's navigation in the later passes that navigate alike
+    /// (samples in memory only; [`TapeSlot`]). Bit-identical either way: false is the
+    /// comparison that shows it.
+    pub share_navigation: bool,
     /// Test only: when a candidate passes, name a pseudo-random one of the pool instead of the
     /// best, unconfirmed (a selector naming terms at random, which the evaluation must catch).
     pub broken_selector: bool,
@@ -117,6 +122,7 @@ impl Default for ExplainOptions {
             stand_in_share: 0.2,
             noise_levels: true,
             candidate_sigma: Vec::new(),
+            share_navigation: true,
             broken_selector: false,
         }
     }
@@ -217,6 +223,103 @@ pub struct ExplainData<'a> {
     pub truth: Option<&'a [TruthRow]>,
     /// Initial navigation state.
     pub start: NavState,
+    /// Where the passes keep and find the data's navigation (None: every pass navigates).
+    pub tape: Option<&'a TapeSlot>,
+}
+
+/// The navigation of explain's first open-loop pass over samples in memory, replayed by the
+/// later passes that navigate alike ([`crate::estimate::nav_tape`]): one per explain run. A
+/// file's samples get none: explain reads a file again on every pass so that its memory does
+/// not grow with the input, and a tape would (about 49 kB per second of data).
+pub struct TapeSlot {
+    /// Which samples the tape is of (None: a file, no tape).
+    source: Option<usize>,
+    /// Set by the first open-loop pass: its tape, or None when it could not be kept.
+    tape: std::sync::OnceLock<Option<NavTape>>,
+}
+
+impl TapeSlot {
+    /// An empty slot for the samples of `imu`.
+    pub fn new(imu: &ImuInput) -> TapeSlot {
+        TapeSlot {
+            source: source_id(imu),
+            tape: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The slot's tape when it is of `data`'s samples and a pass with `cfg` over them fits it.
+    fn tape_for(&self, cfg: &FilterConfig, data: &ExplainData) -> Option<&NavTape> {
+        self.tape
+            .get()
+            .and_then(|t| t.as_ref())
+            .filter(|t| self.holds(data) && t.fits(cfg, &data.start, data.aid))
+    }
+
+    /// True when the slot is for `data`'s samples (and they are in memory).
+    fn holds(&self, data: &ExplainData) -> bool {
+        self.source.is_some() && self.source == source_id(&data.imu)
+    }
+
+    /// The pass of `model` with `cfg` over `data` (every record kept, no observer) replayed
+    /// from this slot's tape, or None when the slot holds no tape of these samples that the
+    /// pass fits (the caller then runs it in full).
+    pub fn replay(
+        &self,
+        model: &Model,
+        cfg: &FilterConfig,
+        data: &ExplainData,
+    ) -> anyhow::Result<Option<FilterRun>> {
+        let Some(tape) = self.tape_for(cfg, data) else {
+            return Ok(None);
+        };
+        let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
+        filter::run_replay(
+            model,
+            cfg,
+            tape,
+            data.aid,
+            truth
+                .as_mut()
+                .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
+            |_| {},
+            &mut filter::NoObserver,
+            true,
+        )
+        .map(Some)
+    }
+}
+
+/// What identifies samples in memory: their address (None for a file).
+fn source_id(imu: &ImuInput) -> Option<usize> {
+    match imu {
+        ImuInput::Memory(d) => Some(d.samples.as_ptr() as usize),
+        ImuInput::File { .. } => None,
+    }
+}
+
+impl<'a> ExplainData<'a> {
+    /// The same data with passes sharing their navigation through the slot given with the data,
+    /// else `slot` (`share`), or with none (not `share`).
+    fn sharing(&self, slot: &'a TapeSlot, share: bool) -> ExplainData<'a> {
+        ExplainData {
+            tape: match self.tape {
+                _ if !share => None,
+                Some(given) => Some(given),
+                None => Some(slot),
+            },
+            ..*self
+        }
+    }
+}
+
+/// About how many filter steps of `step_s` [s] a pass over `data` takes (the tape's room).
+fn expected_steps(data: &ExplainData, step_s: f64) -> usize {
+    let end = match data.imu {
+        ImuInput::Memory(d) => d.samples.last().map(|s| s.t),
+        ImuInput::File { .. } => data.aid.last().map(|a| a.t),
+    };
+    let span = end.map_or(0.0, |t| (t - data.start.t).max(0.0));
+    (span / step_s).ceil() as usize + data.aid.len() + 2
 }
 
 /// Parses a candidate list: names and prefix groups (`kaq_*,kas_y,d_*`), or `None` for the
@@ -399,32 +502,89 @@ fn run_pass_watched(
     splits.push(Split::Manoeuvre);
     splits.push(Split::Measurement);
     let mut sig = Signatures::new(model, cands, &splits);
-    let mut samples = data.imu.samples()?;
-    let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
-    let mut io = filter::StreamIo {
-        samples: &mut *samples,
-        aiding: &mut data.aid.iter().cloned(),
-        truth: truth
-            .as_mut()
-            .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
-    };
-    let run = filter::run_stream(
+    let run = filter_pass(
         model,
         cfg,
-        data.start,
-        &mut io,
+        data,
         progress,
-        &mut |_| {},
         &mut filter::Tee(&mut sig, watch),
-        &mut |_| Ok(()),
-        // every epoch's record only for the truth's checks; else the last (the estimates)
-        data.truth.is_some(),
     )?;
     run.check()
         .map_err(|e| anyhow::anyhow!("{} pass: {e}", model.name))?;
     let stats = pass_stats(model, &run, &sig.level, data.truth);
     sig.dispersion = stats.nis_mean;
     Ok(Pass { run, sig, stats })
+}
+
+/// One filter pass of `model` with `cfg` over `data`, watched by `obs`: replayed from the data's
+/// navigation tape when an earlier pass recorded one it fits, else run over the samples (the
+/// first open-loop pass over samples in memory recording the tape).
+fn filter_pass(
+    model: &Model,
+    cfg: &FilterConfig,
+    data: &ExplainData,
+    progress: &mut dyn FnMut(f64),
+    obs: &mut dyn filter::Observer,
+) -> anyhow::Result<FilterRun> {
+    let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
+    // every epoch's record only for the truth's checks; else the last (the estimates)
+    let keep_records = data.truth.is_some();
+    // the data's navigation, when an earlier open-loop pass of this run recorded it
+    let slot = data.tape.filter(|s| s.holds(data));
+    let tape = slot.and_then(|s| s.tape_for(cfg, data));
+    let run = if let Some(tape) = tape {
+        filter::run_replay(
+            model,
+            cfg,
+            tape,
+            data.aid,
+            truth
+                .as_mut()
+                .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
+            progress,
+            obs,
+            keep_records,
+        )?
+    } else {
+        // the first open-loop pass records it (when it will fit)
+        let mut rec = slot
+            .filter(|s| s.tape.get().is_none())
+            .and_then(|_| TapeRecorder::new(cfg, &data.start, data.aid))
+            .filter(|_| expected_steps(data, cfg.step_s) <= nav_tape::max_steps());
+        if let Some(r) = rec.as_mut() {
+            r.reserve(expected_steps(data, cfg.step_s));
+        }
+        let mut none = filter::NoObserver;
+        let recorder: &mut dyn filter::Observer = match rec.as_mut() {
+            Some(r) => r,
+            None => &mut none,
+        };
+        let mut samples = data.imu.samples()?;
+        let mut io = filter::StreamIo {
+            samples: &mut *samples,
+            aiding: &mut data.aid.iter().cloned(),
+            truth: truth
+                .as_mut()
+                .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
+        };
+        let run = filter::run_stream(
+            model,
+            cfg,
+            data.start,
+            &mut io,
+            progress,
+            &mut |_| {},
+            &mut filter::Tee(obs, recorder),
+            &mut |_| Ok(()),
+            keep_records,
+        )?;
+        if let (Some(s), Some(r)) = (slot, rec) {
+            // (a tape too large or of a pass that ended early: the later passes run in full)
+            let _ = s.tape.set(r.finish(&run));
+        }
+        run
+    };
+    Ok(run)
 }
 
 /// Runs explain: baseline pass, selection, re-tests, extended pass, gain. `config_for` gives the
@@ -440,6 +600,9 @@ pub fn explain(
 ) -> anyhow::Result<Explanation> {
     let given = cands;
     let cands = candidates_here(baseline, cands, data);
+    // the passes share one navigation of the data where they navigate alike
+    let slot = TapeSlot::new(&data.imu);
+    let data = &data.sharing(&slot, opts.share_navigation);
     let first = Context {
         baseline,
         data,

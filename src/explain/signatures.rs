@@ -392,6 +392,13 @@ impl Observer for Signatures {
         self.count += 1;
     }
 
+    fn step_sums(&mut self, sums: &crate::estimate::nav_tape::StepSums<'_>) {
+        self.acc.set_sums(sums.regressors, sums.count);
+        self.f_sum = sums.f;
+        self.f2_sum = sums.f2;
+        self.count = sums.count as _;
+    }
+
     fn step(&mut self, t: f64, dt: f64, np: &NavPoint, a: &[f64], pattern: &[(usize, usize)]) {
         let (n, m) = (self.n, self.cands.len());
         if !self.gnss.is_empty() {

@@ -547,6 +547,16 @@ impl RegressorAccumulator {
         }
     }
 
+    /// Sets the step's sums from `all` (every spec regressor's sum, indexed as
+    /// `common::REGRESSORS`, added in the samples' order as [`RegressorAccumulator::add`] adds)
+    /// over `count` samples: a replayed step ([`crate::estimate::nav_tape`]).
+    pub fn set_sums(&mut self, all: &[f64], count: u32) {
+        for (s, &id) in self.sum.iter_mut().zip(&self.ids) {
+            *s = all[id];
+        }
+        self.count = count;
+    }
+
     /// Starts a new step.
     pub fn reset(&mut self) {
         self.sum.iter_mut().for_each(|s| *s = 0.0);
