@@ -17,7 +17,7 @@ use crate::nav::strapdown::{NavState, Vertical};
 use nalgebra::Vector3;
 
 /// A tape larger than this [bytes] is not kept (the passes then run in full).
-pub const MAX_BYTES: usize = 64 << 20;
+pub const MAX_BYTES: usize = 256 << 20;
 
 /// Bytes a tape holds per filter step.
 pub const STEP_BYTES: usize = std::mem::size_of::<Step>() + 8 * common::REGRESSOR_COUNT;

@@ -14,6 +14,8 @@ pub(super) struct Signatures {
     pub(super) cands: Vec<usize>,
     /// Baseline instrument terms: (model index, term index).
     pub(super) base_terms: Vec<(usize, usize)>,
+    /// Per candidate, the indices into `base_terms` of the terms on its sensor axis.
+    same_axis: Vec<Vec<usize>>,
     /// Accumulator of the candidates' and baseline terms' regressors (ids below).
     pub(super) acc: RegressorAccumulator,
     pub(super) r_mean: Vec<f64>,
@@ -204,9 +206,26 @@ impl Signatures {
                     .collect()
             })
             .collect();
+        // each candidate's baseline terms on its sensor axis, in the baseline's order
+        let same_axis = cands
+            .iter()
+            .map(|&t| {
+                let info = &common::TERMS[t];
+                base_terms
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, &(_, bt))| {
+                        let bi = &common::TERMS[bt];
+                        bi.sensor == info.sensor && bi.axis == info.axis
+                    })
+                    .map(|(k, _)| k)
+                    .collect()
+            })
+            .collect();
         Signatures {
             n,
             cands: cands.to_vec(),
+            same_axis,
             base_terms,
             acc: RegressorAccumulator::new(r_ids.clone()),
             r_mean: vec![0.0; r_ids.len()],
@@ -443,12 +462,8 @@ impl Observer for Signatures {
             let rv = self.r_mean[self.cand_r[c]];
             self.reg_sum[c] += rv;
             self.cand_sq[c] += rv * rv;
-            let info = &common::TERMS[t_c];
-            for (k, &(_, bt)) in self.base_terms.iter().enumerate() {
-                let bi = &common::TERMS[bt];
-                if bi.sensor == info.sensor && bi.axis == info.axis {
-                    self.cross[c * nb + k] += rv * self.base_r[k];
-                }
+            for &k in &self.same_axis[c] {
+                self.cross[c * nb + k] += rv * self.base_r[k];
             }
             let mut col = [0.0; common::NAV_COUNT];
             common::term_column(t_c, np, rv, &mut col);
