@@ -269,21 +269,36 @@ impl TapeSlot {
         cfg: &FilterConfig,
         data: &ExplainData,
     ) -> anyhow::Result<Option<FilterRun>> {
+        self.replay_watched(model, cfg, data, &mut |_| {}, &mut filter::NoObserver, true)
+    }
+
+    /// [`TapeSlot::replay`] watched by `obs`, reporting `progress`, keeping every record or
+    /// only the last.
+    fn replay_watched(
+        &self,
+        model: &Model,
+        cfg: &FilterConfig,
+        data: &ExplainData,
+        progress: &mut dyn FnMut(f64),
+        obs: &mut dyn filter::Observer,
+        keep_records: bool,
+    ) -> anyhow::Result<Option<FilterRun>> {
         let Some(tape) = self.tape_for(cfg, data) else {
             return Ok(None);
         };
         let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
+        let truth = truth
+            .as_mut()
+            .map(|t| t as &mut dyn crate::io::truth::TruthLookup);
         filter::run_replay(
             model,
             cfg,
             tape,
             data.aid,
-            truth
-                .as_mut()
-                .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
-            |_| {},
-            &mut filter::NoObserver,
-            true,
+            truth,
+            progress,
+            obs,
+            keep_records,
         )
         .map(Some)
     }
@@ -526,64 +541,52 @@ fn filter_pass(
     progress: &mut dyn FnMut(f64),
     obs: &mut dyn filter::Observer,
 ) -> anyhow::Result<FilterRun> {
-    let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
     // every epoch's record only for the truth's checks; else the last (the estimates)
     let keep_records = data.truth.is_some();
     // the data's navigation, when an earlier open-loop pass of this run recorded it
     let slot = data.tape.filter(|s| s.holds(data));
-    let tape = slot.and_then(|s| s.tape_for(cfg, data));
-    let run = if let Some(tape) = tape {
-        filter::run_replay(
-            model,
-            cfg,
-            tape,
-            data.aid,
-            truth
-                .as_mut()
-                .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
-            progress,
-            obs,
-            keep_records,
-        )?
-    } else {
-        // the first open-loop pass records it (when it will fit)
-        let mut rec = slot
-            .filter(|s| s.tape.get().is_none())
-            .and_then(|_| TapeRecorder::new(cfg, &data.start, data.aid))
-            .filter(|_| expected_steps(data, cfg.step_s) <= nav_tape::max_steps());
-        if let Some(r) = rec.as_mut() {
-            r.reserve(expected_steps(data, cfg.step_s));
+    if let Some(s) = slot {
+        if let Some(run) = s.replay_watched(model, cfg, data, progress, obs, keep_records)? {
+            return Ok(run);
         }
-        let mut none = filter::NoObserver;
-        let recorder: &mut dyn filter::Observer = match rec.as_mut() {
-            Some(r) => r,
-            None => &mut none,
-        };
-        let mut samples = data.imu.samples()?;
-        let mut io = filter::StreamIo {
-            samples: &mut *samples,
-            aiding: &mut data.aid.iter().cloned(),
-            truth: truth
-                .as_mut()
-                .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
-        };
-        let run = filter::run_stream(
-            model,
-            cfg,
-            data.start,
-            &mut io,
-            progress,
-            &mut |_| {},
-            &mut filter::Tee(obs, recorder),
-            &mut |_| Ok(()),
-            keep_records,
-        )?;
-        if let (Some(s), Some(r)) = (slot, rec) {
-            // (a tape too large or of a pass that ended early: the later passes run in full)
-            let _ = s.tape.set(r.finish(&run));
-        }
-        run
+    }
+    // the first open-loop pass records it (when it will fit)
+    let mut rec = slot
+        .filter(|s| s.tape.get().is_none())
+        .and_then(|_| TapeRecorder::new(cfg, &data.start, data.aid))
+        .filter(|_| expected_steps(data, cfg.step_s) <= nav_tape::max_steps());
+    if let Some(r) = rec.as_mut() {
+        r.reserve(expected_steps(data, cfg.step_s));
+    }
+    let mut none = filter::NoObserver;
+    let recorder: &mut dyn filter::Observer = match rec.as_mut() {
+        Some(r) => r,
+        None => &mut none,
     };
+    let mut truth = data.truth.map(crate::io::truth::TruthSlice::new);
+    let mut samples = data.imu.samples()?;
+    let mut io = filter::StreamIo {
+        samples: &mut *samples,
+        aiding: &mut data.aid.iter().cloned(),
+        truth: truth
+            .as_mut()
+            .map(|t| t as &mut dyn crate::io::truth::TruthLookup),
+    };
+    let run = filter::run_stream(
+        model,
+        cfg,
+        data.start,
+        &mut io,
+        progress,
+        &mut |_| {},
+        &mut filter::Tee(obs, recorder),
+        &mut |_| Ok(()),
+        keep_records,
+    )?;
+    if let (Some(s), Some(r)) = (slot, rec) {
+        // (a tape too large or of a pass that ended early: the later passes run in full)
+        let _ = s.tape.set(r.finish(&run));
+    }
     Ok(run)
 }
 
