@@ -35,7 +35,7 @@ pub struct EvalArgs {
     #[arg(long, value_delimiter = ',')]
     groups: Option<Vec<String>>,
     /// Threads (default: all cores, or as many as an address-space limit `ulimit -v` leaves room
-    /// for: about 4 MB + 0.175 MB per simulated second each).
+    /// for: about 4 MB + 0.18 MB per simulated second each).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     jobs: Option<u64>,
     /// Simulated seconds per case (300 to 7200; default 600).

@@ -233,7 +233,7 @@ pub struct ExplainData<'a> {
 /// not grow with the input, and a tape would (about 49 kB per second of data).
 pub struct TapeSlot {
     /// Which samples the tape is of (None: a file, no tape).
-    source: Option<usize>,
+    source: Option<(usize, usize, u64)>,
     /// Set by the first open-loop pass: its tape, or None when it could not be kept.
     tape: std::sync::OnceLock<Option<NavTape>>,
 }
@@ -304,10 +304,15 @@ impl TapeSlot {
     }
 }
 
-/// What identifies samples in memory: their address (None for a file).
-fn source_id(imu: &ImuInput) -> Option<usize> {
+/// What identifies samples in memory: their address, number and last time's bits (None for a
+/// file).
+fn source_id(imu: &ImuInput) -> Option<(usize, usize, u64)> {
     match imu {
-        ImuInput::Memory(d) => Some(d.samples.as_ptr() as usize),
+        ImuInput::Memory(d) => Some((
+            d.samples.as_ptr() as usize,
+            d.samples.len(),
+            d.samples.last().map_or(0, |s| s.t.to_bits()),
+        )),
         ImuInput::File { .. } => None,
     }
 }
