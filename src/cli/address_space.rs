@@ -6,9 +6,9 @@
 use anyhow::{bail, Result};
 
 /// Address space one job takes for cases of `seconds` simulated seconds [bytes]: measured
-/// (2026-12-07, max RSS of `--jobs 2` less `--jobs 1`, one malloc arena) 48 MB at 300 s and 167
-/// MB at 1200 s, and 62 MB and 208 MB for the whole `--jobs 1` process: the case's samples and
-/// the navigation tape its passes share (about 0.115 and 0.049 MB per simulated second), taken
+/// (2026-12-07, max RSS of `--jobs 2` less `--jobs 1`, one malloc arena) 40 MB at 300 s and 168
+/// MB at 1200 s, and 60 MB and 203 MB for the whole `--jobs 1` process: the case's samples and
+/// the navigation tape its passes share (about 0.115 and 0.044 MB per simulated second), taken
 /// as 0.125 + 0.055 = 0.18 MB/s plus 4 MB for the thread's stack and buffers (a review's
 /// 5000-s case reached 851 MB of the 0.175 MB/s estimate's 879 before it was stopped).
 pub fn job_bytes(seconds: f64) -> f64 {

@@ -1205,6 +1205,12 @@ pub fn run_stream(
         next = io.samples.next_sample()?;
     }
     let mut diverged = None;
+    let mut out = Records {
+        keep: keep_records,
+        all: &mut records,
+        last: &mut last,
+        on_record,
+    };
     // the start state: the first row of a navigation output
     obs.nav_sample(&e.nav.state, &e.x, &e.p);
     while let Some(smp) = next {
@@ -1223,12 +1229,6 @@ pub fn run_stream(
         if !step_done && !aid_due && next.is_some() {
             continue;
         }
-        let mut out = Records {
-            keep: keep_records,
-            all: &mut records,
-            last: &mut last,
-            on_record,
-        };
         diverged = e.end_step(smp.t, &mut aiding, io.truth.as_deref_mut(), obs, &mut out)?;
         if diverged.is_some() {
             break;
@@ -1273,6 +1273,12 @@ pub fn run_replay(
     let mut truth = truth;
     let (mut records, mut last) = (Vec::new(), None);
     let mut diverged = None;
+    let mut out = Records {
+        keep: keep_records,
+        all: &mut records,
+        last: &mut last,
+        on_record: &mut |_| Ok(()),
+    };
     obs.nav_sample(&e.nav.state, &e.x, &e.p);
     let steps = tape.len();
     for k in 0..steps {
@@ -1285,12 +1291,6 @@ pub fn run_replay(
         if k.is_multiple_of(200) {
             progress(k as f64 / steps.max(1) as f64);
         }
-        let mut out = Records {
-            keep: keep_records,
-            all: &mut records,
-            last: &mut last,
-            on_record: &mut |_| Ok(()),
-        };
         diverged = e.end_step(end.t, &mut aiding, truth.as_deref_mut(), obs, &mut out)?;
         if diverged.is_some() {
             break;

@@ -57,9 +57,10 @@ pub fn run_hidden_on(
         cands.retain(|&t| common::TERMS[t].sensor != Sensor::Gnss);
     }
     // explain's passes and the oracle's share one navigation of the data where they can
-    let slot = crate::explain::TapeSlot::new(&ImuInput::Memory(&sim.imu));
+    let imu = ImuInput::Memory(&sim.imu);
+    let slot = crate::explain::TapeSlot::new(&imu);
     let data = ExplainData {
-        imu: ImuInput::Memory(&sim.imu),
+        imu,
         aid: &aid,
         truth: Some(&sim.truth),
         start: sim.start,

@@ -230,7 +230,7 @@ pub struct ExplainData<'a> {
 /// The navigation of explain's first open-loop pass over samples in memory, replayed by the
 /// later passes that navigate alike ([`crate::estimate::nav_tape`]): one per explain run. A
 /// file's samples get none: explain reads a file again on every pass so that its memory does
-/// not grow with the input, and a tape would (about 49 kB per second of data).
+/// not grow with the input, and a tape would (about 44 kB per second of data).
 pub struct TapeSlot {
     /// Which samples the tape is of (None: a file, no tape).
     source: Option<(usize, usize, u64)>,
@@ -556,12 +556,12 @@ fn filter_pass(
         }
     }
     // the first open-loop pass records it (when it will fit)
+    let steps = expected_steps(data, cfg.step_s);
     let mut rec = slot
-        .filter(|s| s.tape.get().is_none())
-        .and_then(|_| TapeRecorder::new(cfg, &data.start, data.aid))
-        .filter(|_| expected_steps(data, cfg.step_s) <= nav_tape::max_steps());
+        .filter(|s| s.tape.get().is_none() && steps <= nav_tape::max_steps())
+        .and_then(|_| TapeRecorder::new(cfg, &data.start, data.aid));
     if let Some(r) = rec.as_mut() {
-        r.reserve(expected_steps(data, cfg.step_s));
+        r.reserve(steps);
     }
     let mut none = filter::NoObserver;
     let recorder: &mut dyn filter::Observer = match rec.as_mut() {
