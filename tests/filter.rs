@@ -485,3 +485,49 @@ fn attitude_residual_matches_h_under_attitude_error_and_mounting() {
         );
     }
 }
+
+/// Aiding from the truth scatters every component about the receiver's truth with the σ it
+/// states: each of north, east and height (metres) and the three velocities has a mean square
+/// error over its σ² within the χ² band of its fix count (99.9 %). Until 2026-12-07 the heights
+/// were the truth itself under a stated σ of 0.1 m, and explain rightly named the height σ stated
+/// too large in evaluation cases meant to state every level right.
+#[test]
+fn aiding_from_the_truth_has_the_noise_it_states() {
+    let case = &reproduce::cases(true, 3)[0];
+    let sim = simulate(&Scenario::parse(&case.scenario, "static").unwrap(), |_| {});
+    let priors = Priors {
+        sigma_p: "0.1 m".into(),
+        ..Priors::default()
+    };
+    let aid = reproduce::aiding_from_truth(&sim, &priors, true, 11).unwrap();
+    let truth = &sim.gnss_truth[1..];
+    assert_eq!(aid.len(), truth.len());
+    let mut sq = [0.0; 6];
+    for (a, t) in aid.iter().zip(truth) {
+        assert_eq!(a.t, t.t);
+        let (lat, lon, h, sig) = a.pos.unwrap();
+        let rm = sinsmodel::nav::earth::radius_meridian(t.lat) + t.h;
+        let rn = sinsmodel::nav::earth::radius_transverse(t.lat) + t.h;
+        let e = [
+            (lat - t.lat) * rm / sig[0],
+            (lon - t.lon) * rn * t.lat.cos() / sig[1],
+            (h - t.h) / sig[2],
+        ];
+        let (v, sv) = a.vel.unwrap();
+        for k in 0..3 {
+            sq[k] += e[k] * e[k];
+            sq[3 + k] += ((v[k] - t.v[k]) / sv).powi(2);
+        }
+    }
+    let n = truth.len() as f64;
+    // χ²_n / n within ±3.3 √(2/n) of 1 (n in the hundreds: the normal approximation)
+    let band = 3.3 * (2.0 / n).sqrt();
+    for (k, s) in sq.iter().enumerate() {
+        let ms = s / n;
+        assert!(
+            (ms - 1.0).abs() < band,
+            "component {k} (north, east, height, v_n, v_e, v_d): mean square error {ms:.3} σ², \
+             {n} fixes"
+        );
+    }
+}

@@ -26,7 +26,7 @@ pub fn ci(v: Option<[f64; 2]>) -> String {
 pub fn headline(s: &Summary) -> Vec<String> {
     let mut v = vec![
         format!(
-            "detection {} (λ ≥ 50: {}{}), false alarms {}{} of {} null cases, wrong term {}{}, a noise level named in {} of the cases",
+            "detection {} (λ ≥ 50: {}{}), false alarms {}{} of {} null cases, wrong term {}{}, a noise level named in {} of the cases, one stated right named as a cause in {}{}",
             pct(s.detection_rate),
             pct(s.detection_rate_lambda_50),
             ci(s.detection_lambda_50_ci),
@@ -35,7 +35,9 @@ pub fn headline(s: &Summary) -> Vec<String> {
             s.null_cases,
             pct(s.wrong_term_rate),
             ci(s.wrong_term_ci),
-            pct(s.noise_finding_rate)
+            pct(s.noise_finding_rate),
+            pct(s.noise_false_alarm_rate),
+            ci(s.noise_false_alarm_ci)
         ),
         format!(
             "coefficient error median {} (90 %: {}), calibration (truth within ±2σ) {}{}, gain recovery median {}",

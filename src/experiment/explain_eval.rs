@@ -467,10 +467,16 @@ pub struct Summary {
     pub false_alarm_rate: Option<f64>,
     /// Non-null cases in which a wrong term was named.
     pub wrong_term_rate: Option<f64>,
-    /// Cases in which a noise level was named (the simulations state their noise correctly,
-    /// except the heights of the truth-formed aiding, which carry none).
+    /// Cases in which a noise level was named (as a cause or as a stand-in).
     #[serde(default)]
     pub noise_finding_rate: Option<f64>,
+    /// Cases in which a noise level the case states right was named as a cause (not as a
+    /// stand-in): a false alarm about the noise (target ≤ 0.05, as for terms).
+    #[serde(default)]
+    pub noise_false_alarm_rate: Option<f64>,
+    /// 95 % confidence interval of the same.
+    #[serde(default)]
+    pub noise_false_alarm_ci: Option<[f64; 2]>,
     /// Median of |θ̂ − θ|/|θ| over the detected cases (target ≤ 0.10).
     pub coef_error_median: Option<f64>,
     /// 90th percentile of the same.
@@ -646,6 +652,7 @@ pub fn summarize(spec: &EvalSpec, cases: &[CaseResult]) -> Summary {
         .filter(|c| c.noise_misstated.iter().all(|l| c.noise_named.contains(l)))
         .count();
     let noise_only: Vec<&&CaseResult> = noise.iter().filter(|c| c.term.is_none()).collect();
+    let noise_false = cases.iter().filter(|c| noise_false_alarm(c)).count();
     Summary {
         cases: cases.len(),
         seed: spec.seed,
@@ -658,6 +665,8 @@ pub fn summarize(spec: &EvalSpec, cases: &[CaseResult]) -> Summary {
             cases.iter().filter(|c| !c.noise_named.is_empty()).count(),
             cases.len(),
         ),
+        noise_false_alarm_rate: rate(noise_false, cases.len()),
+        noise_false_alarm_ci: wilson(noise_false, cases.len()),
         coef_error_median: quantile(&mut errs, 0.5),
         coef_error_p90: quantile(&mut errs, 0.9),
         calibration: rate(calibrated, calib.len()),
@@ -677,6 +686,13 @@ pub fn summarize(spec: &EvalSpec, cases: &[CaseResult]) -> Summary {
             noise_only.len(),
         ),
     }
+}
+
+/// Whether explain named, as a cause, a noise level that case `c` states right.
+pub fn noise_false_alarm(c: &CaseResult) -> bool {
+    c.noise_named
+        .iter()
+        .any(|l| !c.noise_stand_ins.contains(l) && !c.noise_misstated.contains(l))
 }
 
 /// Re-exported for the command line: the default explain options.
