@@ -121,21 +121,16 @@ fn demo_finds_d_and_writes_the_design_contract() {
         summary.iter().any(|l| l.starts_with("Left unexplained: ")),
         "{summary:#?}"
     );
-    // the demo's heights carry no noise: the σ stated for them scales down to the search
-    // bound, which is a bound, not an estimate with an interval
-    let h = findings
-        .iter()
-        .find(|f| f["term"] == "sigma_pos_h")
-        .expect("sigma_pos_h");
-    assert_eq!(h["scale_bound"], "at most", "{h}");
-    assert!(h["scale_interval"].is_null() && h["sigma"].is_null(), "{h}");
-    assert!(
-        h["words"]
-            .as_str()
-            .unwrap()
-            .contains("at the search bound (≤"),
-        "{h}"
-    );
+    // the demo states every noise level as simulated (its heights too, since 2026-12-07: before,
+    // they carried no noise under a stated σ and the height σ was named at its search bound):
+    // no level is named as a cause
+    for f in findings.iter().filter(|f| f["kind"] == "noise") {
+        assert!(
+            !(f["stand_in"].is_null() && f["not_attributed"].is_null()),
+            "a noise level stated right named as a cause: {}",
+            f["words"]
+        );
+    }
     let before = v["gain"]["model_error_rms_before"].as_f64().unwrap();
     let after = v["gain"]["model_error_rms_after"].as_f64().unwrap();
     assert!(after < 0.2 * before, "model error {before} -> {after}");
@@ -954,8 +949,9 @@ fn one_term_kept_out_that_explains_two_findings_unnames_both() {
 
 /// The demo with its cause (d·f²) withheld from the candidates: the white-noise scales that
 /// take up the vibration's misfit (hundreds of times the stated) are fitted but not named as a
-/// cause, the vibration split shows the accelerometer's is not one level, and the summary says
-/// the causes found leave most of the misfit unexplained.
+/// cause (the accelerometer's is beyond what a grade mis-states, and tested quiet against
+/// vibrating; until 2026-12-07, with the demo's heights noise-free, that split failed too), and
+/// the summary says the causes found leave most of the misfit unexplained.
 #[test]
 fn demo_with_its_cause_withheld_names_no_noise_level() {
     let out = tmp("demo-withheld");
@@ -977,7 +973,14 @@ fn demo_with_its_cause_withheld_names_no_noise_level() {
         .unwrap_or_else(|| panic!("no accelerometer noise fitted: {stderr}"));
     assert!(vrw["scale"].as_f64().unwrap() > 30.0, "{vrw}");
     let why = vrw["stand_in"].as_str().unwrap_or("");
-    assert!(why.contains("vibration"), "{vrw}");
+    assert!(why.contains("mis-stated within a grade"), "{vrw}");
+    let split = vrw["consistency"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["split"] == "vibration")
+        .unwrap_or_else(|| panic!("no vibration split: {vrw}"));
+    assert_eq!(split["tested"], true, "{vrw}");
     for f in findings {
         let sensor_noise =
             f["kind"] == "noise" && !f["term"].as_str().unwrap().starts_with("sigma_");
@@ -1006,9 +1009,11 @@ fn demo_with_its_cause_withheld_names_no_noise_level() {
     let by_causes = v["gain"]["misfit_unexplained_by_causes"].as_f64().unwrap();
     assert!((by_causes * 100.0 - pct).abs() < 0.1, "{by_causes} {left}");
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    // (until 2026-12-07 the demo's noise-free heights put the height σ at its search bound,
+    // which the glance table wrote as "(a bound, no estimate)"; the words of a bound are tested
+    // in explain::noise)
     assert!(
-        report.contains("Left unexplained by the causes found:")
-            && report.contains("(a bound, no estimate)"),
+        report.contains("Left unexplained by the causes found:"),
         "the report's glance table"
     );
     std::fs::remove_dir_all(&out).unwrap();

@@ -30,6 +30,7 @@ mod diagnostics;
 mod findings;
 mod noise;
 mod offset_lever;
+mod offset_order;
 mod raw_noise;
 pub mod restamp;
 mod rivals;
@@ -1004,7 +1005,7 @@ fn keep_stand_ins(
             .then(|| suggested_prior(f, ctx.opts))
             .flatten();
         f.stand_in = f.stand_in.as_ref().and(joined(
-            stand_in_reason(f, unexplained, ctx.opts),
+            stand_in_reason(f, unexplained, ctx.opts, Some(&r.offset_order)),
             rival.as_ref().map(|r| r.why.clone()),
         ));
         let info = &common::TERMS[n.term];
@@ -1554,13 +1555,14 @@ fn baseline_and_select(
         max: 0.0,
         t: f64::NAN,
     };
+    let mut order = offset_order::OffsetOrder::new(ctx.baseline);
     let base = run_pass_watched(
         ctx.baseline,
         cands,
         ctx.data,
         &cfg,
         &mut |f| progress(1, f),
-        &mut drift,
+        &mut filter::Tee(&mut drift, &mut order),
     )?;
     let linearisation = (cfg.mode == filter::Mode::OpenLoop && drift.max > MAX_OPEN_LOOP_TILT)
         .then(|| drift.words(ctx.data.start.t));
@@ -1585,7 +1587,8 @@ fn baseline_and_select(
         .filter(|t| t.testable)
         .filter_map(|t| Some((t.term.clone(), t.confounded_with.clone()?)))
         .collect();
-    let r = select_and_retest(ctx, cands.to_vec(), base, &eligible, progress)?;
+    let mut r = select_and_retest(ctx, cands.to_vec(), base, &eligible, progress)?;
+    r.offset_order = order;
     Ok(Stage {
         truth_warning,
         linearisation,
@@ -1745,6 +1748,9 @@ struct Rounds {
     /// Each pass that named a term: its round, candidates (term indices) and prior-scaled
     /// information per group, for the terms' consistency splits.
     split_passes: Vec<(usize, Vec<usize>, selection::Scaled)>,
+    /// The velocity at the baseline pass's position fixes against its mean over spans before
+    /// them: whether a time offset's first-order H describes an offset of a given size.
+    offset_order: offset_order::OffsetOrder,
 }
 
 /// The Occam term ln det(I + S J S) of terms `added` (J their information through the pass of
@@ -1824,6 +1830,7 @@ fn select_and_retest(
         implausible,
         rounds: 1,
         split_passes: Vec::new(),
+        offset_order: Default::default(),
     };
     let mut excluded: Vec<usize> = Vec::new(); // term indices in a class or added
     let mut pool_terms = cands;
@@ -2075,7 +2082,7 @@ fn complete_findings(
         if f.not_attributed.is_some() {
             f.not_attributed_because.push(Unnamed::ClassNotSeparable);
         }
-        f.stand_in = stand_in_reason(&f, unexplained, ctx.opts);
+        f.stand_in = stand_in_reason(&f, unexplained, ctx.opts, Some(&r.offset_order));
         f.suggested_prior = suggested_prior(&f, ctx.opts);
         (f.headline, f.words) =
             finding_words(&f, info, prior_sigma(t, ctx.opts) / info.display_to_si);
@@ -2107,12 +2114,23 @@ fn baseline_excess(base: &PassStats) -> Option<f64> {
 /// prior's objection z² to a value at z prior σ, or, beyond that many prior σ and with a support
 /// below [`SMALL_SHARE_SUPPORT`] z², its round removed less than `stand_in_share` of the baseline's
 /// excess misfit (`unexplained`, the share the extended model leaves, is said with it).
-fn stand_in_reason(f: &Finding, unexplained: Option<f64>, opts: &ExplainOptions) -> Option<String> {
+fn stand_in_reason(
+    f: &Finding,
+    unexplained: Option<f64>,
+    opts: &ExplainOptions,
+    order: Option<&offset_order::OffsetOrder>,
+) -> Option<String> {
     let mut why: Vec<String> = f
         .consistency
         .iter()
         .filter_map(|c| c.disagreement(&f.unit))
         .collect();
+    // an IMU–GNSS time offset its H (v·dt) does not describe on the pass's motion
+    if let (Some(order), Some(info)) = (order, common::TERMS.iter().find(|t| t.name == "dt_gnss")) {
+        if f.term == info.name {
+            why.extend(order.stand_in_words(f.estimate * info.display_to_si));
+        }
+    }
     // a value the term cannot physically have is no property of the sensor
     if let Some(info) = common::TERMS.iter().find(|t| t.name == f.term) {
         if (f.estimate * info.display_to_si).abs() > info.limit {
@@ -2424,22 +2442,22 @@ mod tests {
     fn a_finding_far_beyond_its_prior_or_explaining_little_is_a_stand_in() {
         let o = ExplainOptions::default();
         // within its prior and explaining most of the misfit: a cause
-        assert!(stand_in_reason(&finding(3.0, Some(0.9)), Some(0.05), &o).is_none());
+        assert!(stand_in_reason(&finding(3.0, Some(0.9)), Some(0.05), &o, None).is_none());
         // the baseline was consistent (no excess to share): judged by its prior alone
-        assert!(stand_in_reason(&finding(3.0, None), None, &o).is_none());
-        let far = stand_in_reason(&finding(91.0, Some(0.9)), Some(0.05), &o).unwrap();
+        assert!(stand_in_reason(&finding(3.0, None), None, &o, None).is_none());
+        let far = stand_in_reason(&finding(91.0, Some(0.9)), Some(0.05), &o, None).unwrap();
         assert!(far.contains("91.0 prior σ"), "{far}");
-        let little = stand_in_reason(&finding(6.0, Some(0.08)), Some(0.9), &o).unwrap();
+        let little = stand_in_reason(&finding(6.0, Some(0.08)), Some(0.9), &o, None).unwrap();
         assert!(
             little.contains("8.00 %") && little.contains("leaves 90.0 %"),
             "{little}"
         );
         // explaining little counts beyond 5 prior σ (within them: a small effect beside larger
         // ones, e.g. a 3.6 σ lever arm beside an asynchrony), whatever is left
-        assert!(stand_in_reason(&finding(6.0, Some(0.08)), Some(0.0), &o).is_some());
-        assert!(stand_in_reason(&finding(3.6, Some(0.08)), Some(0.0), &o).is_none());
-        assert!(stand_in_reason(&finding(0.6, Some(0.06)), Some(0.53), &o).is_none());
-        assert!(stand_in_reason(&finding(5.0, Some(0.5)), Some(0.0), &o).is_none());
+        assert!(stand_in_reason(&finding(6.0, Some(0.08)), Some(0.0), &o, None).is_some());
+        assert!(stand_in_reason(&finding(3.6, Some(0.08)), Some(0.0), &o, None).is_none());
+        assert!(stand_in_reason(&finding(0.6, Some(0.06)), Some(0.53), &o, None).is_none());
+        assert!(stand_in_reason(&finding(5.0, Some(0.5)), Some(0.0), &o, None).is_none());
     }
 
     #[test]
@@ -2448,7 +2466,7 @@ mod tests {
         let with = |z: f64, share: Option<f64>, two_dl: f64| {
             let mut f = finding(z, share);
             f.two_delta_loglik = two_dl;
-            stand_in_reason(&f, Some(0.0), &o)
+            stand_in_reason(&f, Some(0.0), &o, None)
         };
         // 19 prior σ (z² 361) on a consistent baseline, supported by 2Δℓ 15.8: a stand-in
         let w = with(19.0, None, 15.8).unwrap();
@@ -2533,7 +2551,7 @@ mod tests {
             &|k| Split::Speed(1.0).group_label(k),
             &[(-1.6, 0.02), (-0.4, 0.02)],
         )];
-        let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default()).unwrap();
+        let why = stand_in_reason(&f, Some(0.0), &ExplainOptions::default(), None).unwrap();
         assert!(why.contains("slower and the faster"), "{why}");
     }
 
@@ -2554,7 +2572,7 @@ mod tests {
         f.estimate = 40.0;
         f.sigma = 0.293;
         f.consistency = vec![holds(&[(40.1, 0.4), (39.9, 0.4)])];
-        f.stand_in = stand_in_reason(&f, Some(0.0), &o);
+        f.stand_in = stand_in_reason(&f, Some(0.0), &o, None);
         assert!(f.stand_in.is_some());
         // 3 × 40 = 120 → 200 ms, beyond the 100 ms tau_x can have: the limit
         f.suggested_prior = suggested_prior(&f, &o);
