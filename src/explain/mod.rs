@@ -1587,8 +1587,7 @@ fn baseline_and_select(
         .filter(|t| t.testable)
         .filter_map(|t| Some((t.term.clone(), t.confounded_with.clone()?)))
         .collect();
-    let mut r = select_and_retest(ctx, cands.to_vec(), base, &eligible, progress)?;
-    r.offset_order = order;
+    let r = select_and_retest(ctx, cands.to_vec(), (base, order), &eligible, progress)?;
     Ok(Stage {
         truth_warning,
         linearisation,
@@ -1810,11 +1809,12 @@ fn without_stand_ins(
 }
 
 /// Selection on the baseline pass, then rounds of adding the selected terms, re-running the
-/// filter (which must confirm them at the selection's α, see [`occam`]) and selecting again.
+/// filter (which must confirm them at the selection's α, see [`occam`]) and selecting again; the
+/// rounds keep what the baseline pass's [`offset_order::OffsetOrder`] watched.
 fn select_and_retest(
     ctx: &Context,
     cands: Vec<usize>,
-    base: Pass,
+    (base, offset_order): (Pass, offset_order::OffsetOrder),
     eligible: &[bool],
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Rounds> {
@@ -1830,7 +1830,7 @@ fn select_and_retest(
         implausible,
         rounds: 1,
         split_passes: Vec::new(),
-        offset_order: Default::default(),
+        offset_order,
     };
     let mut excluded: Vec<usize> = Vec::new(); // term indices in a class or added
     let mut pool_terms = cands;
@@ -2125,15 +2125,14 @@ fn stand_in_reason(
         .iter()
         .filter_map(|c| c.disagreement(&f.unit))
         .collect();
-    // an IMU–GNSS time offset its H (v·dt) does not describe on the pass's motion
-    if let (Some(order), Some(info)) = (order, common::TERMS.iter().find(|t| t.name == "dt_gnss")) {
-        if f.term == info.name {
-            why.extend(order.stand_in_words(f.estimate * info.display_to_si));
-        }
-    }
-    // a value the term cannot physically have is no property of the sensor
     if let Some(info) = common::TERMS.iter().find(|t| t.name == f.term) {
-        if (f.estimate * info.display_to_si).abs() > info.limit {
+        let value_si = f.estimate * info.display_to_si;
+        // an IMU–GNSS time offset its H (v·dt) does not describe on the pass's motion
+        if info.name == "dt_gnss" {
+            why.extend(order.and_then(|o| o.stand_in_words(value_si)));
+        }
+        // a value the term cannot physically have is no property of the sensor
+        if value_si.abs() > info.limit {
             let (v, l) =
                 crate::io::units::sig_distinct(f.estimate, info.limit / info.display_to_si);
             why.push(format!(

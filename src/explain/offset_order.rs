@@ -63,7 +63,6 @@ impl Observer for OffsetOrder {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn scalar_update(
         &mut self,
         _t: f64,
@@ -84,26 +83,24 @@ impl Observer for OffsetOrder {
         self.drift.0 += self.v_nav.iter().map(|x| x * x).sum::<f64>();
         self.drift.1 += self.dv_hat.iter().map(|x| x * x).sum::<f64>();
         let first = self.recent.front().map_or(t, |x| x.0);
+        let size = v.iter().map(|x| x * x).sum::<f64>();
+        // one walk back through the history, the spans shortest first: a span's mean is complete
+        // once the walk passes its start (a span the history does not reach back over is left out)
+        let (mut sum, mut n) = ([0.0; 3], 0usize);
+        let mut walk = self.recent.iter().rev().peekable();
         for (k, &span) in SPANS_S.iter().enumerate() {
-            // the history must reach back over the whole span
-            if t - first < span - 1e-9 {
-                continue;
-            }
-            let (mut sum, mut n) = ([0.0; 3], 0usize);
-            for (_, u) in self
-                .recent
-                .iter()
-                .rev()
-                .take_while(|x| x.0 >= t - span - 1e-9)
-            {
+            while let Some((_, u)) = walk.next_if(|x| x.0 >= t - span - 1e-9) {
                 for j in 0..3 {
                     sum[j] += u[j];
                 }
                 n += 1;
             }
-            let n = n.max(1) as f64;
-            self.error[k] += (0..3).map(|j| (v[j] - sum[j] / n).powi(2)).sum::<f64>();
-            self.size[k] += (0..3).map(|j| v[j] * v[j]).sum::<f64>();
+            if t - first < span - 1e-9 {
+                break;
+            }
+            let m = n.max(1) as f64;
+            self.error[k] += (0..3).map(|j| (v[j] - sum[j] / m).powi(2)).sum::<f64>();
+            self.size[k] += size;
             self.fixes[k] += 1;
         }
     }
