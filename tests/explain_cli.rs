@@ -109,6 +109,19 @@ fn demo_finds_d_and_writes_the_design_contract() {
             );
         }
     }
+    // no cause but the hidden d: the simulation has nothing else (until 2026-12-08 the demo ran
+    // open loop about a free navigation 8.4° off, whose neglected ½φ²·g read as an
+    // accelerometer delay: "Found: tau_x = -0.105 ± 0.015 ms")
+    for f in findings {
+        let cause = f["stand_in"].is_null() && f["not_attributed"].is_null();
+        let of_d = |t: &serde_json::Value| t.as_str().is_some_and(|t| t.starts_with("d_"));
+        let with_d = of_d(&f["term"]) || f["equivalent"].as_array().unwrap().iter().any(of_d);
+        assert!(!cause || with_d, "a wrong cause named: {}", f["words"]);
+    }
+    // the free navigation drifts beyond small angles: explain runs closed loop and says why
+    assert_eq!(v["closed_loop_instead"], true, "{}", v["linearisation"]);
+    let why = v["linearisation"].as_str().unwrap();
+    assert!(why.contains("ran closed loop instead"), "{why}");
     // the baseline had an excess to explain: what the extension leaves is said, named or not
     let summary: Vec<&str> = v["summary"]
         .as_array()
@@ -153,6 +166,70 @@ fn demo_finds_d_and_writes_the_design_contract() {
     assert!(ok, "{stderr}");
     std::fs::remove_dir_all(&out).unwrap();
     std::fs::remove_file(&j).unwrap();
+}
+
+/// The demo's filter follows --mode and --step (until 2026-12-08 it ran open loop at 0.01 s
+/// whatever they said); an explicit --mode open stays open loop about the drifting navigation,
+/// with the warning that names --mode closed.
+#[test]
+fn the_demo_follows_mode_and_step() {
+    let run = |extra: &[&str], name: &str| {
+        let out = tmp(name);
+        let mut args = vec![
+            "explain",
+            "--demo-seconds",
+            "120",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let (ok, _, stderr) = sinsmodel(&args);
+        assert!(ok, "{stderr}");
+        let v = json(&out.join("explain.json"));
+        std::fs::remove_dir_all(&out).unwrap();
+        v
+    };
+    let open = run(&["--mode", "open", "--step", "0.02"], "demo-open");
+    assert_eq!(open["closed_loop_instead"], false);
+    let why = open["linearisation"].as_str().unwrap();
+    assert!(why.contains("Run with --mode closed"), "{why}");
+    assert!(
+        open["data"]
+            .as_str()
+            .unwrap()
+            .contains("filter step 0.02 s"),
+        "{}",
+        open["data"]
+    );
+    let closed = run(&["--mode", "closed"], "demo-closed");
+    assert!(
+        closed["linearisation"].is_null(),
+        "{}",
+        closed["linearisation"]
+    );
+    assert_eq!(closed["closed_loop_instead"], false);
+    assert!(closed["data"]
+        .as_str()
+        .unwrap()
+        .contains("closed loop (--mode closed)"));
+    for (bad, says) in [
+        (["--mode", "sideways"], "--mode `sideways`"),
+        (["--step", "10"], "milliseconds written as seconds"),
+        (["--init-speed", "5"], "--init-speed belongs to --init auto"),
+    ] {
+        let out = tmp("demo-bad-mode");
+        let mut args = vec![
+            "explain",
+            "--demo-seconds",
+            "120",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(bad);
+        let (ok, _, stderr) = sinsmodel(&args);
+        assert!(!ok && stderr.contains(says), "{bad:?}: {stderr}");
+        assert!(!out.exists(), "{bad:?}: nothing written");
+    }
 }
 
 #[test]

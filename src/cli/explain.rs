@@ -58,6 +58,8 @@ pub fn run(args: &ExplainArgs) -> Result<()> {
     }
     let opts = ExplainOptions {
         alpha: args.alpha,
+        // an explicit --mode is kept; by default a drifting open loop runs closed instead
+        closed_loop_on_drift: args.data.mode.is_none(),
         ..ExplainOptions::default()
     };
     if let Some(j) = &args.json {
@@ -269,6 +271,14 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     let baseline = Model::parse(model_text)?;
     let cands = explain::parse_candidates(args.candidates.as_deref(), &baseline)
         .map_err(anyhow::Error::msg)?;
+    // the demo's filter follows --mode and --step (open loop and 0.01 s without them);
+    // --init-speed means something only with --init auto on data
+    let (mode, step) = (args.data.mode_given()?, args.data.step_given()?);
+    if args.data.init_speed.is_some() {
+        bail!(
+            "--init-speed belongs to --init auto on data; the embedded demo starts from its truth"
+        );
+    }
     let out = OutputDir::create(&args.out, &[], "explain")?;
     let case = reproduce::explain_demo(seconds, seed);
     eprintln!(
@@ -288,11 +298,25 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
         start: sim.start,
         tape: None,
     };
-    let config_for = |m: &Model| reproduce::config(m, &priors);
+    let config_for = |m: &Model| {
+        let mut c = reproduce::config(m, &priors)?;
+        c.mode = mode.unwrap_or(c.mode);
+        c.step_s = step.unwrap_or(c.step_s);
+        Ok(c)
+    };
     let e = run_explain(&baseline, &cands, &data, &config_for, opts)?;
     // the estimates against the hidden value, measured on this run
     eprintln!("{}", explain_notes::demo_against_truth(&e));
-    let what = explain_notes::demo_description(seconds, seed);
+    let mut what = explain_notes::demo_description(seconds, seed);
+    if mode == Some(sinsmodel::estimate::filter::Mode::ClosedLoop) {
+        what.push_str("; closed loop (--mode closed)");
+    }
+    if let Some(s) = step {
+        what.push_str(&format!(
+            "; filter step {} s (--step)",
+            sinsmodel::io::units::shown_number(s)
+        ));
+    }
     let skipped = already_in_baseline(args.candidates.as_deref(), &baseline);
     finish(args, out, &e, &what, &skipped)
 }

@@ -316,9 +316,19 @@ impl DataOptions {
         Ok(())
     }
 
+    /// `--mode` when given, checked: open or closed.
+    pub fn mode_given(&self) -> Result<Option<Mode>> {
+        match self.mode.as_deref() {
+            None => Ok(None),
+            Some("open") => Ok(Some(Mode::OpenLoop)),
+            Some("closed") => Ok(Some(Mode::ClosedLoop)),
+            Some(m) => bail!("--mode `{m}`: expected open or closed"),
+        }
+    }
+
     /// `--step` when given, checked: in (0, 1] s (a longer step integrates the error model over
     /// whole manoeuvres with a second-order Φ: milliseconds written as seconds).
-    pub(crate) fn step_given(&self) -> Result<Option<f64>> {
+    pub fn step_given(&self) -> Result<Option<f64>> {
         match self.step {
             Some(s) if !(s.is_finite() && s > 0.0 && s <= 1.0) => {
                 let hint = if s.is_finite() && s > 1.0 {
@@ -350,10 +360,8 @@ impl DataOptions {
             priors::apply_grade(model, g, &mut cfg.prior_sigma);
             cfg = cfg.with_sensor_noise(model, g.gyro_arw, g.accel_vrw);
         }
-        cfg.mode = match args.mode.as_deref() {
-            Some("open") => Mode::OpenLoop,
-            Some("closed") => Mode::ClosedLoop,
-            Some(m) => bail!("--mode `{m}`: expected open or closed"),
+        cfg.mode = match args.mode_given()? {
+            Some(m) => m,
             // a velocity reference's rows hold only to first order about the aided solution
             None if args.body_velocity.is_some() || args.attitude.is_some() => Mode::ClosedLoop,
             None => Mode::OpenLoop,

@@ -392,9 +392,13 @@ pub struct Explanation {
     pub baseline_priors_widened: bool,
     /// 2Δ log-likelihood of the baseline with the widened priors over the priors as given.
     pub baseline_priors_gain: Option<f64>,
-    /// Open loop about a navigation whose attitude error estimate passed 10°: why the linear
-    /// error model may not hold, in words (None in closed loop or within small angles).
+    /// Open loop about a navigation whose attitude error estimate passed
+    /// [`super::MAX_OPEN_LOOP_TILT`]: why the linear error model may not hold, in words (None
+    /// in closed loop or within small angles).
     pub linearisation: Option<String>,
+    /// True when explain ran closed loop because the open-loop baseline pass drifted beyond
+    /// small angles (`linearisation` says how far).
+    pub closed_loop_instead: bool,
     /// The time offset fitted to every order by re-stamping the fixes (explain run again on
     /// them); None when no offset was found or it was too small to refit.
     pub restamp: Option<super::restamp::Restamp>,

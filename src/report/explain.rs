@@ -51,6 +51,7 @@ pub fn json(e: &Explanation, extended_names: &[String], data: &str) -> Value {
         "not_testable": e.not_testable,
         "implausible": e.implausible,
         "linearisation": e.linearisation,
+        "closed_loop_instead": e.closed_loop_instead,
         "restamp": e.restamp,
         "unconfirmed": e.unconfirmed
             .iter()
