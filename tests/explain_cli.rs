@@ -121,7 +121,15 @@ fn demo_finds_d_and_writes_the_design_contract() {
     // the free navigation drifts beyond small angles: explain runs closed loop and says why
     assert_eq!(v["closed_loop_instead"], true, "{}", v["linearisation"]);
     let why = v["linearisation"].as_str().unwrap();
-    assert!(why.contains("ran closed loop instead"), "{why}");
+    assert!(
+        why.starts_with("Closed loop instead of open loop:"),
+        "{why}"
+    );
+    assert_eq!(summary_first(&v), why, "the summary opens with it");
+    assert!(v["data"]
+        .as_str()
+        .unwrap()
+        .contains("closed loop (its open-loop"));
     // the baseline had an excess to explain: what the extension leaves is said, named or not
     let summary: Vec<&str> = v["summary"]
         .as_array()
@@ -166,6 +174,11 @@ fn demo_finds_d_and_writes_the_design_contract() {
     assert!(ok, "{stderr}");
     std::fs::remove_dir_all(&out).unwrap();
     std::fs::remove_file(&j).unwrap();
+}
+
+/// The first line of explain.json's summary.
+fn summary_first(v: &serde_json::Value) -> &str {
+    v["summary"][0].as_str().unwrap()
 }
 
 /// The demo's filter follows --mode and --step (until 2026-12-08 it ran open loop at 0.01 s
@@ -216,6 +229,11 @@ fn the_demo_follows_mode_and_step() {
         (["--mode", "sideways"], "--mode `sideways`"),
         (["--step", "10"], "milliseconds written as seconds"),
         (["--init-speed", "5"], "--init-speed belongs to --init auto"),
+        (
+            ["--step", "1e-7"],
+            "shorter than the demo's IMU sample interval",
+        ),
+        (["--zupt", "0.01"], "--zupt: a data option; it needs data"),
     ] {
         let out = tmp("demo-bad-mode");
         let mut args = vec![
@@ -304,6 +322,10 @@ fn explain_refuses_bad_input_with_the_reason() {
         ),
         (
             vec!["explain", "--aid", "x.txt", "--out", o],
+            "--aid: a data option; it needs data (--imu FILE",
+        ),
+        (
+            vec!["explain", "--imu", "x.txt", "--out", o],
             "--model BASELINE is required",
         ),
         (

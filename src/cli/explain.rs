@@ -112,6 +112,13 @@ fn check_json_option(args: &ExplainArgs, j: &Path) -> Result<()> {
 /// explain on the data the options name: the candidates checked against the aiding, every
 /// option checked before the (long) run.
 fn on_data(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
+    // a data option without the data: the demo runs only when none is given
+    if args.data.imu.is_none() {
+        bail!(
+            "{}: a data option; it needs data (--imu FILE with --aid or --static-aid, and --model). Without data options explain runs its embedded demo, which cannot use it (the demo takes --model, --candidates, --alpha, --mode, --step, --demo-seconds, --demo-seed, --out, --json)",
+            args.data.given_names().join(", ")
+        );
+    }
     if args.demo_seconds.is_some() || args.demo_seed.is_some() {
         bail!("--demo-seconds and --demo-seed belong to the embedded demo, not to a run on data");
     }
@@ -279,13 +286,23 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
             "--init-speed belongs to --init auto on data; the embedded demo starts from its truth"
         );
     }
-    let out = OutputDir::create(&args.out, &[], "explain")?;
     let case = reproduce::explain_demo(seconds, seed);
+    let sc = sinsmodel::sim::scenario::Scenario::parse(&case.scenario, "embedded demo")?;
+    // (a step shorter than a sample would be the sample's: said, as on data)
+    if let Some(s) = step.filter(|&s| s < 0.999 / sc.imu_rate_hz) {
+        bail!(
+            "--step {} s is shorter than the demo's IMU sample interval ({} s at {} Hz); give --step {} or more",
+            sinsmodel::io::units::shown_number(s),
+            sinsmodel::io::units::shown_number(1.0 / sc.imu_rate_hz),
+            sinsmodel::io::units::shown_number(sc.imu_rate_hz),
+            sinsmodel::io::units::shown_number(1.0 / sc.imu_rate_hz)
+        );
+    }
+    let out = OutputDir::create(&args.out, &[], "explain")?;
     eprintln!(
         "demo: simulating {:.0} s of the paper's vibration case (6 g / 3 g at 90 Hz on N, E, D; 2 kHz) with d_x d_y d_z = 5e-5 s^2/m hidden; baseline {}",
         seconds, baseline.name
     );
-    let sc = sinsmodel::sim::scenario::Scenario::parse(&case.scenario, "embedded demo")?;
     let pb = progress::bar(1000, "simulate");
     let sim = sinsmodel::sim::simulator::simulate(&sc, |f| pb.set_position((f * 1000.0) as u64));
     pb.finish_and_clear();
@@ -339,7 +356,13 @@ fn finish(
     for (k, w) in sinsmodel::io::warnings::take().into_iter().enumerate() {
         e.summary.insert(k, format!("Warning about the data: {w}"));
     }
-    let text = explain_files::write(&out, &e, data)?;
+    // the mode explain chose is part of what the data went through
+    let data = if e.closed_loop_instead {
+        format!("{data}; closed loop (its open-loop baseline pass drifted beyond small angles)")
+    } else {
+        data.to_string()
+    };
+    let text = explain_files::write(&out, &e, &data)?;
     out.commit()?;
     if let Some(j) = &args.json {
         // checked again: the file may have been replaced while the run worked

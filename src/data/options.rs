@@ -232,25 +232,36 @@ impl DataOptions {
 
     /// True when any data option was given (explain runs its embedded demo when none is).
     pub fn any_given(&self) -> bool {
-        self.imu.is_some()
-            || self.imu_format.is_some()
-            || self.clock_offset.is_some()
-            || self.aid.is_some()
-            || self.aid_use.is_some()
-            || self.static_aid.is_some()
-            || !self.prior.is_empty()
-            || self.noise.is_some()
-            || self.truth.is_some()
-            || self.init.is_some()
-            || self.zupt.is_some()
-            || self.force
-            || self.grade.is_some()
-            || !self.outage.is_empty()
-            || self.gnss_delay.is_some()
-            || self.lever_arm.is_some()
-            || self.body_velocity.is_some()
-            || self.mounting.is_some()
-            || self.attitude.is_some()
+        !self.given_names().is_empty()
+    }
+
+    /// The data options given, as spelled on the command line (`--mode`, `--step` and
+    /// `--init-speed` are not among them: the demo reads the first two).
+    pub fn given_names(&self) -> Vec<&'static str> {
+        [
+            (self.imu.is_some(), "--imu"),
+            (self.imu_format.is_some(), "--imu-format"),
+            (self.clock_offset.is_some(), "--clock-offset"),
+            (self.aid.is_some(), "--aid"),
+            (self.aid_use.is_some(), "--aid-use"),
+            (self.static_aid.is_some(), "--static-aid"),
+            (!self.prior.is_empty(), "--prior"),
+            (self.noise.is_some(), "--noise"),
+            (self.truth.is_some(), "--truth"),
+            (self.init.is_some(), "--init"),
+            (self.zupt.is_some(), "--zupt"),
+            (self.force, "--force"),
+            (self.grade.is_some(), "--grade"),
+            (!self.outage.is_empty(), "--outage"),
+            (self.gnss_delay.is_some(), "--gnss-delay"),
+            (self.lever_arm.is_some(), "--lever-arm"),
+            (self.body_velocity.is_some(), "--body-velocity"),
+            (self.mounting.is_some(), "--mounting"),
+            (self.attitude.is_some(), "--attitude"),
+        ]
+        .into_iter()
+        .filter_map(|(given, name)| given.then_some(name))
+        .collect()
     }
 
     /// True when the aiding comes from a GNSS file (`--aid`): GNSS terms (time offset, lever

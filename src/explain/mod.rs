@@ -624,26 +624,11 @@ pub fn explain(
         config_for,
         opts,
     };
-    let mut stage = match baseline_and_select(&first, &cands, progress)? {
+    let stage = match baseline_and_select(&first, &cands, progress)? {
         Ok(stage) => stage,
-        // the free navigation left small angles: the linear error model does not hold about it,
-        // and its neglected terms would read as sensor or aiding terms; the navigation
-        // corrected at every fix keeps the errors small
         Err(drift) => {
-            let closed = |m: &Model| -> anyhow::Result<FilterConfig> {
-                let mut c = config_for(m)?;
-                c.mode = filter::Mode::ClosedLoop;
-                Ok(c)
-            };
-            let mut e = explain(baseline, given, as_given, &closed, opts, progress)?;
-            let words = format!(
-                "{} explain ran closed loop instead (the navigation corrected at every fix; --mode open keeps open loop and this warning).",
-                drift.words(data.start.t, false)
-            );
-            warn(&words);
-            e.linearisation = Some(words);
-            e.closed_loop_instead = true;
-            return Ok(e);
+            let again = (baseline, given, as_given);
+            return explain_closed_loop(again, config_for, opts, progress, &drift);
         }
     };
     // a baseline term beyond a few prior σ even with the findings added: its prior is too tight
@@ -668,21 +653,9 @@ pub fn explain(
     // the priors are hyperparameters: the baseline's innovation log-likelihood is the data's
     // evidence for them, so the run with the widened priors is kept only when its baseline
     // gains more than their BIC penalty
-    let mut prior_gain = None;
-    let mut ctx = &first;
-    if !widen.is_empty() {
-        // (a drift the widened priors bring is not followed: the run as given stays)
-        if let Ok(again) = baseline_and_select(&widened, &cands, progress)? {
-            let gain = 2.0 * (again.base_stats.loglik - stage.base_stats.loglik);
-            let n = again.r.pass.run.innovations.len().max(2) as f64;
-            prior_gain = Some(gain);
-            if gain > widen.len() as f64 * n.ln() {
-                stage = again;
-                ctx = &widened;
-            }
-        }
-    }
-    let widened_kept = std::ptr::eq(ctx, &widened);
+    let (stage, prior_gain, widened_kept) =
+        prefer_widened(&widened, &cands, stage, widen.len(), progress)?;
+    let ctx = if widened_kept { &widened } else { &first };
     let Stage {
         truth_warning,
         linearisation,
@@ -777,6 +750,60 @@ pub fn explain(
     };
     expl.summary = summary(&expl);
     Ok(expl)
+}
+
+/// The stage with `k` widened priors (`widened`) when the data's evidence for them, its
+/// baseline's innovation log-likelihood over `stage`'s, beats their BIC penalty k ln N: (the
+/// stage kept, that 2Δℓ, whether the widened one was kept). A drift the widened priors bring is
+/// not followed: the run as given stays.
+fn prefer_widened(
+    widened: &Context,
+    cands: &[usize],
+    stage: Stage,
+    k: usize,
+    progress: &mut dyn FnMut(usize, f64),
+) -> anyhow::Result<(Stage, Option<f64>, bool)> {
+    if k == 0 {
+        return Ok((stage, None, false));
+    }
+    let Ok(again) = baseline_and_select(widened, cands, progress)? else {
+        return Ok((stage, None, false));
+    };
+    let gain = 2.0 * (again.base_stats.loglik - stage.base_stats.loglik);
+    let n = again.r.pass.run.innovations.len().max(2) as f64;
+    Ok(if gain > k as f64 * n.ln() {
+        (again, Some(gain), true)
+    } else {
+        (stage, Some(gain), false)
+    })
+}
+
+/// explain run again closed loop on `(baseline, candidates, data)` after its open-loop baseline
+/// pass drifted beyond small angles (`drift`): the free navigation the errors were linearised
+/// about left the linear error model, whose neglected terms would read as sensor or aiding
+/// terms; the navigation corrected at every fix keeps the errors small. The summary opens with
+/// why.
+fn explain_closed_loop(
+    (baseline, cands, data): (&Model, &[usize], &ExplainData),
+    config_for: &dyn Fn(&Model) -> anyhow::Result<FilterConfig>,
+    opts: &ExplainOptions,
+    progress: &mut dyn FnMut(usize, f64),
+    drift: &AttitudeDrift,
+) -> anyhow::Result<Explanation> {
+    let closed = |m: &Model| -> anyhow::Result<FilterConfig> {
+        let mut c = config_for(m)?;
+        c.mode = filter::Mode::ClosedLoop;
+        Ok(c)
+    };
+    let mut e = explain(baseline, cands, data, &closed, opts, progress)?;
+    let words = format!(
+        "Closed loop instead of open loop: {} explain therefore ran closed loop (the navigation corrected at every fix); --mode open keeps open loop, with a warning.",
+        drift.words(data.start.t, false)
+    );
+    e.summary.insert(0, words.clone());
+    e.linearisation = Some(words);
+    e.closed_loop_instead = true;
+    Ok(e)
 }
 
 /// What [`judge_kept_out`] reads: the candidates here, the candidates as given, the stand-ins
@@ -1549,13 +1576,18 @@ impl filter::Observer for AttitudeDrift {
 
 impl AttitudeDrift {
     /// What the drift means for an open-loop explain, in words (times from `t0` [s]); `advise`
-    /// adds the advice to run closed loop (the run kept open loop).
+    /// opens with the drift and adds the advice to run closed loop (the run kept open loop).
     fn words(&self, t0: f64, advise: bool) -> String {
         let phi = self.max.min(std::f64::consts::PI);
         let off = 100.0 * (1.0 - phi.cos());
         let neglected_mg = 0.5 * phi * phi * 1e3;
         format!(
-            "Open loop about a drifting navigation: the free-inertial solution the error model is linearised about reaches an attitude error of {} deg (the filter's estimate, {:.1} s after the start), where the small-angle model's couplings are off by 1 − cos φ = {} % and the terms it neglects, ½φ²·g = {} mg on the specific force, can read as sensor or aiding terms.{}",
+            "{}the free-inertial solution the open-loop error model is linearised about reaches an attitude error of {} deg (the filter's estimate, {:.1} s after the start), where the small-angle model's couplings are off by 1 − cos φ = {} % and the terms it neglects, ½φ²·g = {} mg on the specific force, can read as sensor or aiding terms.{}",
+            if advise {
+                "Open loop about a drifting navigation: "
+            } else {
+                ""
+            },
             sig3(self.max.to_degrees()),
             self.t - t0,
             sig3(off),

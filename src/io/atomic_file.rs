@@ -296,8 +296,18 @@ impl OutputDir {
                 }
             }
         }
-        std::fs::create_dir_all(&parent)
-            .with_context(|| format!("cannot create {}", parent.display()))?;
+        std::fs::create_dir_all(&parent).with_context(|| {
+            let why = if parent.ancestors().any(Path::is_file) {
+                " (a file stands where a directory of that path would be)"
+            } else {
+                ""
+            };
+            format!(
+                "--out {}: cannot create its directory {}{why}",
+                target.display(),
+                parent.display()
+            )
+        })?;
         remove_stale(&parent, &name);
         let staging = sibling(target, "staging");
         if std::fs::symlink_metadata(&staging).is_ok() {
