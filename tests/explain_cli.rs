@@ -125,6 +125,8 @@ fn demo_finds_d_and_writes_the_design_contract() {
         why.starts_with("Closed loop instead of open loop:"),
         "{why}"
     );
+    // (the open-loop pass ends where the drift passes the bound: the rest would be thrown away)
+    assert!(why.contains("the open-loop pass stopped"), "{why}");
     assert_eq!(summary_first(&v), why, "the summary opens with it");
     assert!(v["data"]
         .as_str()
@@ -186,17 +188,16 @@ fn summary_first(v: &serde_json::Value) -> &str {
 /// with the warning that names --mode closed.
 #[test]
 fn the_demo_follows_mode_and_step() {
+    // the 120-s demo writing into `out`, with `extra`
+    fn demo_in(out: &Path, extra: &[&str]) -> (bool, String, String) {
+        let mut args = vec!["explain", "--demo-seconds", "120"];
+        args.extend(["--out", out.to_str().unwrap()]);
+        args.extend(extra);
+        sinsmodel(&args)
+    }
     let run = |extra: &[&str], name: &str| {
         let out = tmp(name);
-        let mut args = vec![
-            "explain",
-            "--demo-seconds",
-            "120",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let (ok, _, stderr) = sinsmodel(&args);
+        let (ok, _, stderr) = demo_in(&out, extra);
         assert!(ok, "{stderr}");
         let v = json(&out.join("explain.json"));
         std::fs::remove_dir_all(&out).unwrap();
@@ -206,6 +207,10 @@ fn the_demo_follows_mode_and_step() {
     assert_eq!(open["closed_loop_instead"], false);
     let why = open["linearisation"].as_str().unwrap();
     assert!(why.contains("Run with --mode closed"), "{why}");
+    assert!(
+        !why.contains("pass stopped"),
+        "open loop runs to the end: {why}"
+    );
     assert!(
         open["data"]
             .as_str()
@@ -236,15 +241,7 @@ fn the_demo_follows_mode_and_step() {
         (["--zupt", "0.01"], "--zupt: a data option; it needs data"),
     ] {
         let out = tmp("demo-bad-mode");
-        let mut args = vec![
-            "explain",
-            "--demo-seconds",
-            "120",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend(bad);
-        let (ok, _, stderr) = sinsmodel(&args);
+        let (ok, _, stderr) = demo_in(&out, &bad);
         assert!(!ok && stderr.contains(says), "{bad:?}: {stderr}");
         assert!(!out.exists(), "{bad:?}: nothing written");
     }

@@ -351,6 +351,12 @@ pub trait Observer {
     /// At the start and after every IMU sample: the navigation state, and the error estimate x
     /// and covariance P (n×n row-major) as of the last propagation step or update.
     fn nav_sample(&mut self, _s: &NavState, _x: &[f64], _p: &[f64]) {}
+    /// After every filter step of a pass over the samples ([`run_stream`]): why the pass should
+    /// end here, if it should (it then ends as a diverged one does, with that reason: the run
+    /// is cut short, and [`FilterRun::check`] says so). Replays are not stopped.
+    fn stop(&self) -> Option<String> {
+        None
+    }
     /// In a replay ([`run_replay`]), instead of every `sample`: the sums over the step's samples,
     /// before the step's propagation.
     fn step_sums(&mut self, _sums: &StepSums<'_>) {}
@@ -402,6 +408,9 @@ impl Observer for Tee<'_> {
     fn nav_sample(&mut self, s: &NavState, x: &[f64], p: &[f64]) {
         self.0.nav_sample(s, x, p);
         self.1.nav_sample(s, x, p);
+    }
+    fn stop(&self) -> Option<String> {
+        self.0.stop().or_else(|| self.1.stop())
     }
     fn step_sums(&mut self, sums: &StepSums<'_>) {
         self.0.step_sums(sums);
@@ -1230,6 +1239,9 @@ pub fn run_stream(
             continue;
         }
         diverged = e.end_step(smp.t, &mut aiding, io.truth.as_deref_mut(), obs, &mut out)?;
+        if diverged.is_none() {
+            diverged = obs.stop();
+        }
         if diverged.is_some() {
             break;
         }

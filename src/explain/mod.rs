@@ -1557,9 +1557,20 @@ struct AttitudeDrift {
     max: f64,
     /// Its time [s].
     t: f64,
+    /// Asks the pass to end once |φ̂| passes [`MAX_OPEN_LOOP_TILT`] (explain then runs closed
+    /// loop: the rest of the open-loop pass would be thrown away).
+    stop_beyond: bool,
 }
 
 impl filter::Observer for AttitudeDrift {
+    fn stop(&self) -> Option<String> {
+        (self.stop_beyond && self.max > MAX_OPEN_LOOP_TILT).then(|| {
+            format!(
+                "the open-loop pass stopped at an attitude error estimate of {} deg",
+                sig3(self.max.to_degrees())
+            )
+        })
+    }
     fn nav_sample(&mut self, s: &NavState, x: &[f64], _p: &[f64]) {
         let v = self
             .phi
@@ -1581,22 +1592,39 @@ impl AttitudeDrift {
         let phi = self.max.min(std::f64::consts::PI);
         let off = 100.0 * (1.0 - phi.cos());
         let neglected_mg = 0.5 * phi * phi * 1e3;
+        let (opening, advice) = if advise {
+            (
+                "Open loop about a drifting navigation: ",
+                " Run with --mode closed (the navigation corrected at every fix) before reading the findings below as properties of the sensor.",
+            )
+        } else {
+            ("", "")
+        };
+        // a stopped pass saw the drift only up to the small angles' bound
+        let (when, growing) = if self.stop_beyond {
+            (
+                format!(
+                    "passes {} deg {:.1} s after the start (the filter's estimate, {} deg there; the open-loop pass stopped)",
+                    sig3(MAX_OPEN_LOOP_TILT.to_degrees()),
+                    self.t - t0,
+                    sig3(self.max.to_degrees())
+                ),
+                ", and growing with the drift",
+            )
+        } else {
+            (
+                format!(
+                    "reaches {} deg (the filter's estimate, {:.1} s after the start)",
+                    sig3(self.max.to_degrees()),
+                    self.t - t0
+                ),
+                "",
+            )
+        };
         format!(
-            "{}the free-inertial solution the open-loop error model is linearised about reaches an attitude error of {} deg (the filter's estimate, {:.1} s after the start), where the small-angle model's couplings are off by 1 − cos φ = {} % and the terms it neglects, ½φ²·g = {} mg on the specific force, can read as sensor or aiding terms.{}",
-            if advise {
-                "Open loop about a drifting navigation: "
-            } else {
-                ""
-            },
-            sig3(self.max.to_degrees()),
-            self.t - t0,
+            "{opening}the attitude error of the free-inertial solution the open-loop error model is linearised about {when}, where the small-angle model's couplings are off by 1 − cos φ = {} % and the terms it neglects, ½φ²·g = {} mg on the specific force{growing}, can read as sensor or aiding terms.{advice}",
             sig3(off),
             sig3(neglected_mg),
-            if advise {
-                " Run with --mode closed (the navigation corrected at every fix) before reading the findings below as properties of the sensor."
-            } else {
-                ""
-            }
         )
     }
 }
@@ -1628,10 +1656,12 @@ fn baseline_and_select(
     progress: &mut dyn FnMut(usize, f64),
 ) -> anyhow::Result<Result<Stage, AttitudeDrift>> {
     let cfg = (ctx.config_for)(ctx.baseline)?;
+    let open_loop = cfg.mode == filter::Mode::OpenLoop;
     let mut drift = AttitudeDrift {
         phi: ["phi_n", "phi_e", "phi_d"].map(|n| ctx.baseline.index_of(n)),
         max: 0.0,
         t: f64::NAN,
+        stop_beyond: open_loop && ctx.opts.closed_loop_on_drift,
     };
     let mut order = offset_order::OffsetOrder::new(ctx.baseline);
     let base = run_pass_watched(
@@ -1641,11 +1671,13 @@ fn baseline_and_select(
         &cfg,
         &mut |f| progress(1, f),
         &mut filter::Tee(&mut drift, &mut order),
-    )?;
-    let drifted = cfg.mode == filter::Mode::OpenLoop && drift.max > MAX_OPEN_LOOP_TILT;
-    if drifted && ctx.opts.closed_loop_on_drift {
+    );
+    // (the pass stopped where the drift passed small angles: its run is cut short)
+    let drifted = open_loop && drift.max > MAX_OPEN_LOOP_TILT;
+    if drift.stop_beyond && drifted {
         return Ok(Err(drift));
     }
+    let base = base?;
     let linearisation = drifted.then(|| drift.words(ctx.data.start.t, true));
     let base_stats = base.stats.clone();
     let innovations_before = normalised(&base.run);
