@@ -236,7 +236,7 @@ fn the_demo_follows_mode_and_step() {
         (["--init-speed", "5"], "--init-speed belongs to --init auto"),
         (
             ["--step", "1e-7"],
-            "shorter than the demo's IMU sample interval",
+            "shorter than the demo's 2000 Hz IMU sample interval",
         ),
         (["--zupt", "0.01"], "--zupt: a data option; it needs data"),
     ] {

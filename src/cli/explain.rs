@@ -288,15 +288,12 @@ fn demo(args: &ExplainArgs, opts: &ExplainOptions) -> Result<()> {
     }
     let case = reproduce::explain_demo(seconds, seed);
     let sc = sinsmodel::sim::scenario::Scenario::parse(&case.scenario, "embedded demo")?;
-    // (a step shorter than a sample would be the sample's: said, as on data)
-    if let Some(s) = step.filter(|&s| s < 0.999 / sc.imu_rate_hz) {
-        bail!(
-            "--step {} s is shorter than the demo's IMU sample interval ({} s at {} Hz); give --step {} or more",
-            sinsmodel::io::units::shown_number(s),
-            sinsmodel::io::units::shown_number(1.0 / sc.imu_rate_hz),
-            sinsmodel::io::units::shown_number(sc.imu_rate_hz),
-            sinsmodel::io::units::shown_number(1.0 / sc.imu_rate_hz)
+    if let Some(s) = step {
+        let whose = format!(
+            "the demo's {} Hz IMU",
+            sinsmodel::io::units::shown_number(sc.imu_rate_hz)
         );
+        sinsmodel::data::DataOptions::check_step_interval(s, 1.0 / sc.imu_rate_hz, &whose)?;
     }
     let out = OutputDir::create(&args.out, &[], "explain")?;
     eprintln!(

@@ -225,12 +225,10 @@ impl DataOptions {
             None => None,
         };
         let step_s = match step {
-            Some(s) if s < 0.999 * imu.interval() => bail!(
-                "--step {s} s is shorter than the IMU's median sample interval ({:.6} s); give --step {:.6} or more",
-                imu.interval(),
-                imu.interval()
-            ),
-            Some(s) => s,
+            Some(s) => {
+                DataOptions::check_step_interval(s, imu.interval(), "the IMU's median")?;
+                s
+            }
             None => DEFAULT_STEP_S.max(imu.interval()),
         };
         let outages = self.outages(imu.first_t())?;

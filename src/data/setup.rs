@@ -326,6 +326,21 @@ impl DataOptions {
         }
     }
 
+    /// `--step` `s` [s] checked against the IMU's sample interval [s] (`whose`, e.g. "the
+    /// IMU's median"): a step shorter than a sample would be the sample's.
+    pub fn check_step_interval(s: f64, interval: f64, whose: &str) -> Result<()> {
+        if s < 0.999 * interval {
+            // (to the microsecond, as a step is given)
+            let us = format!("{interval:.6}");
+            let us = us.trim_end_matches('0').trim_end_matches('.');
+            bail!(
+                "--step {} s is shorter than {whose} sample interval ({us} s); give --step {us} or more",
+                crate::io::units::shown_number(s)
+            );
+        }
+        Ok(())
+    }
+
     /// `--step` when given, checked: in (0, 1] s (a longer step integrates the error model over
     /// whole manoeuvres with a second-order Φ: milliseconds written as seconds).
     pub fn step_given(&self) -> Result<Option<f64>> {

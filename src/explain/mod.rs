@@ -798,7 +798,7 @@ fn explain_closed_loop(
     let mut e = explain(baseline, cands, data, &closed, opts, progress)?;
     let words = format!(
         "Closed loop instead of open loop: {} explain therefore ran closed loop (the navigation corrected at every fix); --mode open keeps open loop, with a warning.",
-        drift.words(data.start.t, false)
+        drift.words(data.start.t)
     );
     e.summary.insert(0, words.clone());
     e.linearisation = Some(words);
@@ -1586,19 +1586,20 @@ impl filter::Observer for AttitudeDrift {
 }
 
 impl AttitudeDrift {
-    /// What the drift means for an open-loop explain, in words (times from `t0` [s]); `advise`
-    /// opens with the drift and adds the advice to run closed loop (the run kept open loop).
-    fn words(&self, t0: f64, advise: bool) -> String {
+    /// What the drift means for an open-loop explain, in words (times from `t0` [s]): for a
+    /// pass stopped at the bound (explain then runs closed loop), where it passed it; for one
+    /// that ran on in open loop, how far it drifted, with the advice to run closed loop.
+    fn words(&self, t0: f64) -> String {
         let phi = self.max.min(std::f64::consts::PI);
         let off = 100.0 * (1.0 - phi.cos());
         let neglected_mg = 0.5 * phi * phi * 1e3;
-        let (opening, advice) = if advise {
+        let (opening, advice) = if self.stop_beyond {
+            ("", "")
+        } else {
             (
                 "Open loop about a drifting navigation: ",
                 " Run with --mode closed (the navigation corrected at every fix) before reading the findings below as properties of the sensor.",
             )
-        } else {
-            ("", "")
         };
         // a stopped pass saw the drift only up to the small angles' bound
         let (when, growing) = if self.stop_beyond {
@@ -1678,7 +1679,7 @@ fn baseline_and_select(
         return Ok(Err(drift));
     }
     let base = base?;
-    let linearisation = drifted.then(|| drift.words(ctx.data.start.t, true));
+    let linearisation = drifted.then(|| drift.words(ctx.data.start.t));
     let base_stats = base.stats.clone();
     let innovations_before = normalised(&base.run);
     // a truth not of this run's attitude (or time) makes every model-error figure meaningless
