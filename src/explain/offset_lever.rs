@@ -114,7 +114,23 @@ pub fn offset_or_lever_arm(
         return Ok(());
     };
     moved_with_the_offset(e, &fitted, &how, &on);
-    super::not_named(&mut e.findings[k], super::Unnamed::OffsetOrLeverArm, how);
+    // the offset and the lever arm are one class the data do not tell apart
+    let f = &mut e.findings[k];
+    if let Some((x, s)) = fitted(common::TERMS[lx].name) {
+        let info = &common::TERMS[lx];
+        if !f.equivalent.iter().any(|q| q == info.name) {
+            f.equivalent.push(info.name.to_string());
+            f.equivalent_estimates
+                .push(super::findings::EquivalentTerm {
+                    term: info.name.to_string(),
+                    estimate: x / info.display_to_si,
+                    sigma: s / info.display_to_si,
+                    unit: info.display.to_string(),
+                    prior_sigmas: (x / super::prior_sigma(lx, opts)).abs(),
+                });
+        }
+    }
+    super::not_named(f, super::Unnamed::OffsetOrLeverArm, how);
     unattributed(e, &ctx_s, &widened, progress)
 }
 

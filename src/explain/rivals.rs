@@ -4,7 +4,7 @@
 //! finding may stand in for it and says so.
 
 use super::diagnostics::loglik_of;
-use super::findings::Finding;
+use super::findings::{EquivalentTerm, Finding};
 use super::restamp;
 use super::words::{finding_words, sig3};
 use super::{model_with, prior_sigma, run_pass, Context, Rounds};
@@ -82,8 +82,7 @@ pub(super) fn offset_stand_ins(
         let Some(rival) = rival else {
             continue;
         };
-        f.stand_in = Some(rival.why.clone());
-        f.offset_in_place = rival.offset;
+        rival.put_on(f);
         f.suggested_prior = None;
         let info = &common::TERMS[t];
         (f.headline, f.words) =
@@ -136,6 +135,7 @@ pub(super) fn withheld_rivals(
                     why,
                     offset: None,
                     beside: Vec::new(),
+                    tie: None,
                 })
             };
             if rival.is_some() {
@@ -146,8 +146,7 @@ pub(super) fn withheld_rivals(
     }
     for (f, rival) in judged.iter_mut().zip(&out) {
         if let Some(rival) = rival {
-            f.stand_in = super::joined(f.stand_in.take(), Some(rival.why.clone()));
-            f.offset_in_place = rival.offset;
+            rival.put_on(f);
         }
     }
     Ok(out)
@@ -253,6 +252,20 @@ fn offset_in_place(
         let withheld = !cands.contains(&w);
         let unit = 1.0 / rival.display_to_si;
         let words = rival_words(rival, withheld, (o.offset_s, o.sigma_s), &how, &fit);
+        // a candidate offset alone in a GNSS term's place that fits as well, but not better
+        // beyond chance (not even in a few blocks, where a vehicle's speed changes): the two
+        // are one class, neither probably the other's stand-in
+        let tie = (!withheld
+            && with.is_empty()
+            && common::TERMS[t].sensor.enters_h()
+            && !fit.better_in_few_blocks())
+        .then(|| EquivalentTerm {
+            term: rival.name.to_string(),
+            estimate: o.offset_s * unit,
+            sigma: o.sigma_s * unit,
+            unit: rival.display.to_string(),
+            prior_sigmas: (o.offset_s / prior_sigma(w, ctx.opts)).abs(),
+        });
         if let Some(why) = words {
             let beside = keep
                 .iter()
@@ -265,6 +278,7 @@ fn offset_in_place(
                 why,
                 offset: Some([o.offset_s * unit, o.sigma_s * unit]),
                 beside,
+                tie,
             }));
         }
     }
@@ -281,6 +295,31 @@ pub(super) struct Rival {
     /// The rounds' other terms as fitted with the rival in the finding's place: (term, value,
     /// σ; SI).
     pub(super) beside: Vec<(usize, f64, f64)>,
+    /// A candidate time offset alone in a GNSS finding's place that fits as well but not
+    /// better beyond chance: its value there (display unit). The finding and the offset are
+    /// then one class the data do not tell apart, not a stand-in and what it stands for.
+    pub(super) tie: Option<EquivalentTerm>,
+}
+
+impl Rival {
+    /// Puts the rival on finding `f`: a tie makes `f` a class with the offset (not attributed,
+    /// the offset its equivalent), else `f` stands in for the rival.
+    fn put_on(&self, f: &mut Finding) {
+        f.offset_in_place = self.offset;
+        match &self.tie {
+            Some(eq) if f.stand_in.is_none() => {
+                if !f.equivalent.contains(&eq.term) {
+                    f.equivalent.push(eq.term.clone());
+                    f.equivalent_estimates.push(eq.clone());
+                }
+                f.separate_by.push(
+                    "a known lever arm (--lever-arm) or offset (--gnss-delay), or a run with more changes of speed".into(),
+                );
+                super::not_named(f, super::Unnamed::OffsetOrLeverArm, self.why.clone());
+            }
+            _ => f.stand_in = super::joined(f.stand_in.take(), Some(self.why.clone())),
+        }
+    }
 }
 
 /// Each noise level among `findings` named a cause while a finding stands in for a time offset
