@@ -648,7 +648,7 @@ fn measured_data() {
     for ch in ["north velocity", "east velocity", "north position"] {
         let lines: Vec<&str> = stderr
             .lines()
-            .filter(|l| l.starts_with(&format!("{ch} innovations")))
+            .filter(|l| l.starts_with("Baseline ") && l.contains(&format!(": {ch} innovations")))
             .collect();
         assert_eq!(lines.len(), 1, "{ch}: {lines:#?}");
         assert!(

@@ -939,11 +939,17 @@ fn companions_move(
         let k = 1.0 / common::TERMS[t].display_to_si;
         Some((last.x[i] * k, last.sigma[i] * k))
     };
-    let beside: Vec<String> = taken
+    // (a companion the data leave at its prior σ moves nothing: named apart, without a value)
+    let mut at_prior = Vec::new();
+    let mut beside: Vec<String> = taken
         .iter()
         .filter_map(|&t| {
             let info = &common::TERMS[t];
             let (x, sd) = value(info.name)?;
+            if sd >= 0.9 * prior_sigma(t, ctx.opts) / info.display_to_si {
+                at_prior.push(info.name);
+                return None;
+            }
             Some(format!(
                 "{} {} ± {} {}",
                 info.name,
@@ -953,6 +959,13 @@ fn companions_move(
             ))
         })
         .collect();
+    if !at_prior.is_empty() {
+        beside.push(format!(
+            "with {} left at {} prior σ",
+            at_prior.join(" and "),
+            if at_prior.len() == 1 { "its" } else { "their" }
+        ));
+    }
     for k in causes {
         let f = &mut findings[k];
         let Some((x, sd)) = value(&f.term) else {

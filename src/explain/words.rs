@@ -509,6 +509,7 @@ fn correlated_p(ch: &super::diagnostics::ChannelStats, channels: usize) -> Optio
 /// or too small), or that it is consistent; times from `t_ref` [s].
 fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>) {
     let mut consistent = true;
+    let first = out.len();
     for ch in &e.baseline.channels {
         let too_large = ch.nis_mean > ch.nis_band[1] * 1.5;
         let correlated = correlated_p(ch, e.baseline.channels.len());
@@ -592,6 +593,10 @@ fn baseline_consistency_words(e: &Explanation, t_ref: f64, out: &mut Vec<String>
                 sig3(ch.nis_mean)
             ));
         }
+    }
+    // (each line is about the baseline's innovations, not the extended model's)
+    for line in &mut out[first..] {
+        *line = format!("Baseline {}: {line}", e.baseline_model);
     }
     if consistent {
         out.push(format!(

@@ -650,8 +650,18 @@ fn findings_section(e: &Explanation, s: &mut String) {
             Some(cmp) => format!("{cmp} {}", num(f.estimate)),
             None => format!("{} ± {}", num(f.estimate), num(f.sigma)),
         };
+        // the llr when selected is conditional on the terms selected before it; section 2's
+        // is the candidate's alone in the baseline pass
+        let alone = e
+            .candidates
+            .iter()
+            .find(|c| c.term == f.term)
+            .map(|c| c.llr)
+            .filter(|a| format!("{a:.1}") != format!("{:.1}", f.llr))
+            .map(|a| format!(" beside the terms selected before it; {a:.1} alone, section 2"))
+            .unwrap_or_default();
         s.push_str(&format!(
-            "- **{}** = {}: {verdict}{share} (llr {:.1}, p {}; round {}).\n\n  <details><summary>In full</summary>{}</details>\n\n",
+            "- **{}** = {}: {verdict}{share} (llr {:.1}{alone}; p {}; round {}).\n\n  <details><summary>In full</summary>{}</details>\n\n",
             f.term,
             notation(&format!("{value} {}", f.unit)),
             f.llr,
