@@ -880,9 +880,12 @@ const MAX_COMPANIONS: usize = 6;
 
 /// Candidates significant alone that the causes take up (not named, not in a class, not
 /// implausible, not unconfirmed) are fitted beside them in one more pass: a cause of the same
-/// sensor whose value then moves by more than 3 of its σ is "not attributed": the data do not fix
-/// its value on this excitation (a delay on z fits what a common delay on x, y and z does on a
-/// turntable that never separates them), and its words say so with both values.
+/// sensor whose value then moves by more than 3 of its σ, where the companions fit the data
+/// better (2Δℓ > 0: the filters' marginal log-likelihoods, priors included, favour them), is
+/// "not attributed": the data do not fix its value on this excitation (a delay on z fits what a
+/// common delay on x, y and z does on a turntable that never separates them), and its words say
+/// so with both values. Where they do not fit better, the value stands and the words say how
+/// far they moved it.
 fn companions_move(
     ctx: &Context,
     r: &Rounds,
@@ -973,6 +976,20 @@ fn companions_move(
         };
         let moved = (x - f.estimate).abs() / f.sigma;
         if !(f.sigma > 0.0 && moved > 3.0) {
+            continue;
+        }
+        if gain <= 0.0 {
+            // the data's evidence (the filters' marginal log-likelihoods) is against the
+            // companions: the freedom they add moves the value, the data do not
+            f.words.push_str(&format!(
+                ". Fitted beside the candidates significant alone that it takes up ({}), it moves to {} ± {} {}, {} of its σ, but they do not fit the data better (2Δℓ {}): its value stands",
+                beside.join(", "),
+                sig3(x),
+                sig3(sd),
+                f.unit,
+                sig3(moved),
+                sig3(gain)
+            ));
             continue;
         }
         let why = format!(
