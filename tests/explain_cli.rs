@@ -255,6 +255,11 @@ fn the_demo_follows_mode_and_step() {
             "shorter than the demo's 2000 Hz IMU sample interval",
         ),
         (["--zupt", "0.01"], "--zupt: a data option; it needs data"),
+        // (1.4 samples: until 2026-12-08 it silently ran every 2 samples)
+        (
+            ["--step", "0.0007"],
+            "would step every 2 samples (0.001 s, 43 % longer than asked); give --step 0.0005 or 0.001",
+        ),
     ] {
         let out = tmp("demo-bad-mode");
         let (ok, _, stderr) = demo_in(&out, &bad);

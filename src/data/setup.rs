@@ -327,15 +327,34 @@ impl DataOptions {
     }
 
     /// `--step` `s` [s] checked against the IMU's sample interval [s] (`whose`, e.g. "the
-    /// IMU's median"): a step shorter than a sample would be the sample's.
+    /// IMU's median"): a step shorter than a sample would be the sample's, and one far from a
+    /// whole number of samples would silently be the next whole number (the filter ends a step
+    /// at the first sample at least `s` after its start: `--step 0.007` on 200 Hz ran 0.01 s).
     pub fn check_step_interval(s: f64, interval: f64, whose: &str) -> Result<()> {
+        // (to the microsecond, as a step is given)
+        let shown = |x: f64| {
+            let t = format!("{x:.6}");
+            t.trim_end_matches('0').trim_end_matches('.').to_string()
+        };
+        let us = shown(interval);
         if s < 0.999 * interval {
-            // (to the microsecond, as a step is given)
-            let us = format!("{interval:.6}");
-            let us = us.trim_end_matches('0').trim_end_matches('.');
             bail!(
                 "--step {} s is shorter than {whose} sample interval ({us} s); give --step {us} or more",
                 crate::io::units::shown_number(s)
+            );
+        }
+        let k = ((s - 1e-9) / interval).ceil().max(1.0);
+        let run = k * interval;
+        if run > 1.1 * s {
+            bail!(
+                "--step {} s is {} of {whose} sample intervals ({us} s): the filter ends a step at a whole sample, so it would step every {} samples ({} s, {} % longer than asked); give --step {} or {}",
+                crate::io::units::shown_number(s),
+                crate::io::units::shown_number((s / interval * 100.0).round() / 100.0),
+                k,
+                shown(run),
+                ((run / s - 1.0) * 100.0).round(),
+                shown((k - 1.0).max(1.0) * interval),
+                shown(run)
             );
         }
         Ok(())

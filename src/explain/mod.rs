@@ -978,27 +978,27 @@ fn companions_move(
         if !(f.sigma > 0.0 && moved > 3.0) {
             continue;
         }
+        let (with, to) = (
+            beside.join(", "),
+            format!(
+                "{} ± {} {}, {} of its σ",
+                sig3(x),
+                sig3(sd),
+                f.unit,
+                sig3(moved)
+            ),
+        );
         if gain <= 0.0 {
             // the data's evidence (the filters' marginal log-likelihoods) is against the
             // companions: the freedom they add moves the value, the data do not
             f.words.push_str(&format!(
-                ". Fitted beside the candidates significant alone that it takes up ({}), it moves to {} ± {} {}, {} of its σ, but they do not fit the data better (2Δℓ {}): its value stands",
-                beside.join(", "),
-                sig3(x),
-                sig3(sd),
-                f.unit,
-                sig3(moved),
+                ". Fitted beside the candidates significant alone that it takes up ({with}), it moves to {to}, but they do not fit the data better (2Δℓ {}): its value stands",
                 sig3(gain)
             ));
             continue;
         }
         let why = format!(
-            "the candidates significant alone that it takes up, fitted beside it ({}), move it to {} ± {} {}, {} of its σ from this value (the fit changes by 2Δℓ {}): the data do not fix its value on this excitation; one that excites these terms apart decides",
-            beside.join(", "),
-            sig3(x),
-            sig3(sd),
-            f.unit,
-            sig3(moved),
+            "the candidates significant alone that it takes up, fitted beside it ({with}), move it to {to} from this value (the fit changes by 2Δℓ {}): the data do not fix its value on this excitation; one that excites these terms apart decides",
             sig3(gain)
         );
         not_named(f, Unnamed::ValueMoves, why);
@@ -1635,7 +1635,7 @@ impl AttitudeDrift {
         let (when, growing) = if self.stop_beyond {
             (
                 format!(
-                    "passes {} deg {:.1} s after the start (the filter's estimate, {} deg there; the open-loop pass stopped)",
+                    "passes {} deg, the small angles' bound (½φ²·g = 1 mg), {:.1} s after the start (the filter's estimate, {} deg there; the open-loop pass stopped)",
                     sig3(MAX_OPEN_LOOP_TILT.to_degrees()),
                     self.t - t0,
                     sig3(self.max.to_degrees())

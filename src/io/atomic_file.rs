@@ -319,8 +319,15 @@ impl OutputDir {
         }
         // registered first: a signal at any moment from here removes it
         register(&staging);
+        // (the staging directory is the run's own; the user gave --out)
         let made = std::fs::create_dir(&staging)
-            .with_context(|| format!("cannot create {}", staging.display()))
+            .with_context(|| {
+                format!(
+                    "--out {}: cannot write in {} (a run writes a directory beside its output there first, then renames it)",
+                    target.display(),
+                    parent.display()
+                )
+            })
             .and_then(|_| write_text(&staging.join(STAGING_MARKER), STAGING_TEXT));
         if let Err(e) = made {
             let _ = std::fs::remove_dir_all(&staging);

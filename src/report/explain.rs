@@ -171,12 +171,29 @@ pub fn extended_preset(e: &Explanation) -> Option<String> {
         };
         s.push_str(&line);
     }
-    if e.findings
+    // whether the extended pass explain reports held the terms left out above (it is run again
+    // without them when a rule un-named one after the rounds)
+    let parts: Vec<&str> = e.extended_model.split('+').collect();
+    let left_out: Vec<&str> = e
+        .findings
         .iter()
-        .any(|f| !f.is_cause() || f.kind == "noise")
-    {
+        .filter(|f| !f.is_cause() && f.kind != "noise")
+        .map(|f| f.term.as_str())
+        .collect();
+    let held: Vec<&str> = left_out
+        .iter()
+        .copied()
+        .filter(|t| parts.contains(t))
+        .collect();
+    if !held.is_empty() {
         s.push_str(&format!(
-            "# the extended pass explain reports ({}) also held the lines above.\n",
+            "# the extended pass explain reports ({}) also held {}, left out here.\n",
+            e.extended_model,
+            held.join(", ")
+        ));
+    } else if !left_out.is_empty() {
+        s.push_str(&format!(
+            "# the extended pass explain reports ({}) holds none of the terms left out above: it was run again without them.\n",
             e.extended_model
         ));
     }
@@ -730,9 +747,10 @@ fn notes_section(s: &mut String) {
          misfit; its words say which, and it is no property of the sensor: it probably stands in \
          for something the candidates lack. **Fitted, not attributed** is significant, but the \
          data do not say its term is the cause: its class holds members whose values differ by \
-         an order of magnitude or more, its value moves when a candidate is fitted beside it, or \
-         a term the candidates withhold fits the data as well; its words say which, and none is \
-         named.\n",
+         an order of magnitude or more, its value moves when a candidate is fitted beside it and \
+         the candidate fits the data better, its value in the extended filter lies within 2σ of \
+         zero, or a term the candidates withhold fits the data as well; its words say which, and \
+         none is named.\n",
     );
 }
 
