@@ -118,7 +118,28 @@ fn demo_finds_d_and_writes_the_design_contract() {
             "{axis} not named a cause: {}",
             f["words"]
         );
+        // d_z's z vibration lies in one half: no split tests it, and its words say so
+        let untested = f["consistency"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|c| c["tested"] == false);
+        assert_eq!(
+            untested,
+            f["words"]
+                .as_str()
+                .unwrap()
+                .contains("Whether it holds across the data is not known"),
+            "{axis}: {}",
+            f["words"]
+        );
     }
+    let d_z = findings.iter().find(|f| f["term"] == "d_z").unwrap();
+    assert!(
+        d_z["words"].as_str().unwrap().contains("is not known"),
+        "{}",
+        d_z["words"]
+    );
     // no cause but the hidden d: the simulation has nothing else (until 2026-12-08 the demo ran
     // open loop about a free navigation 8.4° off, whose neglected ½φ²·g read as an
     // accelerometer delay: "Found: tau_x = -0.105 ± 0.015 ms")

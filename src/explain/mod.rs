@@ -748,6 +748,7 @@ pub fn explain(
         model_error_before,
         model_error_after: model_error_series(&last_pass.run),
     };
+    say_untested(&mut expl.findings);
     expl.summary = summary(&expl);
     Ok(expl)
 }
@@ -1023,6 +1024,25 @@ fn candidates_here(baseline: &Model, cands: &[usize], data: &ExplainData) -> Vec
             _ => true,
         })
         .collect()
+}
+
+/// A term cause none of whose consistency splits could be tested (each leaves its information
+/// in one group: a vibration on one axis in one half of the run) keeps its name, but its words
+/// say that whether it holds across the data is not known (the demo's d_z: its z vibration lies
+/// in the second half).
+fn say_untested(findings: &mut [Finding]) {
+    for f in findings.iter_mut().filter(|f| {
+        f.is_cause()
+            && f.kind != "noise"
+            && !f.consistency.is_empty()
+            && f.consistency.iter().all(|c| !c.tested)
+    }) {
+        let splits: Vec<&str> = f.consistency.iter().map(|c| c.split.as_str()).collect();
+        f.words.push_str(&format!(
+            ". Whether it holds across the data is not known: no split of these data ({}) leaves information on it in two groups",
+            splits.join(", ")
+        ));
+    }
 }
 
 /// A term cause whose value the extended filter leaves within 2σ of zero is no longer named:
