@@ -827,6 +827,10 @@ fn gnss_terms_need_gnss_aiding_and_plausible_known_values() {
         (&["--lever-arm", "600,0,0"][..], "mm read as m?"),
         (&["--gnss-delay", "0.179 ms"][..], "below 1 ms"),
         (&["--lever-arm", "NaN,0,0"][..], "is not a number"),
+        (
+            &["--lever-arm", "0,0,1e400"][..],
+            "beyond the largest number",
+        ),
         (&["--lever-arm", "0.3 furlongs,0,0"][..], "expected metres"),
     ] {
         let (ok, _, stderr) = drive(extra);

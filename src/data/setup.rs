@@ -112,7 +112,7 @@ impl DataOptions {
                     })?,
                 };
                 if !v.is_finite() {
-                    bail!("--lever-arm: {axis} = `{item}` is not a number");
+                    bail!("--lever-arm: {axis} = `{item}` is {}", finite_words(v));
                 }
                 if v.abs() > 10.0 {
                     bail!(
@@ -770,7 +770,7 @@ fn known_mounting(m: &[String]) -> Result<Vec<(usize, f64)>> {
         };
         let k = term(name, "--mounting")?;
         if !v.is_finite() {
-            bail!("--mounting: {name} = `{item}` is not a number");
+            bail!("--mounting: {name} = `{item}` is {}", finite_words(v));
         }
         if let Some(why) = common::TERMS[k].beyond_limit(v) {
             bail!("--mounting: {name} = `{item}`: {why}; a mounting this large is no small misalignment: rotate the reference's velocities into the IMU's axes first");
@@ -786,4 +786,14 @@ fn term(name: &str, option: &str) -> Result<usize> {
         .iter()
         .position(|t| t.name == name)
         .with_context(|| format!("{option}: the spec has no term `{name}` (model-spec/terms.toml)"))
+}
+
+/// Why a value that is not finite is refused: NaN is no number, ±∞ (or a literal beyond
+/// 1.8e308, which parses to ∞) no finite value.
+fn finite_words(v: f64) -> &'static str {
+    if v.is_nan() {
+        "not a number"
+    } else {
+        "beyond the largest number (±1.8e308) or infinite"
+    }
 }

@@ -1236,6 +1236,15 @@ fn noise_finding(
             sig3(f.two_delta_loglik)
         ),
     };
+    // far below the σ the fixes state: the likely causes, as a unit check would name them
+    let words = match f.level {
+        Level::Sigma(_) if f.scale <= 0.01 => format!(
+            "{words}; the {} scatter by a hundredth or less of the σ they state, as a σ written in mm but read as m would, or {} that carry no noise (smoothed or simulated)",
+            if states.contains("reference") { "rows" } else { "fixes" },
+            if states.contains("reference") { "rows" } else { "fixes" },
+        ),
+        _ => words,
+    };
     let headline = words.clone();
     let words = match misfit_share {
         Some(s) => format!(
@@ -1454,11 +1463,18 @@ mod tests {
         );
         assert!(f.scale_interval.is_none() && f.sigma.is_nan());
         assert_eq!(f.scale_bound, Some("at most"));
+        // a hundredth or less of the stated σ: the likely causes are named
+        assert!(
+            f.words.contains("as a σ written in mm but read as m would"),
+            "{}",
+            f.words
+        );
         let mut g = fit(1);
         g.level = Level::GyroArw;
         g.scale = 64.0;
         let f = noise_finding(&g, &stated, None, 900.0);
         assert!(f.words.contains("at the search bound (≥"), "{}", f.words);
+        assert!(!f.words.contains("read as m"), "{}", f.words);
         assert_eq!(f.scale_bound, Some("at least"));
         // bracketed: an estimate with its interval
         let f = noise_finding(&fit(0), &stated, None, 900.0);
