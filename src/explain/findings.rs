@@ -156,6 +156,14 @@ impl Finding {
     pub fn unnamed_because(&self, why: Unnamed) -> bool {
         self.not_attributed_because.contains(&why)
     }
+
+    /// Puts `eq` in the finding's class, unless it is there already.
+    pub(super) fn add_equivalent(&mut self, eq: EquivalentTerm) {
+        if !self.equivalent.contains(&eq.term) {
+            self.equivalent.push(eq.term.clone());
+            self.equivalent_estimates.push(eq);
+        }
+    }
 }
 
 /// Why a fitted finding is not named as a cause: the rule that un-named it.
@@ -321,6 +329,21 @@ pub struct EquivalentTerm {
     pub unit: String,
     /// The estimate in units of the spec's prior σ (how plausible it is a priori).
     pub prior_sigmas: f64,
+}
+
+impl EquivalentTerm {
+    /// Spec term `t` with the value it would need and its σ (display unit) and its prior-σ
+    /// count.
+    pub(super) fn of(t: usize, (estimate, sigma, prior_sigmas): (f64, f64, f64)) -> EquivalentTerm {
+        let info = &crate::model::generated::common::TERMS[t];
+        EquivalentTerm {
+            term: info.name.to_string(),
+            estimate,
+            sigma,
+            unit: info.display.to_string(),
+            prior_sigmas,
+        }
+    }
 }
 
 /// Before/after gain of the extended model.

@@ -1865,14 +1865,9 @@ impl Named {
                 .iter()
                 .map(|&(c, estimate, sigma)| {
                     let tc = sig.cands[c];
-                    let info = &common::TERMS[tc];
-                    EquivalentTerm {
-                        term: info.name.to_string(),
-                        estimate,
-                        sigma,
-                        unit: info.display.to_string(),
-                        prior_sigmas: estimate * info.display_to_si / prior_sigma(tc, opts),
-                    }
+                    let in_prior =
+                        estimate * common::TERMS[tc].display_to_si / prior_sigma(tc, opts);
+                    EquivalentTerm::of(tc, (estimate, sigma, in_prior))
                 })
                 .collect(),
             glr_estimate: s.glr,

@@ -1238,11 +1238,12 @@ fn noise_finding(
     };
     // far below the σ the fixes state: the likely causes, as a unit check would name them
     let words = match f.level {
-        Level::Sigma(_) if f.scale <= 0.01 => format!(
-            "{words}; the {} scatter by a hundredth or less of the σ they state, as a σ written in mm but read as m would, or {} that carry no noise (smoothed or simulated)",
-            if states.contains("reference") { "rows" } else { "fixes" },
-            if states.contains("reference") { "rows" } else { "fixes" },
-        ),
+        Level::Sigma(m) if f.scale <= 0.01 => {
+            let rows = if from_reference(m) { "rows" } else { "fixes" };
+            format!(
+                "{words}; the {rows} scatter by a hundredth or less of the σ they state, as a σ written in mm but read as m would, or {rows} that carry no noise (smoothed or simulated)"
+            )
+        }
         _ => words,
     };
     let headline = words.clone();

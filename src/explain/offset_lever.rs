@@ -4,7 +4,7 @@
 //! offset, the model they name is fitted again on the fixes as given with a horizontal lever
 //! arm in the offset's place; when that fits the data as well, the offset is not named.
 
-use super::findings::Explanation;
+use super::findings::{EquivalentTerm, Explanation};
 use super::rivals::{compare, occam, Comparison, BLOCKS};
 use super::words::sig3;
 use super::{model_with, run_pass, Context, ExplainData, ExplainOptions};
@@ -117,18 +117,9 @@ pub fn offset_or_lever_arm(
     // the offset and the lever arm are one class the data do not tell apart
     let f = &mut e.findings[k];
     if let Some((x, s)) = fitted(common::TERMS[lx].name) {
-        let info = &common::TERMS[lx];
-        if !f.equivalent.iter().any(|q| q == info.name) {
-            f.equivalent.push(info.name.to_string());
-            f.equivalent_estimates
-                .push(super::findings::EquivalentTerm {
-                    term: info.name.to_string(),
-                    estimate: x / info.display_to_si,
-                    sigma: s / info.display_to_si,
-                    unit: info.display.to_string(),
-                    prior_sigmas: (x / super::prior_sigma(lx, opts)).abs(),
-                });
-        }
+        let si = common::TERMS[lx].display_to_si;
+        let prior_sigmas = (x / super::prior_sigma(lx, opts)).abs();
+        f.add_equivalent(EquivalentTerm::of(lx, (x / si, s / si, prior_sigmas)));
     }
     super::not_named(f, super::Unnamed::OffsetOrLeverArm, how);
     unattributed(e, &ctx_s, &widened, progress)

@@ -259,12 +259,9 @@ fn offset_in_place(
             && with.is_empty()
             && common::TERMS[t].sensor.enters_h()
             && !fit.better_in_few_blocks())
-        .then(|| EquivalentTerm {
-            term: rival.name.to_string(),
-            estimate: o.offset_s * unit,
-            sigma: o.sigma_s * unit,
-            unit: rival.display.to_string(),
-            prior_sigmas: (o.offset_s / prior_sigma(w, ctx.opts)).abs(),
+        .then(|| {
+            let prior_sigmas = (o.offset_s / prior_sigma(w, ctx.opts)).abs();
+            EquivalentTerm::of(w, (o.offset_s * unit, o.sigma_s * unit, prior_sigmas))
         });
         if let Some(why) = words {
             let beside = keep
@@ -308,10 +305,7 @@ impl Rival {
         f.offset_in_place = self.offset;
         match &self.tie {
             Some(eq) if f.stand_in.is_none() => {
-                if !f.equivalent.contains(&eq.term) {
-                    f.equivalent.push(eq.term.clone());
-                    f.equivalent_estimates.push(eq.clone());
-                }
+                f.add_equivalent(eq.clone());
                 f.separate_by.push(
                     "a known lever arm (--lever-arm) or offset (--gnss-delay), or a run with more changes of speed".into(),
                 );

@@ -158,7 +158,7 @@ fn unname_pairs(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOp
                 sig3(prior)
             );
             f.withheld_alike
-                .push(kept_out_term(pool[w], (est, sd, prior)));
+                .push(EquivalentTerm::of(pool[w], (est, sd, prior)));
             not_named(f, Unnamed::WithheldTermFits, why);
         }
     }
@@ -206,7 +206,7 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
             .into_iter()
             .filter(|m| may_take(t, pool[m.0]))
             .map(|(a, estimate, sigma, prior_sigmas)| {
-                kept_out_term(pool[a], (estimate, sigma, prior_sigmas))
+                EquivalentTerm::of(pool[a], (estimate, sigma, prior_sigmas))
             })
             .collect();
         let f = &mut findings[k];
@@ -273,18 +273,5 @@ fn name_taken(tried: &Tried, findings: &mut [Finding], opts: &super::ExplainOpti
                 f.withheld_alike = members;
             }
         }
-    }
-}
-
-/// Spec term `t` kept out, with the value it would need (display unit), its σ and its prior-σ
-/// count.
-fn kept_out_term(t: usize, (estimate, sigma, prior_sigmas): (f64, f64, f64)) -> EquivalentTerm {
-    let info = &common::TERMS[t];
-    EquivalentTerm {
-        term: info.name.to_string(),
-        estimate,
-        sigma,
-        unit: info.display.to_string(),
-        prior_sigmas,
     }
 }
